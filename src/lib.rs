@@ -1,1 +1,17 @@
-//! bench-sph library.
+//! bench-sph: a 2D SPH dam-break solver (Müller 2003, as ported by the seed paper) behind
+//! interchangeable parallel strategies, and the tools to measure them.
+//!
+//! - [`sph`]: the pure physics (constants, state, neighbour search, per-particle passes);
+//! - [`solver`]: one step as three passes run by a strategy's executor;
+//! - [`scene`]: initial dam-break states; [`io`]: CSV in and out;
+//! - [`run`]: timed runs; [`clock`], [`checksum`]: what a run reports;
+//! - [`cli`]: the `bench-sph` command line.
+
+pub mod checksum;
+pub mod cli;
+pub mod clock;
+pub mod io;
+pub mod run;
+pub mod scene;
+pub mod solver;
+pub mod sph;

@@ -31,7 +31,11 @@ impl<T: Send> Split for &mut [T] {
 
 impl<A: Split, B: Split> Split for (A, B) {
     fn len(&self) -> usize {
-        assert_eq!(self.0.len(), self.1.len(), "outputs split in lockstep must have equal lengths");
+        assert_eq!(
+            self.0.len(),
+            self.1.len(),
+            "outputs split in lockstep must have equal lengths"
+        );
         self.0.len()
     }
 

@@ -1,0 +1,19 @@
+//! `bench-sph list`: every strategy in the registry, one per line.
+
+use std::io::Write;
+
+use sph_strategies::StrategyName;
+
+/// Writes one line per strategy: its name, then its description.
+pub fn run(out: &mut impl Write) -> anyhow::Result<()> {
+    let width = StrategyName::ALL
+        .iter()
+        .map(|s| s.as_str().len())
+        .max()
+        .unwrap_or(0);
+    for s in StrategyName::ALL {
+        let info = s.info();
+        writeln!(out, "{:width$}  {}", info.name, info.description)?;
+    }
+    Ok(())
+}

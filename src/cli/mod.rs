@@ -1,0 +1,77 @@
+//! The `bench-sph` command line (clap derive): one module for the definitions, one per command.
+
+mod list;
+mod simulate;
+
+use clap::{Parser, Subcommand};
+use sph_strategies::StrategyName;
+
+pub use simulate::SimulateArgs;
+
+/// bench-sph: which parallel strategy wins for a 2D SPH fluid, by how much and why.
+#[derive(Debug, Parser)]
+#[command(name = "bench-sph", version, about, long_about = None)]
+pub struct Cli {
+    /// What to do.
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The commands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run the dam break once and report its time.
+    #[command(after_help = "Examples:\n  \
+        bench-sph simulate                               # the paper's run: seed preset, N = 1000, 1000 steps\n  \
+        bench-sph simulate --neighbors grid --n 100000 --steps 10\n  \
+        bench-sph simulate --steps 100 --dump final.csv --json")]
+    Simulate(SimulateArgs),
+    /// List the parallel strategies, one per line: name, then what it does.
+    List,
+}
+
+/// Parses the command line and runs the command.
+pub fn run() -> anyhow::Result<()> {
+    match Cli::parse().command {
+        Command::Simulate(args) => simulate::run(&args),
+        Command::List => list::run(&mut std::io::stdout().lock()),
+    }
+}
+
+/// A whole number of at least 1.
+fn positive(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(0) => Err("must be at least 1".to_owned()),
+        Ok(v) => Ok(v),
+        Err(_) => Err(format!("'{s}' is not a whole number of at least 1")),
+    }
+}
+
+/// A strategy name from the registry.
+fn strategy(s: &str) -> Result<StrategyName, String> {
+    s.parse::<StrategyName>().map_err(|e| e.to_string())
+}
+
+/// The machine's hardware threads (1 when unknown).
+pub fn hardware_threads() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    #[test]
+    fn the_command_line_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn zero_and_negative_counts_are_rejected() {
+        assert!(positive("0").is_err());
+        assert!(positive("-3").is_err());
+        assert!(positive("x").is_err());
+        assert_eq!(positive("12"), Ok(12));
+    }
+}

@@ -1,0 +1,183 @@
+//! `bench-sph simulate`: one run of the dam break, timed.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use clap::Args;
+use serde::Serialize;
+use sph_strategies::{Config, StrategyName};
+
+use crate::checksum::checksum_hex;
+use crate::io::{dump_csv, init_csv};
+use crate::run::{RunError, run_timed};
+use crate::scene::dam_break;
+use crate::solver::{Simulation, StepError};
+use crate::sph::neighbors::NeighborMode;
+use crate::sph::params::Preset;
+use crate::sph::state::{Domain, State};
+
+/// Options of `simulate`.
+#[derive(Debug, Clone, Args)]
+pub struct SimulateArgs {
+    /// Constants and integration order to reproduce.
+    #[arg(long, value_enum, default_value_t = Preset::Seed)]
+    pub preset: Preset,
+    /// Number of particles [default: 1000, or the row count of --init].
+    #[arg(long, value_parser = super::positive)]
+    pub n: Option<usize>,
+    /// Number of steps.
+    #[arg(long, default_value_t = 1000, value_parser = super::positive)]
+    pub steps: usize,
+    /// Neighbour search.
+    #[arg(long, value_enum, default_value_t = NeighborMode::AllPairs)]
+    pub neighbors: NeighborMode,
+    /// Parallel strategy (see `bench-sph list`).
+    #[arg(long, default_value = "seq", value_parser = super::strategy)]
+    pub strategy: StrategyName,
+    /// Worker threads [default: the machine's hardware threads].
+    #[arg(long, value_parser = super::positive)]
+    pub cores: Option<usize>,
+    /// Chunks per pass, for strategies that use chunks.
+    #[arg(long, default_value_t = 10, value_parser = super::positive)]
+    pub chunks: usize,
+    /// Seed of the initial jitter.
+    #[arg(long, default_value_t = 2019)]
+    pub seed: u64,
+    /// Initial state from CSV (header row; columns x,y required, vx,vy optional).
+    #[arg(long, value_name = "FILE.csv")]
+    pub init: Option<PathBuf>,
+    /// Write the final state to CSV (i,x,y,vx,vy,fx,fy,rho,p; exact round-trip).
+    #[arg(long, value_name = "FILE.csv")]
+    pub dump: Option<PathBuf>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What `simulate --json` prints (field names as in the study's CSVs).
+#[derive(Debug, Serialize)]
+struct Report {
+    preset: Preset,
+    neighbors: NeighborMode,
+    strategy: String,
+    cores: usize,
+    chunks: Option<usize>,
+    seed: Option<u64>,
+    init: Option<String>,
+    n: usize,
+    steps: usize,
+    wall_s: f64,
+    cpu_s: f64,
+    particle_steps_per_s: f64,
+    checksum: String,
+}
+
+/// Runs `simulate`.
+pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
+    let (state, domain) = initial_state(args)?;
+    let n = state.len();
+    // Open the dump file before the run, so a bad path costs nothing.
+    let mut dump = match &args.dump {
+        Some(path) => Some((path, create(path)?)),
+        None => None,
+    };
+    let cores = args.cores.unwrap_or_else(super::hardware_threads);
+    let config = Config {
+        cores,
+        chunks: args.chunks,
+    };
+    let mut sim = Simulation::new(args.preset.params(), domain, state, args.neighbors);
+    let outcome = run_timed(&mut sim, args.strategy, &config, args.steps);
+
+    let diverged = matches!(outcome, Err(RunError::Step(StepError::Diverged { .. })));
+    if let Some((path, out)) = dump.as_mut().filter(|_| outcome.is_ok() || diverged) {
+        dump_csv::write(&sim.state, out)
+            .with_context(|| format!("cannot write dump file '{}'", path.display()))?;
+    }
+    let elapsed = match outcome {
+        Ok(e) => e,
+        Err(err) if diverged => {
+            let note = args
+                .dump
+                .as_ref()
+                .map(|p| format!(" (state at that step written to '{}')", p.display()));
+            anyhow::bail!("{err}{}", note.unwrap_or_default());
+        }
+        Err(err) => return Err(err.into()),
+    };
+
+    let info = args.strategy.info();
+    let report = Report {
+        preset: args.preset,
+        neighbors: args.neighbors,
+        strategy: info.name.to_owned(),
+        cores: if args.strategy == StrategyName::Seq {
+            1
+        } else {
+            cores
+        },
+        chunks: info.uses_chunks.then_some(args.chunks),
+        seed: args.init.is_none().then_some(args.seed),
+        init: args.init.as_ref().map(|p| p.display().to_string()),
+        n,
+        steps: args.steps,
+        wall_s: elapsed.wall_s,
+        cpu_s: elapsed.cpu_s,
+        particle_steps_per_s: (n * args.steps) as f64 / elapsed.wall_s,
+        checksum: checksum_hex(&sim.state),
+    };
+    print_report(&report, args.json)
+}
+
+/// The initial state and its tank, from --init or the preset's dam break.
+fn initial_state(args: &SimulateArgs) -> anyhow::Result<(State, Domain)> {
+    let Some(path) = &args.init else {
+        let n = args.n.unwrap_or(1000);
+        return Ok((
+            dam_break::initial_state(args.preset, n, args.seed),
+            dam_break::domain(args.preset, n),
+        ));
+    };
+    let rows = init_csv::read(path)?;
+    let n = rows.state.len();
+    if let Some(asked) = args.n.filter(|&asked| asked != n) {
+        anyhow::bail!(
+            "--n {asked} conflicts with init file '{}', which holds {n} particles",
+            path.display()
+        );
+    }
+    let domain = dam_break::domain(args.preset, n);
+    init_csv::check_walls(path, &rows, domain)?;
+    Ok((rows.state, domain))
+}
+
+fn create(path: &Path) -> anyhow::Result<BufWriter<File>> {
+    let file = File::create(path)
+        .with_context(|| format!("cannot write dump file '{}'", path.display()))?;
+    Ok(BufWriter::new(file))
+}
+
+fn print_report(r: &Report, json: bool) -> anyhow::Result<()> {
+    let mut out = std::io::stdout().lock();
+    if json {
+        serde_json::to_writer(&mut out, r)?;
+        writeln!(out)?;
+        return Ok(());
+    }
+    let chunks = r.chunks.map_or_else(|| "n/a".to_owned(), |c| c.to_string());
+    writeln!(
+        out,
+        "preset {}, {} neighbours, strategy {} (cores {}, chunks {chunks})",
+        r.preset, r.neighbors, r.strategy, r.cores
+    )?;
+    writeln!(out, "N = {} particles, {} steps", r.n, r.steps)?;
+    writeln!(
+        out,
+        "wall {:.3} s, CPU {:.3} s (user+sys), {:.3e} particle-steps/s",
+        r.wall_s, r.cpu_s, r.particle_steps_per_s
+    )?;
+    writeln!(out, "checksum {}", r.checksum)?;
+    Ok(())
+}

@@ -1,0 +1,144 @@
+//! A uniform cell list with cell size H, rebuilt every step by a stable counting sort of the
+//! particle indices by cell: O(N + cells), deterministic, no hashing of floats.
+//!
+//! Candidates of particle i are the particles in the 3×3 cells around it. Within one row of
+//! the grid the three cells are contiguous in the sorted order, so each row is one slice. The
+//! hits are sorted by index before they are visited, so sums run in the same order as
+//! all-pairs and give the same bits.
+
+use smallvec::SmallVec;
+
+use super::{Neighbors, distance_squared};
+use crate::sph::state::{Domain, Positions};
+
+/// A cell list over a fixed domain.
+#[derive(Debug, Clone)]
+pub struct Grid {
+    /// Cell edge, px (the kernel radius).
+    cell: f64,
+    /// Cells along x.
+    cols: usize,
+    /// Cells along y.
+    rows: usize,
+    /// Particles of cell c are `order[start[c]..start[c + 1]]`, in increasing index.
+    start: Vec<u32>,
+    /// Particle indices sorted by cell (row-major), stable.
+    order: Vec<u32>,
+    /// Positions in `order`, so that a candidate scan reads contiguous memory.
+    sorted_x: Vec<f64>,
+    /// See `sorted_x`.
+    sorted_y: Vec<f64>,
+    /// Each particle's cell, from the last rebuild.
+    cell_of: Vec<u32>,
+}
+
+impl Grid {
+    /// An empty grid covering `domain` with cells of edge `h`, with room for `n` particles.
+    ///
+    /// # Panics
+    /// If the grid would need more than `u32::MAX` cells or particles.
+    pub fn new(domain: Domain, h: f64, n: usize) -> Self {
+        // Positions lie in [0, width] × [0, height]; floor(width / h) is the last column.
+        let cols = (domain.width / h) as usize + 1;
+        let rows = (domain.height / h) as usize + 1;
+        let cells = cols * rows;
+        assert!(
+            cells < u32::MAX as usize && n < u32::MAX as usize,
+            "grid too large"
+        );
+        Grid {
+            cell: h,
+            cols,
+            rows,
+            start: vec![0; cells + 1],
+            order: Vec::with_capacity(n),
+            sorted_x: Vec::with_capacity(n),
+            sorted_y: Vec::with_capacity(n),
+            cell_of: Vec::with_capacity(n),
+        }
+    }
+
+    /// The (column, row) of a position. Positions outside the domain fall into the edge
+    /// cells, which never loses a neighbour: anything within H of an edge-cell particle is in
+    /// that cell or the one next to it.
+    #[inline]
+    fn cell_coords(&self, x: f64, y: f64) -> (usize, usize) {
+        // `as usize` saturates: negative and NaN give 0, huge values clamp below.
+        let cx = ((x / self.cell) as usize).min(self.cols - 1);
+        let cy = ((y / self.cell) as usize).min(self.rows - 1);
+        (cx, cy)
+    }
+
+    /// Bytes held by the grid's arrays (capacity), for memory reports.
+    pub fn heap_bytes(&self) -> usize {
+        4 * (self.start.capacity() + self.order.capacity() + self.cell_of.capacity())
+            + 8 * (self.sorted_x.capacity() + self.sorted_y.capacity())
+    }
+}
+
+impl Neighbors for Grid {
+    fn rebuild(&mut self, pos: Positions<'_>) {
+        let n = pos.len();
+        self.cell_of.clear();
+        self.start.fill(0);
+        for i in 0..n {
+            let (cx, cy) = self.cell_coords(pos.x[i], pos.y[i]);
+            let c = cy * self.cols + cx;
+            self.cell_of.push(c as u32);
+            self.start[c] += 1;
+        }
+        // Inclusive prefix sums: start[c] is now where cell c ends.
+        let mut sum = 0;
+        for s in &mut self.start {
+            sum += *s;
+            *s = sum;
+        }
+        // Scatter from the last particle down, filling each cell from its end: each cell keeps
+        // its particles in increasing index, and start[c] ends up where cell c begins.
+        self.order.resize(n, 0);
+        for (i, &c) in self.cell_of.iter().enumerate().rev() {
+            let slot = &mut self.start[c as usize];
+            *slot -= 1;
+            self.order[*slot as usize] = i as u32;
+        }
+        self.sorted_x.clear();
+        self.sorted_y.clear();
+        self.sorted_x
+            .extend(self.order.iter().map(|&j| pos.x[j as usize]));
+        self.sorted_y
+            .extend(self.order.iter().map(|&j| pos.y[j as usize]));
+    }
+
+    #[inline]
+    fn for_each_within(
+        &self,
+        i: usize,
+        pos: Positions<'_>,
+        hsq: f64,
+        mut visit: impl FnMut(usize, f64),
+    ) {
+        let (xi, yi) = (pos.x[i], pos.y[i]);
+        let (cx, cy) = self.cell_coords(xi, yi);
+        let (c0, c1) = (cx.saturating_sub(1), (cx + 1).min(self.cols - 1));
+        // Each hit is packed as (particle index << 32 | sorted slot), so sorting the keys
+        // sorts by particle index and the slot gives back its coordinates.
+        let mut hits: SmallVec<[u64; 64]> = SmallVec::new();
+        for row in cy.saturating_sub(1)..=(cy + 1).min(self.rows - 1) {
+            let lo = self.start[row * self.cols + c0] as usize;
+            let hi = self.start[row * self.cols + c1 + 1] as usize;
+            for k in lo..hi {
+                if distance_squared(xi, yi, self.sorted_x[k], self.sorted_y[k]) < hsq {
+                    hits.push(u64::from(self.order[k]) << 32 | k as u64);
+                }
+            }
+        }
+        hits.sort_unstable();
+        for &key in &hits {
+            let k = key as u32 as usize;
+            visit(
+                (key >> 32) as usize,
+                distance_squared(xi, yi, self.sorted_x[k], self.sorted_y[k]),
+            );
+        }
+    }
+}

@@ -1,0 +1,150 @@
+//! The three passes of one step, each a pure function of one particle and read-only state
+//! (Müller, Charypar & Gross 2003, as the seed and C++ sources evaluate it; operation order
+//! is part of the contract — see the README's "Physics" section). No threads, clocks, I/O or
+//! allocation here: the solver decides which particles each call covers.
+
+use glam::DVec2;
+
+use super::neighbors::{Neighbors, distance_squared};
+use super::params::{Integrator, Params};
+use super::state::{Domain, Positions};
+
+/// Density (Müller 2003 eq. 3 with the poly6 kernel, eq. 20; self term included) and
+/// pressure `GAS_CONST · (rho − REST_DENS)` (eq. 12) of particle `i`, plus the number of its
+/// neighbours j ≠ i.
+///
+/// Contributions `(MASS·POLY6) · ((u·u)·u)`, `u = HSQ − r2`, are summed in index order from 0.
+/// The neighbours are written to `slots` in index order, as many as fit; the returned count
+/// is the true number.
+#[inline]
+pub fn density_pressure(
+    i: usize,
+    pos: Positions<'_>,
+    nb: &impl Neighbors,
+    prm: &Params,
+    slots: &mut [u32],
+) -> (f64, f64, u32) {
+    let mut rho = 0.0;
+    let mut count = 0usize;
+    nb.for_each_within(i, pos, prm.hsq, |j, r2| {
+        let u = prm.hsq - r2;
+        rho += prm.mass_poly6 * ((u * u) * u);
+        if j != i {
+            if let Some(slot) = slots.get_mut(count) {
+                *slot = j as u32;
+            }
+            count += 1;
+        }
+    });
+    (rho, prm.gas_const * (rho - prm.rest_density), count as u32)
+}
+
+/// Read-only inputs of the force pass.
+#[derive(Debug, Clone, Copy)]
+pub struct ForceInputs<'a> {
+    /// Positions.
+    pub pos: Positions<'a>,
+    /// Velocity x of every particle.
+    pub vx: &'a [f64],
+    /// Velocity y of every particle.
+    pub vy: &'a [f64],
+    /// Density of every particle, from this step's first pass.
+    pub rho: &'a [f64],
+    /// Pressure of every particle, from this step's first pass.
+    pub p: &'a [f64],
+}
+
+/// Force on particle `i`: pressure (Müller 2003 eq. 10 with the spiky gradient, eq. 21) plus
+/// viscosity (eq. 14 with the viscosity Laplacian, eq. 22) over j ≠ i with `r < H`, in index
+/// order, plus `G · rho_i`.
+///
+/// Two particles at the same point (r = 0, j ≠ i) have no pressure direction: that term is
+/// zero there (the Haskell source divides by zero), the viscosity term is still added.
+///
+/// `neighbors` is particle i's list from the density pass when it fit in its slots; without
+/// it the search is asked again. Both give the same j in the same order.
+#[inline]
+pub fn force(
+    i: usize,
+    input: &ForceInputs<'_>,
+    neighbors: Option<&[u32]>,
+    nb: &impl Neighbors,
+    prm: &Params,
+) -> DVec2 {
+    let xi = input.pos.at(i);
+    let vi = DVec2::new(input.vx[i], input.vy[i]);
+    let (rho_i, p_i) = (input.rho[i], input.p[i]);
+    let mut fpress = DVec2::ZERO;
+    let mut fvisc = DVec2::ZERO;
+    let mut add = |j: usize, r2: f64| {
+        if j == i {
+            return;
+        }
+        // r2 < HSQ can still round to r = H: the sources decide on r.
+        let r = r2.sqrt();
+        if r < prm.h {
+            let d = input.pos.at(j) - xi;
+            let (rho_j, p_j) = (input.rho[j], input.p[j]);
+            let hr = prm.h - r;
+            if r > 0.0 {
+                fpress += ((((-d / r) * prm.mass) * (p_i + p_j)) / (2.0 * rho_j))
+                    * prm.spiky_grad
+                    * (hr * hr);
+            }
+            let vj = DVec2::new(input.vx[j], input.vy[j]);
+            fvisc += (((prm.visc_mass * (vj - vi)) / rho_j) * prm.visc_lap) * hr;
+        }
+    };
+    match neighbors {
+        Some(list) => {
+            for &j in list {
+                let j = j as usize;
+                add(
+                    j,
+                    distance_squared(xi.x, xi.y, input.pos.x[j], input.pos.y[j]),
+                );
+            }
+        }
+        None => nb.for_each_within(i, input.pos, prm.hsq, add),
+    }
+    (fpress + fvisc) + prm.gravity * rho_i
+}
+
+/// Symplectic Euler step of one particle followed by the wall clamps; returns the new
+/// (position, velocity).
+///
+/// A component beyond `EPS` of a wall is put back at `EPS` and its velocity multiplied by
+/// `BOUND_DAMPING`.
+#[inline]
+pub fn integrate(
+    x: DVec2,
+    v: DVec2,
+    f: DVec2,
+    rho: f64,
+    prm: &Params,
+    domain: Domain,
+) -> (DVec2, DVec2) {
+    let mut v = match prm.integrator {
+        Integrator::Seed => v + prm.dt * (f / rho),
+        Integrator::Cpp => v + (prm.dt * f) / rho,
+    };
+    let mut x = x + prm.dt * v;
+    let eps = prm.eps;
+    if x.x - eps < 0.0 {
+        v.x *= prm.bound_damping;
+        x.x = eps;
+    }
+    if x.x + eps > domain.width {
+        v.x *= prm.bound_damping;
+        x.x = domain.width - eps;
+    }
+    if x.y - eps < 0.0 {
+        v.y *= prm.bound_damping;
+        x.y = eps;
+    }
+    if x.y + eps > domain.height {
+        v.y *= prm.bound_damping;
+        x.y = domain.height - eps;
+    }
+    (x, v)
+}

@@ -1,0 +1,131 @@
+//! The particle state, one array per field (struct of arrays).
+
+use glam::DVec2;
+
+/// The simulation domain: walls at x = 0, x = `width`, y = 0, y = `height` (px).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Domain {
+    /// Distance between the left and right walls, px.
+    pub width: f64,
+    /// Distance between the floor and the ceiling, px.
+    pub height: f64,
+}
+
+/// Every particle's fields, index `i` in each array being particle `i`.
+///
+/// `fx, fy, rho, p` hold the values computed during the most recent step (zero before the
+/// first). A pass writes some arrays and only reads the others, so passes can run in parallel
+/// over particles without copying.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct State {
+    /// Position x, px.
+    pub x: Vec<f64>,
+    /// Position y, px.
+    pub y: Vec<f64>,
+    /// Velocity x, px/s.
+    pub vx: Vec<f64>,
+    /// Velocity y, px/s.
+    pub vy: Vec<f64>,
+    /// Force x (as the sources define it: pressure + viscosity + gravity · rho).
+    pub fx: Vec<f64>,
+    /// Force y.
+    pub fy: Vec<f64>,
+    /// Density.
+    pub rho: Vec<f64>,
+    /// Pressure `GAS_CONST · (rho − REST_DENS)`.
+    pub p: Vec<f64>,
+}
+
+/// The names of [`State`]'s fields, in dump-column order.
+pub const FIELD_NAMES: [&str; 8] = ["x", "y", "vx", "vy", "fx", "fy", "rho", "p"];
+
+impl State {
+    /// A state with the given positions and velocities; force, density and pressure zero.
+    ///
+    /// # Panics
+    /// If the four arrays differ in length.
+    pub fn from_kinematics(x: Vec<f64>, y: Vec<f64>, vx: Vec<f64>, vy: Vec<f64>) -> Self {
+        let n = x.len();
+        assert!(
+            y.len() == n && vx.len() == n && vy.len() == n,
+            "field lengths differ"
+        );
+        State {
+            x,
+            y,
+            vx,
+            vy,
+            fx: vec![0.0; n],
+            fy: vec![0.0; n],
+            rho: vec![0.0; n],
+            p: vec![0.0; n],
+        }
+    }
+
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Whether there are no particles.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Particle `i`'s position.
+    pub fn position(&self, i: usize) -> DVec2 {
+        DVec2::new(self.x[i], self.y[i])
+    }
+
+    /// Particle `i`'s velocity.
+    pub fn velocity(&self, i: usize) -> DVec2 {
+        DVec2::new(self.vx[i], self.vy[i])
+    }
+
+    /// The fields in [`FIELD_NAMES`] order.
+    pub fn fields(&self) -> [&[f64]; 8] {
+        [
+            &self.x, &self.y, &self.vx, &self.vy, &self.fx, &self.fy, &self.rho, &self.p,
+        ]
+    }
+
+    /// The first non-finite value, as (field name, particle index), scanning field by field.
+    pub fn first_non_finite(&self) -> Option<(&'static str, usize)> {
+        FIELD_NAMES
+            .iter()
+            .zip(self.fields())
+            .find_map(|(name, values)| {
+                values
+                    .iter()
+                    .position(|v| !v.is_finite())
+                    .map(|i| (*name, i))
+            })
+    }
+}
+
+/// Read-only positions, as the neighbour searches and passes see them.
+#[derive(Debug, Clone, Copy)]
+pub struct Positions<'a> {
+    /// x of every particle, px.
+    pub x: &'a [f64],
+    /// y of every particle, px.
+    pub y: &'a [f64],
+}
+
+impl Positions<'_> {
+    /// Particle `i`'s position.
+    #[inline]
+    pub fn at(&self, i: usize) -> DVec2 {
+        DVec2::new(self.x[i], self.y[i])
+    }
+
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Whether there are no particles.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+}

@@ -1,0 +1,252 @@
+//! `bench-sph simulate` driven through the built binary: output, dump round trip, and a clear
+//! `Error: ...` with a non-zero exit for each kind of bad input.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn bench_sph(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Runs and expects failure whose message contains every one of `needles`.
+fn fails_with(args: &[&str], needles: &[&str]) {
+    let o = bench_sph(args);
+    let err = stderr(&o);
+    assert!(!o.status.success(), "{args:?} succeeded: {}", stdout(&o));
+    for needle in needles {
+        assert!(
+            err.contains(needle),
+            "{args:?}: stderr lacks {needle:?}:\n{err}"
+        );
+    }
+    assert!(
+        !err.contains("panicked") && !err.contains("RUST_BACKTRACE"),
+        "{args:?} panicked:\n{err}"
+    );
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.to_str().unwrap().to_owned()
+}
+
+#[test]
+fn json_output_carries_the_run_and_its_configuration() {
+    let o = bench_sph(&["simulate", "--n", "50", "--steps", "5", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("one JSON object");
+    assert_eq!(v["n"], 50);
+    assert_eq!(v["steps"], 5);
+    assert_eq!(v["preset"], "seed");
+    assert_eq!(v["neighbors"], "all-pairs");
+    assert_eq!(v["strategy"], "seq");
+    assert!(v["wall_s"].as_f64().unwrap() > 0.0);
+    assert!(v["cpu_s"].as_f64().unwrap() >= 0.0);
+    assert!(v["particle_steps_per_s"].as_f64().unwrap() > 0.0);
+    assert_eq!(v["checksum"].as_str().unwrap().len(), 16);
+}
+
+#[test]
+fn text_output_names_n_steps_wall_and_cpu_time() {
+    let o = bench_sph(&[
+        "simulate",
+        "--n",
+        "40",
+        "--steps",
+        "3",
+        "--neighbors",
+        "grid",
+        "--preset",
+        "cpp",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    for needle in [
+        "N = 40",
+        "3 steps",
+        "wall",
+        "CPU",
+        "particle-steps/s",
+        "checksum",
+        "cpp",
+        "grid",
+    ] {
+        assert!(out.contains(needle), "missing {needle:?} in\n{out}");
+    }
+}
+
+#[test]
+fn a_dump_loads_back_with_init_and_continues_exactly_as_an_unbroken_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let dump = dir.path().join("half.csv");
+    let dump = dump.to_str().unwrap();
+    let json = |args: &[&str]| -> serde_json::Value {
+        let o = bench_sph(args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_str(stdout(&o).trim()).unwrap()
+    };
+    let whole = json(&["simulate", "--n", "300", "--steps", "40", "--json"]);
+    json(&[
+        "simulate", "--n", "300", "--steps", "20", "--dump", dump, "--json",
+    ]);
+    let text = std::fs::read_to_string(dump).unwrap();
+    assert!(text.starts_with("i,x,y,vx,vy,fx,fy,rho,p\n"));
+    assert_eq!(text.lines().count(), 301);
+    let resumed = json(&["simulate", "--init", dump, "--steps", "20", "--json"]);
+    assert_eq!(resumed["n"], 300);
+    assert_eq!(resumed["checksum"], whole["checksum"]);
+}
+
+#[test]
+fn init_accepts_any_column_order_and_ignores_extra_columns() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = write(dir.path(), "s.csv", "note,y,x\na,100,200\nb,100.5,210\n");
+    let o = bench_sph(&["simulate", "--init", &f, "--steps", "2", "--json"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("\"n\":2"));
+}
+
+#[test]
+fn a_diverging_run_is_an_error_naming_step_and_particle_and_its_dump_shows_the_state() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = write(
+        dir.path(),
+        "boom.csv",
+        "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n",
+    );
+    let dump = dir.path().join("out.csv");
+    fails_with(
+        &["simulate", "--init", &f, "--dump", dump.to_str().unwrap()],
+        &["Error:", "diverged at step 1", "particle 0"],
+    );
+    assert!(std::fs::read_to_string(&dump).unwrap().contains("inf"));
+}
+
+#[test]
+fn bad_init_files_give_one_clear_error_with_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    fails_with(
+        &["simulate", "--init", "/no/such/file.csv"],
+        &["Error:", "cannot read init file", "/no/such/file.csv"],
+    );
+    fails_with(
+        &["simulate", "--init", &write(d, "empty.csv", "")],
+        &["Error:", "holds no particles"],
+    );
+    fails_with(
+        &["simulate", "--init", &write(d, "header.csv", "x,y\n")],
+        &["Error:", "holds no particles"],
+    );
+    fails_with(
+        &["simulate", "--init", &write(d, "noy.csv", "x,vx\n1,2\n")],
+        &["Error:", "missing column 'y'"],
+    );
+    fails_with(
+        &[
+            "simulate",
+            "--init",
+            &write(d, "nan.csv", "x,y\n100,100\n200,abc\n"),
+        ],
+        &["Error:", "line 3", "column 'y'", "'abc'"],
+    );
+    fails_with(
+        &["simulate", "--init", &write(d, "inf.csv", "x,y\n100,NaN\n")],
+        &["Error:", "line 2", "not a finite number"],
+    );
+    fails_with(
+        &[
+            "simulate",
+            "--init",
+            &write(d, "ragged.csv", "x,y\n100,100\n1,2,3\n"),
+        ],
+        &["Error:", "line 3"],
+    );
+    fails_with(
+        &[
+            "simulate",
+            "--init",
+            &write(d, "out.csv", "x,y\n100,100\n5000,100\n"),
+        ],
+        &["Error:", "line 3", "outside the walls"],
+    );
+    fails_with(
+        &[
+            "simulate",
+            "--init",
+            &write(d, "two.csv", "x,y\n100,100\n200,100\n"),
+            "--n",
+            "3",
+        ],
+        &["Error:", "--n 3 conflicts", "2 particles"],
+    );
+}
+
+#[test]
+fn bad_numbers_and_names_are_refused_before_anything_runs() {
+    fails_with(&["simulate", "--n", "0"], &["--n", "at least 1"]);
+    fails_with(&["simulate", "--steps", "0"], &["--steps", "at least 1"]);
+    fails_with(&["simulate", "--cores", "0"], &["--cores", "at least 1"]);
+    fails_with(&["simulate", "--chunks", "0"], &["--chunks", "at least 1"]);
+    fails_with(&["simulate", "--n", "-5"], &["-5"]);
+    fails_with(&["simulate", "--steps", "ten"], &["ten"]);
+    fails_with(
+        &["simulate", "--strategy", "turbo"],
+        &["unknown strategy 'turbo'", "seq"],
+    );
+    fails_with(
+        &["simulate", "--preset", "python"],
+        &["python", "seed", "cpp"],
+    );
+    fails_with(
+        &["simulate", "--neighbors", "octree"],
+        &["octree", "all-pairs", "grid"],
+    );
+}
+
+#[test]
+fn an_unwritable_dump_path_fails_before_the_run() {
+    let o = bench_sph(&[
+        "simulate",
+        "--n",
+        "10",
+        "--steps",
+        "100000000",
+        "--dump",
+        "/no/such/dir/out.csv",
+    ]);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(
+        err.starts_with("Error: cannot write dump file '/no/such/dir/out.csv'"),
+        "{err}"
+    );
+}
+
+#[test]
+fn list_prints_one_strategy_per_line_name_first() {
+    let o = bench_sph(&["list"]);
+    assert!(o.status.success());
+    let out = stdout(&o);
+    let names: Vec<&str> = out
+        .lines()
+        .map(|l| l.split_whitespace().next().unwrap())
+        .collect();
+    assert_eq!(names, sph_strategies::StrategyName::names());
+    assert!(
+        out.lines().all(|l| l.split_whitespace().count() > 3),
+        "each line has a description"
+    );
+}

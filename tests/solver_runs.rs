@@ -1,0 +1,133 @@
+//! Whole runs of the solver: the two neighbour searches agree, the reference run stays finite
+//! and inside the walls, and a diverging run stops with an error naming step and particle.
+
+use bench_sph::run::{RunError, run_timed};
+use bench_sph::scene::dam_break;
+use bench_sph::solver::{Simulation, StepError};
+use bench_sph::sph::neighbors::NeighborMode;
+use bench_sph::sph::params::Preset;
+use bench_sph::sph::state::{Domain, FIELD_NAMES, State};
+use sph_strategies::{Config, StrategyName};
+
+const SEQ: Config = Config {
+    cores: 1,
+    chunks: 1,
+};
+
+fn run(preset: Preset, n: usize, steps: usize, mode: NeighborMode) -> State {
+    let mut sim = Simulation::new(
+        preset.params(),
+        dam_break::domain(preset, n),
+        dam_break::initial_state(preset, n, 2019),
+        mode,
+    );
+    run_timed(&mut sim, StrategyName::Seq, &SEQ, steps).expect("run completes");
+    sim.state
+}
+
+/// Per field: max |a - b| <= tol * max |b| over all particles.
+fn max_relative_gap(a: &State, b: &State) -> Vec<(&'static str, f64)> {
+    FIELD_NAMES
+        .iter()
+        .zip(a.fields().iter().zip(b.fields()))
+        .map(|(name, (fa, fb))| {
+            let gap = fa
+                .iter()
+                .zip(fb.iter())
+                .map(|(x, y)| (x - y).abs())
+                .fold(0.0, f64::max);
+            let scale = fb.iter().map(|y| y.abs()).fold(0.0, f64::max);
+            (*name, if scale == 0.0 { gap } else { gap / scale })
+        })
+        .collect()
+}
+
+#[test]
+fn grid_agrees_with_all_pairs_to_1e_9_after_10_steps_for_both_presets() {
+    for preset in Preset::ALL {
+        let all_pairs = run(preset, 1000, 10, NeighborMode::AllPairs);
+        let grid = run(preset, 1000, 10, NeighborMode::Grid);
+        for (field, gap) in max_relative_gap(&grid, &all_pairs) {
+            assert!(gap <= 1e-9, "{preset} {field}: relative gap {gap:e}");
+        }
+    }
+}
+
+#[test]
+fn grid_visits_neighbours_in_index_order_so_it_gives_the_same_bits_as_all_pairs() {
+    for preset in Preset::ALL {
+        assert_eq!(
+            run(preset, 700, 200, NeighborMode::Grid),
+            run(preset, 700, 200, NeighborMode::AllPairs)
+        );
+    }
+}
+
+#[test]
+fn the_reference_run_stays_finite_and_inside_the_walls() {
+    let domain = dam_break::domain(Preset::Seed, 1000);
+    let s = run(Preset::Seed, 1000, 1000, NeighborMode::AllPairs);
+    assert_eq!(s.first_non_finite(), None);
+    let eps = 16.0;
+    for i in 0..s.len() {
+        assert!(
+            (eps..=domain.width - eps).contains(&s.x[i]),
+            "particle {i} x = {}",
+            s.x[i]
+        );
+        assert!(
+            (eps..=domain.height - eps).contains(&s.y[i]),
+            "particle {i} y = {}",
+            s.y[i]
+        );
+    }
+    // The dam has collapsed: particles reached the floor and spread to the right.
+    assert!(s.y.iter().cloned().fold(f64::MAX, f64::min) < 40.0);
+    assert!(s.x.iter().cloned().fold(0.0, f64::max) > 900.0);
+}
+
+#[test]
+fn a_run_past_the_layout_capacity_grows_the_tank_and_stays_inside_it() {
+    let n = 3000; // more than the seed layout's 1406
+    let domain = dam_break::domain(Preset::Seed, n);
+    assert!(domain.width > 1200.0);
+    let s = run(Preset::Seed, n, 20, NeighborMode::Grid);
+    assert_eq!(s.first_non_finite(), None);
+    assert!(
+        s.x.iter()
+            .all(|&x| (16.0..=domain.width - 16.0).contains(&x))
+    );
+}
+
+#[test]
+fn a_diverging_run_stops_with_the_step_and_particle_that_went_non_finite() {
+    // Opposite velocities near f64::MAX: the viscosity difference overflows to infinity.
+    let init = State::from_kinematics(
+        vec![500.0, 505.0],
+        vec![500.0, 500.0],
+        vec![0.0, 0.0],
+        vec![1e308, -1e308],
+    );
+    let mut sim = Simulation::new(
+        Preset::Seed.params(),
+        Domain {
+            width: 1200.0,
+            height: 900.0,
+        },
+        init,
+        NeighborMode::AllPairs,
+    );
+    let err = run_timed(&mut sim, StrategyName::Seq, &SEQ, 5).unwrap_err();
+    match err {
+        RunError::Step(StepError::Diverged {
+            step,
+            particle,
+            field,
+        }) => {
+            assert_eq!((step, particle), (1, 0));
+            assert!(FIELD_NAMES.contains(&field));
+        }
+        other => panic!("expected divergence, got {other}"),
+    }
+    assert_eq!(sim.steps_done, 1);
+}
