@@ -14,12 +14,29 @@
 //!    [`Executor::for_each_chunk`] once per pass, as often as it likes.
 //!
 //! Strategies are chosen by name through the [registry](StrategyName); adding one is one new
-//! file plus one registry line.
+//! file plus one registry line. They are [`seq`], [`rayon_iter`], [`rayon_spawn`],
+//! [`rayon_chunks`], [`crossbeam_pool`] and [`std_static`]; each module's documentation says
+//! how it schedules a pass and what that costs. The rayon strategies own a pool of exactly
+//! `cores` threads built in [`Strategy::build`]; `crossbeam-pool` starts its `cores` threads
+//! once per run; `std-static` starts threads on every pass.
+//!
+//! All of this is safe Rust except one small private module, `erased_job`, which lets
+//! `crossbeam-pool`'s long-lived threads call a kernel borrowed for one pass (its safe API
+//! returns only once every worker is done with the kernel; see the `// SAFETY:` notes there).
 
+pub mod crossbeam_pool;
+mod erased_job;
 mod panic;
+pub mod rayon_chunks;
+pub mod rayon_iter;
+mod rayon_pool;
+pub mod rayon_spawn;
 mod registry;
 pub mod seq;
 mod split;
+pub mod std_static;
+#[cfg(test)]
+mod testing;
 
 pub use panic::KernelPanic;
 pub use registry::{StrategyName, UnknownStrategy, run};

@@ -50,6 +50,11 @@ macro_rules! registry {
 
 registry! {
     Seq => seq::Seq,
+    RayonIter => rayon_iter::RayonIter,
+    RayonSpawn => rayon_spawn::RayonSpawn,
+    RayonChunks => rayon_chunks::RayonChunks,
+    CrossbeamPool => crossbeam_pool::CrossbeamPool,
+    StdStatic => std_static::StdStatic,
 }
 
 impl StrategyName {
