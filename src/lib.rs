@@ -5,12 +5,14 @@
 //! - [`solver`]: one step as three passes run by a strategy's executor;
 //! - [`scene`]: initial dam-break states; [`io`]: CSV in and out;
 //! - [`run`]: timed runs; [`clock`], [`checksum`]: what a run reports;
+//! - [`plot`]: the bundled font shared by charts and animations;
 //! - [`cli`]: the `bench-sph` command line.
 
 pub mod checksum;
 pub mod cli;
 pub mod clock;
 pub mod io;
+pub mod plot;
 pub mod run;
 pub mod scene;
 pub mod solver;
