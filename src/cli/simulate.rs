@@ -54,6 +54,10 @@ pub struct SimulateArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Test-only: make the density kernel panic at this particle, to check that a worker's
+    /// panic becomes an error of the run on every strategy.
+    #[arg(long, hide = true, value_name = "PARTICLE")]
+    pub inject_panic_at: Option<usize>,
 }
 
 /// What `simulate --json` prints (field names as in the study's CSVs).
@@ -89,6 +93,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         chunks: args.chunks,
     };
     let mut sim = Simulation::new(args.preset.params(), domain, state, args.neighbors);
+    sim.inject_panic_at(args.inject_panic_at);
     let outcome = run_timed(&mut sim, args.strategy, &config, args.steps);
 
     let diverged = matches!(outcome, Err(RunError::Step(StepError::Diverged { .. })));

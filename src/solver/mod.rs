@@ -1,11 +1,13 @@
 //! One step = three passes over all particles, each handed to a strategy's executor, plus the
-//! grid rebuild before them and the divergence check after them.
+//! grid rebuild before them and the divergence check after them. How each pass is cut into
+//! kernel calls lives in [`schedule`].
+
+mod schedule;
 
 use sph_strategies::{Executor, KernelPanic};
 
-use crate::sph::neighbors::{self, AnyNeighbors, NeighborLists, NeighborMode, Neighbors, SlotsMut};
+use crate::sph::neighbors::{self, AnyNeighbors, NeighborLists, NeighborMode, Neighbors};
 use crate::sph::params::Params;
-use crate::sph::passes::{self, ForceInputs};
 use crate::sph::state::{Domain, Positions, State};
 
 /// Why a step failed.
@@ -44,6 +46,43 @@ pub struct Simulation {
     pub steps_done: usize,
     neighbors: AnyNeighbors,
     lists: NeighborLists,
+    fault: Option<usize>,
+}
+
+/// One pass of a step, for benchmarks and traces.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Pass {
+    /// Density and pressure (and each particle's neighbour list).
+    Density,
+    /// Pressure, viscosity and gravity forces.
+    Forces,
+    /// Symplectic Euler and the walls.
+    Integrate,
+}
+
+impl Pass {
+    /// The three passes in step order.
+    pub const ALL: [Pass; 3] = [Pass::Density, Pass::Forces, Pass::Integrate];
+
+    /// Lower-case name, as in bench ids and traces.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Pass::Density => "density",
+            Pass::Forces => "forces",
+            Pass::Integrate => "integrate",
+        }
+    }
+}
+
+/// Runs `$body` with `$nb` bound to the concrete search inside `$any`, so that the code in
+/// `$body` is monomorphised per search (picked once per call, not per particle).
+macro_rules! with_search {
+    ($any:expr, $nb:ident => $body:expr) => {
+        match $any {
+            AnyNeighbors::AllPairs($nb) => $body,
+            AnyNeighbors::Grid($nb) => $body,
+        }
+    };
 }
 
 impl Simulation {
@@ -58,21 +97,22 @@ impl Simulation {
             steps_done: 0,
             neighbors,
             lists,
+            fault: None,
         }
+    }
+
+    /// Makes the density kernel panic when it reaches `particle` (test-only fault injection,
+    /// checked once per kernel call, to exercise the strategies' panic handling end to end).
+    pub fn inject_panic_at(&mut self, particle: Option<usize>) {
+        self.fault = particle;
     }
 
     /// Runs `steps` steps on `exec`. Stops at the first failing step.
     pub fn advance<E: Executor>(&mut self, exec: &E, steps: usize) -> Result<(), StepError> {
         for _ in 0..steps {
             let step = self.steps_done + 1;
-            // The search is picked once per step; the passes are monomorphised per search.
-            let (lists, state, prm, domain) =
-                (&mut self.lists, &mut self.state, &self.params, self.domain);
-            match &mut self.neighbors {
-                AnyNeighbors::AllPairs(nb) => step_once(exec, nb, lists, state, prm, domain),
-                AnyNeighbors::Grid(nb) => step_once(exec, nb, lists, state, prm, domain),
-            }
-            .map_err(|source| StepError::Kernel { step, source })?;
+            self.step_once(exec)
+                .map_err(|source| StepError::Kernel { step, source })?;
             self.steps_done = step;
             if let Some((field, particle)) = self.state.first_non_finite() {
                 return Err(StepError::Diverged {
@@ -85,6 +125,38 @@ impl Simulation {
         Ok(())
     }
 
+    /// One step without the divergence check: rebuild the search, then the three passes.
+    fn step_once<E: Executor>(&mut self, exec: &E) -> Result<(), KernelPanic> {
+        self.rebuild_neighbors();
+        Pass::ALL
+            .into_iter()
+            .try_for_each(|pass| self.run_pass(exec, pass))
+    }
+
+    /// Brings the neighbour search up to date with the current positions.
+    pub fn rebuild_neighbors(&mut self) {
+        let pos = Positions {
+            x: &self.state.x,
+            y: &self.state.y,
+        };
+        with_search!(&mut self.neighbors, nb => nb.rebuild(pos));
+    }
+
+    /// Runs one pass over all particles on `exec`. The density pass needs an up-to-date search
+    /// ([`Simulation::rebuild_neighbors`]); the force pass needs this step's densities.
+    pub fn run_pass<E: Executor>(&mut self, exec: &E, pass: Pass) -> Result<(), KernelPanic> {
+        let (s, prm, lists) = (&mut self.state, &self.params, &mut self.lists);
+        match pass {
+            Pass::Density => {
+                with_search!(&self.neighbors, nb => schedule::density(exec, nb, lists, s, prm, self.fault))
+            }
+            Pass::Forces => {
+                with_search!(&self.neighbors, nb => schedule::forces(exec, nb, lists, s, prm))
+            }
+            Pass::Integrate => schedule::integrate(exec, s, prm, self.domain),
+        }
+    }
+
     /// Bytes held by the neighbour search and lists, for memory reports.
     pub fn neighbor_heap_bytes(&self) -> usize {
         self.lists.heap_bytes()
@@ -93,65 +165,4 @@ impl Simulation {
                 AnyNeighbors::Grid(g) => g.heap_bytes(),
             }
     }
-}
-
-/// Density and pressure, then forces, then integration, each pass over all particles.
-fn step_once<E: Executor, N: Neighbors>(
-    exec: &E,
-    nb: &mut N,
-    lists: &mut NeighborLists,
-    s: &mut State,
-    prm: &Params,
-    domain: Domain,
-) -> Result<(), KernelPanic> {
-    nb.rebuild(Positions { x: &s.x, y: &s.y });
-    let nb = &*nb;
-    let pos = Positions { x: &s.x, y: &s.y };
-
-    let out = (
-        &mut s.rho[..],
-        &mut s.p[..],
-        &mut lists.count[..],
-        SlotsMut(&mut lists.slots[..]),
-    );
-    exec.for_each_chunk(out, |first, (rho, p, count, mut slots)| {
-        for (k, ((rho, p), count)) in rho.iter_mut().zip(p).zip(count).enumerate() {
-            (*rho, *p, *count) =
-                passes::density_pressure(first + k, pos, nb, prm, slots.particle(k));
-        }
-    })?;
-
-    let lists = &*lists;
-    let input = ForceInputs {
-        pos,
-        vx: &s.vx,
-        vy: &s.vy,
-        rho: &s.rho,
-        p: &s.p,
-    };
-    exec.for_each_chunk((&mut s.fx[..], &mut s.fy[..]), |first, (fx, fy)| {
-        for (k, (fx, fy)) in fx.iter_mut().zip(fy).enumerate() {
-            let i = first + k;
-            let f = passes::force(i, &input, lists.of(i), nb, prm);
-            (*fx, *fy) = (f.x, f.y);
-        }
-    })?;
-
-    let (fx, fy, rho) = (&s.fx, &s.fy, &s.rho);
-    let out = (&mut s.x[..], &mut s.y[..], &mut s.vx[..], &mut s.vy[..]);
-    exec.for_each_chunk(out, |first, (x, y, vx, vy)| {
-        for (k, (((x, y), vx), vy)) in x.iter_mut().zip(y).zip(vx).zip(vy).enumerate() {
-            let i = first + k;
-            let f = glam::DVec2::new(fx[i], fy[i]);
-            let (p, v) = passes::integrate(
-                glam::DVec2::new(*x, *y),
-                glam::DVec2::new(*vx, *vy),
-                f,
-                rho[i],
-                prm,
-                domain,
-            );
-            (*x, *y, *vx, *vy) = (p.x, p.y, v.x, v.y);
-        }
-    })
 }

@@ -1,0 +1,88 @@
+//! Each pass as one `for_each_chunk` call: which arrays it writes (cut in lockstep into the
+//! strategy's chunks), which it only reads, and the per-particle function it applies.
+
+use glam::DVec2;
+use sph_strategies::{Executor, KernelPanic};
+
+use crate::sph::neighbors::{NeighborLists, Neighbors, SlotsMut};
+use crate::sph::params::Params;
+use crate::sph::passes::{self, ForceInputs};
+use crate::sph::state::{Domain, Positions, State};
+
+/// Writes rho, p and the neighbour lists; reads positions.
+pub fn density<E: Executor, N: Neighbors>(
+    exec: &E,
+    nb: &N,
+    lists: &mut NeighborLists,
+    s: &mut State,
+    prm: &Params,
+    fault: Option<usize>,
+) -> Result<(), KernelPanic> {
+    let pos = Positions { x: &s.x, y: &s.y };
+    let out = (
+        &mut s.rho[..],
+        &mut s.p[..],
+        &mut lists.count[..],
+        SlotsMut(&mut lists.slots[..]),
+    );
+    exec.for_each_chunk(out, |first, (rho, p, count, mut slots)| {
+        if let Some(i) = fault.filter(|i| (first..first + rho.len()).contains(i)) {
+            panic!("injected fault at particle {i}");
+        }
+        for (k, ((rho, p), count)) in rho.iter_mut().zip(p).zip(count).enumerate() {
+            (*rho, *p, *count) =
+                passes::density_pressure(first + k, pos, nb, prm, slots.particle(k));
+        }
+    })
+}
+
+/// Writes fx, fy; reads positions, velocities, rho, p and the neighbour lists.
+pub fn forces<E: Executor, N: Neighbors>(
+    exec: &E,
+    nb: &N,
+    lists: &NeighborLists,
+    s: &mut State,
+    prm: &Params,
+) -> Result<(), KernelPanic> {
+    let pos = Positions { x: &s.x, y: &s.y };
+    let input = ForceInputs {
+        pos,
+        vx: &s.vx,
+        vy: &s.vy,
+        rho: &s.rho,
+        p: &s.p,
+    };
+    exec.for_each_chunk((&mut s.fx[..], &mut s.fy[..]), |first, (fx, fy)| {
+        for (k, (fx, fy)) in fx.iter_mut().zip(fy).enumerate() {
+            let i = first + k;
+            let f = passes::force(i, &input, lists.of(i), nb, prm);
+            (*fx, *fy) = (f.x, f.y);
+        }
+    })
+}
+
+/// Writes positions and velocities (each particle only its own); reads fx, fy, rho.
+pub fn integrate<E: Executor>(
+    exec: &E,
+    s: &mut State,
+    prm: &Params,
+    domain: Domain,
+) -> Result<(), KernelPanic> {
+    let (fx, fy, rho) = (&s.fx, &s.fy, &s.rho);
+    let out = (&mut s.x[..], &mut s.y[..], &mut s.vx[..], &mut s.vy[..]);
+    exec.for_each_chunk(out, |first, (x, y, vx, vy)| {
+        for (k, (((x, y), vx), vy)) in x.iter_mut().zip(y).zip(vx).zip(vy).enumerate() {
+            let i = first + k;
+            let f = DVec2::new(fx[i], fy[i]);
+            let (p, v) = passes::integrate(
+                DVec2::new(*x, *y),
+                DVec2::new(*vx, *vy),
+                f,
+                rho[i],
+                prm,
+                domain,
+            );
+            (*x, *y, *vx, *vy) = (p.x, p.y, v.x, v.y);
+        }
+    })
+}

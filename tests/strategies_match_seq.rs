@@ -1,0 +1,130 @@
+//! Every strategy gives the sequential run's bits, whatever the cores and chunks, and a panic
+//! inside a kernel becomes an error of the run (never a hang) on every strategy.
+
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use bench_sph::run::run_timed;
+use bench_sph::scene::dam_break;
+use bench_sph::solver::Simulation;
+use bench_sph::sph::neighbors::NeighborMode;
+use bench_sph::sph::params::Preset;
+use bench_sph::sph::state::{FIELD_NAMES, State};
+use sph_strategies::{Config, StrategyName};
+
+const N: usize = 500;
+const STEPS: usize = 25;
+
+fn run(
+    preset: Preset,
+    mode: NeighborMode,
+    strategy: StrategyName,
+    cores: usize,
+    chunks: usize,
+) -> State {
+    let mut sim = Simulation::new(
+        preset.params(),
+        dam_break::domain(preset, N),
+        dam_break::initial_state(preset, N, 7),
+        mode,
+    );
+    run_timed(&mut sim, strategy, &Config { cores, chunks }, STEPS)
+        .unwrap_or_else(|e| panic!("{strategy} cores={cores} chunks={chunks}: {e}"));
+    sim.state
+}
+
+fn first_bit_difference(a: &State, b: &State) -> Option<String> {
+    FIELD_NAMES
+        .iter()
+        .zip(a.fields().iter().zip(b.fields()))
+        .find_map(|(name, (fa, fb))| {
+            fa.iter()
+                .zip(fb.iter())
+                .position(|(x, y)| x.to_bits() != y.to_bits())
+                .map(|i| format!("{name}[{i}]: {:e} vs {:e}", fa[i], fb[i]))
+        })
+}
+
+#[test]
+fn every_strategy_cores_and_chunks_gives_the_bits_of_the_sequential_run() {
+    for preset in Preset::ALL {
+        for mode in NeighborMode::ALL {
+            let reference = run(preset, mode, StrategyName::Seq, 1, 1);
+            for &strategy in StrategyName::ALL {
+                for cores in [1, 2, 3, 5] {
+                    for chunks in [1, 7, 64, N, 2 * N] {
+                        let got = run(preset, mode, strategy, cores, chunks);
+                        if let Some(diff) = first_bit_difference(&got, &reference) {
+                            panic!(
+                                "{preset} {mode} {strategy} cores={cores} chunks={chunks}: {diff}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn more_cores_and_chunks_than_particles_still_match_the_sequential_run() {
+    let tiny = |strategy, cores, chunks| {
+        let init = dam_break::initial_state(Preset::Seed, 3, 1);
+        let mut sim = Simulation::new(
+            Preset::Seed.params(),
+            dam_break::domain(Preset::Seed, 3),
+            init,
+            NeighborMode::Grid,
+        );
+        run_timed(&mut sim, strategy, &Config { cores, chunks }, 10).expect("runs");
+        sim.state
+    };
+    let reference = tiny(StrategyName::Seq, 1, 1);
+    for &strategy in StrategyName::ALL {
+        assert_eq!(
+            first_bit_difference(&tiny(strategy, 8, 50), &reference),
+            None,
+            "{strategy}"
+        );
+    }
+}
+
+#[test]
+fn a_kernel_panic_on_a_worker_is_an_error_of_the_run_for_every_strategy() {
+    for &strategy in StrategyName::ALL {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+            .args([
+                "simulate",
+                "--strategy",
+                strategy.as_str(),
+                "--cores",
+                "2",
+                "--chunks",
+                "7",
+            ])
+            .args(["--n", "200", "--steps", "50", "--inject-panic-at", "150"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("binary starts");
+        let started = Instant::now();
+        let status = loop {
+            if let Some(status) = child.try_wait().expect("wait") {
+                break status;
+            }
+            if started.elapsed() > Duration::from_secs(60) {
+                child.kill().ok();
+                panic!("{strategy}: still running after a kernel panic (hang)");
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        };
+        let mut err = String::new();
+        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
+        assert!(!status.success(), "{strategy}: exited successfully");
+        assert!(
+            err.contains("Error: step 1 failed") && err.contains("injected fault at particle 150"),
+            "{strategy}: {err}"
+        );
+        assert!(!err.contains("RUST_BACKTRACE"), "{strategy}: {err}");
+    }
+}
