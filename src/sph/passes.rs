@@ -71,43 +71,61 @@ pub fn force(
     nb: &impl Neighbors,
     prm: &Params,
 ) -> DVec2 {
-    let xi = input.pos.at(i);
-    let vi = DVec2::new(input.vx[i], input.vy[i]);
-    let (rho_i, p_i) = (input.rho[i], input.p[i]);
-    let mut fpress = DVec2::ZERO;
-    let mut fvisc = DVec2::ZERO;
-    let mut add = |j: usize, r2: f64| {
-        if j == i {
-            return;
-        }
-        // r2 < HSQ can still round to r = H: the sources decide on r.
-        let r = r2.sqrt();
-        if r < prm.h {
-            let d = input.pos.at(j) - xi;
-            let (rho_j, p_j) = (input.rho[j], input.p[j]);
-            let hr = prm.h - r;
-            if r > 0.0 {
-                fpress += ((((-d / r) * prm.mass) * (p_i + p_j)) / (2.0 * rho_j))
-                    * prm.spiky_grad
-                    * (hr * hr);
-            }
-            let vj = DVec2::new(input.vx[j], input.vy[j]);
-            fvisc += (((prm.visc_mass * (vj - vi)) / rho_j) * prm.visc_lap) * hr;
-        }
+    let me = Particle {
+        x: input.pos.at(i),
+        v: DVec2::new(input.vx[i], input.vy[i]),
+        p: input.p[i],
     };
+    let mut acc = (DVec2::ZERO, DVec2::ZERO);
     match neighbors {
         Some(list) => {
             for &j in list {
                 let j = j as usize;
-                add(
-                    j,
-                    distance_squared(xi.x, xi.y, input.pos.x[j], input.pos.y[j]),
-                );
+                let r2 = distance_squared(me.x.x, me.x.y, input.pos.x[j], input.pos.y[j]);
+                add_pair_force(&mut acc, &me, j, r2, input, prm);
             }
         }
-        None => nb.for_each_within(i, input.pos, prm.hsq, add),
+        None => nb.for_each_within(i, input.pos, prm.hsq, |j, r2| {
+            if j != i {
+                add_pair_force(&mut acc, &me, j, r2, input, prm);
+            }
+        }),
     }
-    (fpress + fvisc) + prm.gravity * rho_i
+    let (fpress, fvisc) = acc;
+    (fpress + fvisc) + prm.gravity * input.rho[i]
+}
+
+/// What the force pass needs of particle i.
+struct Particle {
+    x: DVec2,
+    v: DVec2,
+    p: f64,
+}
+
+/// Adds neighbour j's pressure and viscosity terms to `(fpress, fvisc)` when `r < H`.
+#[inline(always)]
+fn add_pair_force(
+    acc: &mut (DVec2, DVec2),
+    me: &Particle,
+    j: usize,
+    r2: f64,
+    input: &ForceInputs<'_>,
+    prm: &Params,
+) {
+    // r2 < HSQ can still round to r = H: the sources decide on r.
+    let r = r2.sqrt();
+    if r < prm.h {
+        let d = input.pos.at(j) - me.x;
+        let (rho_j, p_j) = (input.rho[j], input.p[j]);
+        let hr = prm.h - r;
+        if r > 0.0 {
+            acc.0 += ((((-d / r) * prm.mass) * (me.p + p_j)) / (2.0 * rho_j))
+                * prm.spiky_grad
+                * (hr * hr);
+        }
+        let vj = DVec2::new(input.vx[j], input.vy[j]);
+        acc.1 += (((prm.visc_mass * (vj - me.v)) / rho_j) * prm.visc_lap) * hr;
+    }
 }
 
 /// Symplectic Euler step of one particle followed by the wall clamps; returns the new

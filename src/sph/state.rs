@@ -94,13 +94,25 @@ impl State {
         FIELD_NAMES
             .iter()
             .zip(self.fields())
-            .find_map(|(name, values)| {
-                values
-                    .iter()
-                    .position(|v| !v.is_finite())
-                    .map(|i| (*name, i))
-            })
+            .find_map(|(name, values)| first_non_finite(values).map(|i| (*name, i)))
     }
+}
+
+/// Index of the first NaN or infinity in `values`. Blocks are checked without branching
+/// (so the common all-finite case vectorises) and only a failing block is searched.
+fn first_non_finite(values: &[f64]) -> Option<usize> {
+    const BLOCK: usize = 64;
+    values.chunks(BLOCK).enumerate().find_map(|(b, block)| {
+        let all_finite = block.iter().fold(true, |ok, v| ok & v.is_finite());
+        if all_finite {
+            None
+        } else {
+            block
+                .iter()
+                .position(|v| !v.is_finite())
+                .map(|k| b * BLOCK + k)
+        }
+    })
 }
 
 /// Read-only positions, as the neighbour searches and passes see them.

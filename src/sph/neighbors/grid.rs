@@ -3,13 +3,14 @@
 //!
 //! Candidates of particle i are the particles in the 3×3 cells around it. Within one row of
 //! the grid the three cells are contiguous in the sorted order, so each row is one slice. The
-//! hits are sorted by index before they are visited, so sums run in the same order as
+//! hits are put in index order before they are visited, so sums run in the same order as
 //! all-pairs and give the same bits.
-
-use smallvec::SmallVec;
 
 use super::{Neighbors, distance_squared};
 use crate::sph::state::{Domain, Positions};
+
+/// Hits of one particle kept on the stack before spilling to the heap.
+const INLINE_HITS: usize = 48;
 
 /// A cell list over a fixed domain.
 #[derive(Debug, Clone)]
@@ -120,25 +121,46 @@ impl Neighbors for Grid {
         let (xi, yi) = (pos.x[i], pos.y[i]);
         let (cx, cy) = self.cell_coords(xi, yi);
         let (c0, c1) = (cx.saturating_sub(1), (cx + 1).min(self.cols - 1));
-        // Each hit is packed as (particle index << 32 | sorted slot), so sorting the keys
-        // sorts by particle index and the slot gives back its coordinates.
-        let mut hits: SmallVec<[u64; 64]> = SmallVec::new();
+        // Hits are kept sorted by particle index as they arrive (insertion into a small stack
+        // buffer: a particle has about 5-30 hits, mostly nearly in order). A crowd beyond the
+        // buffer spills into a vector that is sorted once.
+        let mut index = [0u32; INLINE_HITS];
+        let mut dist2 = [0.0f64; INLINE_HITS];
+        let mut len = 0;
+        let mut spilled: Vec<(u32, f64)> = Vec::new();
         for row in cy.saturating_sub(1)..=(cy + 1).min(self.rows - 1) {
             let lo = self.start[row * self.cols + c0] as usize;
             let hi = self.start[row * self.cols + c1 + 1] as usize;
             for k in lo..hi {
-                if distance_squared(xi, yi, self.sorted_x[k], self.sorted_y[k]) < hsq {
-                    hits.push(u64::from(self.order[k]) << 32 | k as u64);
+                let r2 = distance_squared(xi, yi, self.sorted_x[k], self.sorted_y[k]);
+                if r2 < hsq {
+                    let j = self.order[k];
+                    if len == INLINE_HITS {
+                        spilled.push((j, r2));
+                        continue;
+                    }
+                    let mut slot = len;
+                    while slot > 0 && index[slot - 1] > j {
+                        index[slot] = index[slot - 1];
+                        dist2[slot] = dist2[slot - 1];
+                        slot -= 1;
+                    }
+                    index[slot] = j;
+                    dist2[slot] = r2;
+                    len += 1;
                 }
             }
         }
-        hits.sort_unstable();
-        for &key in &hits {
-            let k = key as u32 as usize;
-            visit(
-                (key >> 32) as usize,
-                distance_squared(xi, yi, self.sorted_x[k], self.sorted_y[k]),
-            );
+        if spilled.is_empty() {
+            for (&j, &r2) in index[..len].iter().zip(&dist2[..len]) {
+                visit(j as usize, r2);
+            }
+        } else {
+            spilled.extend(index.iter().copied().zip(dist2));
+            spilled.sort_unstable_by_key(|&(j, _)| j);
+            for (j, r2) in spilled {
+                visit(j as usize, r2);
+            }
         }
     }
 }
