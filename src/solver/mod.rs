@@ -114,7 +114,12 @@ impl Simulation {
             self.step_once(exec)
                 .map_err(|source| StepError::Kernel { step, source })?;
             self.steps_done = step;
-            if let Some((field, particle)) = self.state.first_non_finite() {
+            // Any non-finite density, pressure, force or position makes the particle's own
+            // velocity non-finite in the same step, so checking velocities (2 arrays rather
+            // than 8) catches every divergence; the full scan then names the first field.
+            if !self.state.velocities_finite()
+                && let Some((field, particle)) = self.state.first_non_finite()
+            {
                 return Err(StepError::Diverged {
                     step,
                     particle,
@@ -127,19 +132,26 @@ impl Simulation {
 
     /// One step without the divergence check: rebuild the search, then the three passes.
     fn step_once<E: Executor>(&mut self, exec: &E) -> Result<(), KernelPanic> {
-        self.rebuild_neighbors();
+        self.rebuild_neighbors_on(exec)?;
         Pass::ALL
             .into_iter()
             .try_for_each(|pass| self.run_pass(exec, pass))
     }
 
-    /// Brings the neighbour search up to date with the current positions.
-    pub fn rebuild_neighbors(&mut self) {
+    /// Brings the neighbour search up to date with the current positions, on `exec`.
+    pub fn rebuild_neighbors_on<E: Executor>(&mut self, exec: &E) -> Result<(), KernelPanic> {
         let pos = Positions {
             x: &self.state.x,
             y: &self.state.y,
         };
-        with_search!(&mut self.neighbors, nb => nb.rebuild(pos));
+        with_search!(&mut self.neighbors, nb => nb.rebuild(exec, pos))
+    }
+
+    /// Brings the neighbour search up to date with the current positions, on this thread.
+    pub fn rebuild_neighbors(&mut self) {
+        let run = self.rebuild_neighbors_on(&sph_strategies::seq::SeqExecutor);
+        // The rebuild's kernels only compute cell numbers and copy positions.
+        run.expect("a sequential grid rebuild cannot panic");
     }
 
     /// Runs one pass over all particles on `exec`. The density pass needs an up-to-date search

@@ -89,6 +89,12 @@ impl State {
         ]
     }
 
+    /// Whether every velocity component is finite (a quick check; see the solver's
+    /// divergence guard).
+    pub fn velocities_finite(&self) -> bool {
+        first_non_finite(&self.vx).is_none() && first_non_finite(&self.vy).is_none()
+    }
+
     /// The first non-finite value, as (field name, particle index), scanning field by field.
     pub fn first_non_finite(&self) -> Option<(&'static str, usize)> {
         FIELD_NAMES

@@ -25,7 +25,7 @@ impl Strategy for Seq {
 }
 
 /// Runs every pass as a single chunk, in place.
-struct SeqExecutor;
+pub struct SeqExecutor;
 
 impl Executor for SeqExecutor {
     fn for_each_chunk<O, F>(&self, out: O, kernel: F) -> Result<(), KernelPanic>

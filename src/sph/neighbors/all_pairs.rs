@@ -1,5 +1,7 @@
 //! The sources' O(N²) loop: particle i tests every particle j.
 
+use sph_strategies::{Executor, KernelPanic};
+
 use super::{Neighbors, distance_squared};
 use crate::sph::state::Positions;
 
@@ -11,7 +13,9 @@ pub struct AllPairs;
 const BLOCK: usize = 8;
 
 impl Neighbors for AllPairs {
-    fn rebuild(&mut self, _pos: Positions<'_>) {}
+    fn rebuild<E: Executor>(&mut self, _exec: &E, _pos: Positions<'_>) -> Result<(), KernelPanic> {
+        Ok(())
+    }
 
     #[inline]
     fn for_each_within(

@@ -6,6 +6,8 @@
 //! hits are put in index order before they are visited, so sums run in the same order as
 //! all-pairs and give the same bits.
 
+use sph_strategies::{Executor, KernelPanic};
+
 use super::{Neighbors, distance_squared};
 use crate::sph::state::{Domain, Positions};
 
@@ -15,12 +17,8 @@ const INLINE_HITS: usize = 48;
 /// A cell list over a fixed domain.
 #[derive(Debug, Clone)]
 pub struct Grid {
-    /// Cell edge, px (the kernel radius).
-    cell: f64,
-    /// Cells along x.
-    cols: usize,
-    /// Cells along y.
-    rows: usize,
+    /// Cell size and counts.
+    shape: Shape,
     /// Particles of cell c are `order[start[c]..start[c + 1]]`, in increasing index.
     start: Vec<u32>,
     /// Particle indices sorted by cell (row-major), stable.
@@ -48,26 +46,17 @@ impl Grid {
             "grid too large"
         );
         Grid {
-            cell: h,
-            cols,
-            rows,
+            shape: Shape {
+                cell: h,
+                cols,
+                rows,
+            },
             start: vec![0; cells + 1],
             order: Vec::with_capacity(n),
             sorted_x: Vec::with_capacity(n),
             sorted_y: Vec::with_capacity(n),
             cell_of: Vec::with_capacity(n),
         }
-    }
-
-    /// The (column, row) of a position. Positions outside the domain fall into the edge
-    /// cells, which never loses a neighbour: anything within H of an edge-cell particle is in
-    /// that cell or the one next to it.
-    #[inline]
-    fn cell_coords(&self, x: f64, y: f64) -> (usize, usize) {
-        // `as usize` saturates: negative and NaN give 0, huge values clamp below.
-        let cx = ((x / self.cell) as usize).min(self.cols - 1);
-        let cy = ((y / self.cell) as usize).min(self.rows - 1);
-        (cx, cy)
     }
 
     /// Bytes held by the grid's arrays (capacity), for memory reports.
@@ -77,16 +66,53 @@ impl Grid {
     }
 }
 
+/// Cell size and counts of a grid (small and `Copy`, so kernels can share it).
+#[derive(Debug, Clone, Copy)]
+struct Shape {
+    /// Cell edge, px (the kernel radius).
+    cell: f64,
+    /// Cells along x.
+    cols: usize,
+    /// Cells along y.
+    rows: usize,
+}
+
+impl Shape {
+    /// The (column, row) of a position. Positions outside the domain fall into the edge
+    /// cells, which never loses a neighbour: anything within H of an edge-cell particle is in
+    /// that cell or the one next to it.
+    #[inline]
+    fn coords(&self, x: f64, y: f64) -> (usize, usize) {
+        // `as usize` saturates: negative and NaN give 0, huge values clamp below.
+        let cx = ((x / self.cell) as usize).min(self.cols - 1);
+        let cy = ((y / self.cell) as usize).min(self.rows - 1);
+        (cx, cy)
+    }
+
+    /// The row-major cell number of a position.
+    #[inline]
+    fn cell_of(&self, x: f64, y: f64) -> u32 {
+        let (cx, cy) = self.coords(x, y);
+        (cy * self.cols + cx) as u32
+    }
+}
+
 impl Neighbors for Grid {
-    fn rebuild(&mut self, pos: Positions<'_>) {
+    /// Cell numbers (per particle) and the gather of sorted positions (per slot) run on the
+    /// executor; the counting sort between them is sequential: one increment per particle
+    /// and one addition per cell.
+    fn rebuild<E: Executor>(&mut self, exec: &E, pos: Positions<'_>) -> Result<(), KernelPanic> {
         let n = pos.len();
-        self.cell_of.clear();
+        let shape = self.shape;
+        self.cell_of.resize(n, 0);
+        exec.for_each_chunk(&mut self.cell_of[..], |first, cells| {
+            for (k, c) in cells.iter_mut().enumerate() {
+                *c = shape.cell_of(pos.x[first + k], pos.y[first + k]);
+            }
+        })?;
         self.start.fill(0);
-        for i in 0..n {
-            let (cx, cy) = self.cell_coords(pos.x[i], pos.y[i]);
-            let c = cy * self.cols + cx;
-            self.cell_of.push(c as u32);
-            self.start[c] += 1;
+        for &c in &self.cell_of {
+            self.start[c as usize] += 1;
         }
         // Inclusive prefix sums: start[c] is now where cell c ends.
         let mut sum = 0;
@@ -102,12 +128,18 @@ impl Neighbors for Grid {
             *slot -= 1;
             self.order[*slot as usize] = i as u32;
         }
-        self.sorted_x.clear();
-        self.sorted_y.clear();
-        self.sorted_x
-            .extend(self.order.iter().map(|&j| pos.x[j as usize]));
-        self.sorted_y
-            .extend(self.order.iter().map(|&j| pos.y[j as usize]));
+        self.sorted_x.resize(n, 0.0);
+        self.sorted_y.resize(n, 0.0);
+        let order = &self.order;
+        exec.for_each_chunk(
+            (&mut self.sorted_x[..], &mut self.sorted_y[..]),
+            |first, (xs, ys)| {
+                for (k, (sx, sy)) in xs.iter_mut().zip(ys).enumerate() {
+                    let j = order[first + k] as usize;
+                    (*sx, *sy) = (pos.x[j], pos.y[j]);
+                }
+            },
+        )
     }
 
     #[inline]
@@ -119,8 +151,8 @@ impl Neighbors for Grid {
         mut visit: impl FnMut(usize, f64),
     ) {
         let (xi, yi) = (pos.x[i], pos.y[i]);
-        let (cx, cy) = self.cell_coords(xi, yi);
-        let (c0, c1) = (cx.saturating_sub(1), (cx + 1).min(self.cols - 1));
+        let (cx, cy) = self.shape.coords(xi, yi);
+        let (c0, c1) = (cx.saturating_sub(1), (cx + 1).min(self.shape.cols - 1));
         // Hits are kept sorted by particle index as they arrive (insertion into a small stack
         // buffer: a particle has about 5-30 hits, mostly nearly in order). A crowd beyond the
         // buffer spills into a vector that is sorted once.
@@ -128,9 +160,9 @@ impl Neighbors for Grid {
         let mut dist2 = [0.0f64; INLINE_HITS];
         let mut len = 0;
         let mut spilled: Vec<(u32, f64)> = Vec::new();
-        for row in cy.saturating_sub(1)..=(cy + 1).min(self.rows - 1) {
-            let lo = self.start[row * self.cols + c0] as usize;
-            let hi = self.start[row * self.cols + c1 + 1] as usize;
+        for row in cy.saturating_sub(1)..=(cy + 1).min(self.shape.rows - 1) {
+            let lo = self.start[row * self.shape.cols + c0] as usize;
+            let hi = self.start[row * self.shape.cols + c1 + 1] as usize;
             for k in lo..hi {
                 let r2 = distance_squared(xi, yi, self.sorted_x[k], self.sorted_y[k]);
                 if r2 < hsq {

@@ -13,6 +13,7 @@ pub use grid::Grid;
 pub use list::{NeighborLists, SLOTS, SlotsMut};
 
 use serde::Serialize;
+use sph_strategies::{Executor, KernelPanic};
 
 use crate::sph::state::{Domain, Positions};
 
@@ -47,8 +48,9 @@ impl std::fmt::Display for NeighborMode {
 
 /// A neighbour search over a set of positions.
 pub trait Neighbors: Sync {
-    /// Brings the search up to date with `pos` (called once per step, before the passes).
-    fn rebuild(&mut self, pos: Positions<'_>);
+    /// Brings the search up to date with `pos` (called once per step, before the passes);
+    /// per-particle parts of the work run on `exec`.
+    fn rebuild<E: Executor>(&mut self, exec: &E, pos: Positions<'_>) -> Result<(), KernelPanic>;
 
     /// Calls `visit(j, r2)` for every particle j (including `i` itself) whose squared
     /// distance `r2 = dx*dx + dy*dy` (with `d = x_j − x_i`) is below `hsq`, in increasing j.
