@@ -6,6 +6,7 @@
 //! - [`scene`]: initial dam-break states; [`io`]: CSV in and out;
 //! - [`run`]: timed runs; [`clock`], [`checksum`]: what a run reports;
 //! - [`plot`]: the bundled font shared by charts and animations;
+//! - [`sweep`]: the cores × chunks study (`bench-sph sweep`) and its result files;
 //! - [`cli`]: the `bench-sph` command line.
 
 pub mod checksum;
@@ -17,3 +18,4 @@ pub mod run;
 pub mod scene;
 pub mod solver;
 pub mod sph;
+pub mod sweep;

@@ -2,11 +2,13 @@
 
 mod list;
 mod simulate;
+mod sweep;
 
 use clap::{Parser, Subcommand};
 use sph_strategies::StrategyName;
 
 pub use simulate::SimulateArgs;
+pub use sweep::SweepArgs;
 
 /// bench-sph: which parallel strategy wins for a 2D SPH fluid, by how much and why.
 #[derive(Debug, Parser)]
@@ -28,6 +30,18 @@ pub enum Command {
     Simulate(SimulateArgs),
     /// List the parallel strategies, one per line: name, then what it does.
     List,
+    /// Measure every strategy over a cores × chunks grid: trials.csv, summary.csv, meta.json.
+    #[command(
+        after_help = "Each cell (strategy, cores, chunks) gets --warmup untimed runs, then --trials timed runs \
+        of the whole simulation from the same initial state; every run's final checksum must equal seq's. \
+        Files are written after every cell; Ctrl-C keeps the finished cells, and --resume DIR continues.\n\n\
+        Examples:\n  \
+        bench-sph sweep --cores 1..6 --chunks 10..200          # the paper's study, every strategy\n  \
+        bench-sph sweep --cores 1,2 --chunks 10,50 --n 300 --steps 50 --trials 3 --no-plots\n  \
+        bench-sph sweep --strategies rayon-chunks,crossbeam-pool --neighbors all-pairs,grid --out results/grid\n  \
+        bench-sph sweep --resume results/2026-11-22T031500Z"
+    )]
+    Sweep(SweepArgs),
 }
 
 /// Parses the command line and runs the command.
@@ -35,6 +49,7 @@ pub fn run() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Simulate(args) => simulate::run(&args),
         Command::List => list::run(&mut std::io::stdout().lock()),
+        Command::Sweep(args) => sweep::run(&args),
     }
 }
 

@@ -1,0 +1,158 @@
+//! `bench-sph sweep`: the cores × chunks study over every strategy.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+use sph_strategies::StrategyName;
+
+use crate::sph::neighbors::NeighborMode;
+use crate::sph::params::Preset;
+use crate::sweep::params::SweepParams;
+use crate::sweep::range::{self, Axis};
+use crate::sweep::{Request, Target};
+
+/// Options of `sweep`.
+#[derive(Debug, Clone, Args)]
+pub struct SweepArgs {
+    /// Worker threads: N, A..B, A..B:S or a comma list [default: 1..the hardware threads].
+    #[arg(long, value_name = "RANGE", conflicts_with = "resume")]
+    pub cores: Option<String>,
+    /// Chunks per pass, for strategies that use chunks: N, A..B (step 10), A..B:S, a comma
+    /// list, or `paper` (2,4,8,12,16,20,25,35,45,60,75,100,150,200,250,333,400).
+    #[arg(
+        long,
+        value_name = "RANGE",
+        default_value = "paper",
+        conflicts_with = "resume"
+    )]
+    pub chunks: String,
+    /// Strategies, comma-separated (see `bench-sph list`) [default: all]. seq at 1 core is
+    /// measured in any case: it is the reference of speedup and checksum.
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = super::strategy, conflicts_with = "resume")]
+    pub strategies: Vec<StrategyName>,
+    /// Presets, comma-separated.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "seed",
+        conflicts_with = "resume"
+    )]
+    pub preset: Vec<Preset>,
+    /// Neighbour searches, comma-separated.
+    #[arg(
+        long,
+        value_enum,
+        value_delimiter = ',',
+        default_value = "all-pairs",
+        conflicts_with = "resume"
+    )]
+    pub neighbors: Vec<NeighborMode>,
+    /// Particle counts: N, a comma list, or A..B:S.
+    #[arg(
+        long,
+        value_name = "LIST",
+        default_value = "1000",
+        conflicts_with = "resume"
+    )]
+    pub n: String,
+    /// Steps per run.
+    #[arg(long, default_value_t = 1000, value_parser = super::positive, conflicts_with = "resume")]
+    pub steps: usize,
+    /// Timed runs per cell.
+    #[arg(long, default_value_t = 5, value_parser = super::positive, conflicts_with = "resume")]
+    pub trials: usize,
+    /// Untimed runs before each cell's trials.
+    #[arg(long, default_value_t = 1, conflicts_with = "resume")]
+    pub warmup: usize,
+    /// Seed of the initial jitter.
+    #[arg(long, default_value_t = 2019, conflicts_with = "resume")]
+    pub seed: u64,
+    /// Results directory [default: results/<UTC timestamp>]. Must not exist or be empty,
+    /// unless --force.
+    #[arg(long, value_name = "DIR", conflicts_with = "resume")]
+    pub out: Option<PathBuf>,
+    /// Continue the sweep in DIR with the parameters of DIR/meta.json: finished cells are
+    /// kept, unfinished ones run (again).
+    #[arg(long, value_name = "DIR")]
+    pub resume: Option<PathBuf>,
+    /// Replace the results files (trials.csv, summary.csv, meta.json) of an existing --out
+    /// directory.
+    #[arg(long, conflicts_with = "resume")]
+    pub force: bool,
+    /// Do not draw charts at the end.
+    #[arg(long)]
+    pub no_plots: bool,
+    /// Test only: record these times (WALL or WALL:CPU seconds, comma-separated, taken in
+    /// turn) instead of the measured ones. The runs still happen and are checked.
+    #[arg(long, value_name = "LIST", hide = true, conflicts_with = "resume")]
+    pub fake_timings: Option<String>,
+    /// Test only: stop as if Ctrl-C was pressed once this many cells are written.
+    #[arg(long, value_name = "K", hide = true)]
+    pub stop_after_cells: Option<usize>,
+}
+
+impl SweepArgs {
+    /// The parameters of a new sweep, with every list expanded and checked.
+    pub fn params(&self) -> anyhow::Result<SweepParams> {
+        let list = |option: &str, spec: &str, axis: Axis| {
+            range::parse(spec, axis).with_context(|| format!("--{option} '{spec}'"))
+        };
+        let default_cores = format!("1..{}", super::hardware_threads());
+        let mut strategies = if self.strategies.is_empty() {
+            StrategyName::ALL.to_vec()
+        } else {
+            self.strategies.clone()
+        };
+        strategies.sort();
+        strategies.dedup();
+        let (mut presets, mut neighbors) = (self.preset.clone(), self.neighbors.clone());
+        presets.sort();
+        presets.dedup();
+        neighbors.sort();
+        neighbors.dedup();
+        Ok(SweepParams {
+            strategies,
+            presets,
+            neighbors,
+            n: list("n", &self.n, Axis::Particles)?,
+            steps: self.steps,
+            cores: list(
+                "cores",
+                self.cores.as_deref().unwrap_or(&default_cores),
+                Axis::Cores,
+            )?,
+            chunks: list("chunks", &self.chunks, Axis::Chunks)?,
+            trials: self.trials,
+            warmup: self.warmup,
+            seed: self.seed,
+            fake_timings: self.fake_timings.clone(),
+        })
+    }
+
+    /// What to run.
+    pub fn request(&self) -> anyhow::Result<Request> {
+        let target = match &self.resume {
+            Some(dir) => Target::Resume { dir: dir.clone() },
+            None => Target::New {
+                params: Box::new(self.params()?),
+                out: self.out.clone(),
+                force: self.force,
+            },
+        };
+        Ok(Request {
+            target,
+            no_plots: self.no_plots,
+            stop_after_cells: self.stop_after_cells,
+            command_line: std::env::args_os()
+                .map(|a| a.to_string_lossy().into_owned())
+                .collect(),
+        })
+    }
+}
+
+/// Runs `sweep`.
+pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
+    crate::sweep::run(args.request()?)
+}

@@ -1,0 +1,262 @@
+//! What a sweep prints: pure functions from plan and rows to text.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use super::plan::{Cell, CellKey, Plan};
+use super::range::{Axis, compact};
+use super::rows::{Status, SummaryRow};
+
+/// A duration for people: `0.25 ms`, `12 ms`, `4.2 s`, `42 s`, `3 min 20 s`, `1 h 05 min`.
+pub fn duration(seconds: f64) -> String {
+    if !seconds.is_finite() {
+        return "unknown".to_owned();
+    }
+    if seconds < 0.001 {
+        return format!("{:.2} ms", seconds * 1000.0);
+    }
+    if seconds < 1.0 {
+        return format!("{:.0} ms", seconds * 1000.0);
+    }
+    if seconds < 10.0 {
+        return format!("{seconds:.1} s");
+    }
+    let s = seconds.round() as u64;
+    match (s / 3600, (s % 3600) / 60, s % 60) {
+        (0, 0, sec) => format!("{sec} s"),
+        (0, min, sec) => format!("{min} min {sec:02} s"),
+        (h, min, _) => format!("{h} h {min:02} min"),
+    }
+}
+
+/// Decimal places that show `seconds` to four significant digits (at least 1, at most 9).
+pub fn places(seconds: f64) -> usize {
+    if !(seconds.is_finite() && seconds > 0.0) {
+        return 4;
+    }
+    (3 - seconds.log10().floor() as i64).clamp(1, 9) as usize
+}
+
+/// `1 warm-up` / `3 warm-ups`, and so on.
+pub fn plural(count: usize, one: &str, many: &str) -> String {
+    format!("{count} {}", if count == 1 { one } else { many })
+}
+
+/// The cells of `plan` with more cores than `hardware_threads`, and their cores values.
+pub fn oversubscribed(plan: &Plan, hardware_threads: usize) -> (usize, Vec<usize>) {
+    let cells: Vec<&Cell> = plan
+        .cells
+        .iter()
+        .filter(|c| c.oversubscribed(hardware_threads))
+        .collect();
+    let mut cores: Vec<usize> = cells.iter().map(|c| c.cores).collect();
+    cores.sort_unstable();
+    cores.dedup();
+    (cells.len(), cores)
+}
+
+/// The warning printed when some cells ask for more threads than the machine has.
+pub fn oversubscription_warning(plan: &Plan, hardware_threads: usize) -> Option<String> {
+    let (count, cores) = oversubscribed(plan, hardware_threads);
+    (count > 0).then(|| {
+        format!(
+            "warning: cores {} exceed this machine's {} hardware threads: {} run anyway \
+             and are marked oversubscribed=true in summary.csv",
+            compact(&cores, Axis::Cores),
+            hardware_threads,
+            plural(count, "cell", "cells"),
+        )
+    })
+}
+
+/// One line for a finished cell: where it is in the plan, what it is, and its result.
+pub fn cell_line(position: usize, total: usize, cell: &Cell, row: &SummaryRow) -> String {
+    let width = total.to_string().len();
+    let mut line = format!("[{position:>width$}/{total}] {:<36}", cell.label());
+    match (row.status, row.mean_s) {
+        (Status::Ok, Some(mean)) => {
+            let p = places(mean);
+            let _ = write!(line, " {mean:>10.p$} s");
+            if let Some(sd) = row.stddev_s {
+                let _ = write!(line, " ± {sd:.p$}");
+            }
+            if let Some(speedup) = row.speedup {
+                let _ = write!(line, "  speedup {speedup:.2}");
+            }
+            if row.outliers.unwrap_or(0) > 0 {
+                let _ = write!(
+                    line,
+                    "  {}",
+                    plural(row.outliers.unwrap_or(0), "outlier", "outliers")
+                );
+            }
+        }
+        _ => {
+            let _ = write!(line, " FAILED: {}", row.reason);
+        }
+    }
+    if row.oversubscribed {
+        line.push_str("  (oversubscribed)");
+    }
+    line
+}
+
+/// The fastest finished cell of each strategy in each group, as a table, groups in plan
+/// order and strategies in registry order. `rows` may hold any number of sessions' rows.
+pub fn best_cells(plan: &Plan, rows: &[SummaryRow]) -> String {
+    let by_key: BTreeMap<CellKey, &SummaryRow> = rows.iter().map(|r| (r.key(), r)).collect();
+    let mut text = String::new();
+    for group in &plan.groups {
+        let _ = writeln!(text, "Fastest cell per strategy ({}):", group.label());
+        let _ = writeln!(
+            text,
+            "  {:<16} {:>5} {:>6} {:>10} {:>10} {:>8} {:>10}",
+            "strategy", "cores", "chunks", "mean s", "stddev s", "speedup", "efficiency"
+        );
+        let mut strategies: Vec<_> = plan
+            .cells
+            .iter()
+            .filter(|c| c.group == *group)
+            .map(|c| c.strategy)
+            .collect();
+        strategies.dedup();
+        for strategy in strategies {
+            let best = plan
+                .cells
+                .iter()
+                .filter(|c| c.group == *group && c.strategy == strategy)
+                .filter_map(|c| by_key.get(&c.key()).copied())
+                .filter(|r| r.status == Status::Ok && r.mean_s.is_some())
+                .min_by(|a, b| {
+                    a.mean_s
+                        .unwrap_or(f64::NAN)
+                        .total_cmp(&b.mean_s.unwrap_or(f64::NAN))
+                });
+            let num = |v: Option<f64>, prec: usize| {
+                v.map_or_else(|| "-".to_owned(), |v| format!("{v:.prec$}"))
+            };
+            match best {
+                Some(r) => {
+                    let _ = writeln!(
+                        text,
+                        "  {:<16} {:>5} {:>6} {:>10} {:>10} {:>8} {:>10}",
+                        strategy.as_str(),
+                        r.cores,
+                        r.chunks.map_or_else(|| "-".to_owned(), |k| k.to_string()),
+                        num(r.mean_s, places(r.mean_s.unwrap_or(0.0))),
+                        num(r.stddev_s, places(r.mean_s.unwrap_or(0.0))),
+                        num(r.speedup, 2),
+                        num(r.efficiency, 2),
+                    );
+                }
+                None => {
+                    let _ = writeln!(text, "  {:<16} (no successful cell)", strategy.as_str());
+                }
+            }
+        }
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::clock::Elapsed;
+    use crate::sph::neighbors::NeighborMode;
+    use crate::sph::params::Preset;
+    use crate::sweep::params::SweepParams;
+    use crate::sweep::rows::{Measured, summary_row};
+    use sph_strategies::StrategyName;
+
+    fn plan() -> Plan {
+        Plan::new(&SweepParams {
+            strategies: vec![StrategyName::RayonChunks],
+            presets: vec![Preset::Seed],
+            neighbors: vec![NeighborMode::AllPairs],
+            n: vec![60],
+            steps: 3,
+            cores: vec![1, 2, 3],
+            chunks: vec![2, 5],
+            trials: 2,
+            warmup: 1,
+            seed: 1,
+            fake_timings: None,
+        })
+    }
+
+    fn row(cell: &Cell, walls: &[f64], failure: Option<&str>) -> SummaryRow {
+        let m: Vec<Measured> = walls
+            .iter()
+            .map(|&w| Measured {
+                elapsed: Elapsed {
+                    wall_s: w,
+                    cpu_s: w,
+                },
+                checksum: "0000000000000001".to_owned(),
+            })
+            .collect();
+        summary_row(cell, &m, failure, Some(4.0), 2)
+    }
+
+    #[test]
+    fn durations_read_naturally() {
+        assert_eq!(duration(0.00025), "0.25 ms");
+        assert_eq!(duration(0.0123), "12 ms");
+        assert_eq!(duration(4.24), "4.2 s");
+        assert_eq!(duration(42.4), "42 s");
+        assert_eq!(duration(200.0), "3 min 20 s");
+        assert_eq!(duration(3900.0), "1 h 05 min");
+        assert_eq!(duration(f64::NAN), "unknown");
+    }
+
+    #[test]
+    fn times_show_four_significant_digits() {
+        assert_eq!(format!("{:.*}", places(0.1361), 0.1361), "0.1361");
+        assert_eq!(format!("{:.*}", places(0.0000694), 0.0000694), "0.00006940");
+        assert_eq!(format!("{:.*}", places(12.3), 12.3), "12.30");
+        assert_eq!(places(12345.0), 1);
+    }
+
+    #[test]
+    fn cores_beyond_the_hardware_threads_are_named_in_a_warning() {
+        let w = oversubscription_warning(&plan(), 2).unwrap();
+        assert!(w.contains("cores 3 exceed"), "{w}");
+        assert!(w.contains("2 cells"), "{w}");
+        assert_eq!(oversubscription_warning(&plan(), 3), None);
+    }
+
+    #[test]
+    fn a_cell_line_shows_its_result_or_its_failure() {
+        let p = plan();
+        let cell = p.cells[1];
+        let ok = cell_line(2, 7, &cell, &row(&cell, &[1.0, 3.0], None));
+        assert!(
+            ok.starts_with("[2/7] rayon-chunks, 1 core, 2 chunks"),
+            "{ok}"
+        );
+        assert!(
+            ok.contains("2.000 s ± 1.414") && ok.contains("speedup 2.00"),
+            "{ok}"
+        );
+        let bad = cell_line(2, 7, &cell, &row(&cell, &[1.0], Some("trial 1: boom")));
+        assert!(bad.contains("FAILED: trial 1: boom"), "{bad}");
+    }
+
+    #[test]
+    fn the_best_cell_table_picks_the_lowest_mean_among_successful_cells() {
+        let p = plan();
+        let rows: Vec<SummaryRow> = vec![
+            row(&p.cells[0], &[4.0], None),
+            row(&p.cells[1], &[3.0], None),
+            row(&p.cells[2], &[1.0], Some("checksum differs")),
+            row(&p.cells[3], &[2.0], None),
+        ];
+        let text = best_cells(&p, &rows);
+        let line = text
+            .lines()
+            .find(|l| l.trim_start().starts_with("rayon-chunks"))
+            .unwrap();
+        assert!(line.contains("2.000"), "{text}");
+        assert!(text.contains("seq"), "{text}");
+    }
+}

@@ -1,0 +1,257 @@
+//! `meta.json`: what was run, on what, with what, and when.
+//!
+//! Top level: the tool's version and git commit, the compiler, the machine, the first
+//! session's command line and start time, the last end time, the sweep's `status`
+//! (`running`, `complete` or `interrupted`) and every parameter (`params`, which `--resume`
+//! reads back). `sessions` lists every invocation (the first and each `--resume`) with its own
+//! command line, times, machine and number of cells run.
+
+use std::path::Path;
+
+use anyhow::Context;
+use serde::{Deserialize, Serialize};
+
+use super::params::SweepParams;
+
+/// The version of bench-sph that wrote the file.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+/// The git commit bench-sph was built from (`-dirty` with local changes), or `unknown`.
+pub const GIT_COMMIT: &str = env!("BENCH_SPH_GIT_COMMIT");
+/// `rustc --version` of the compiler that built bench-sph.
+pub const RUSTC: &str = env!("BENCH_SPH_RUSTC");
+
+/// The state of a sweep as a whole.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SweepStatus {
+    /// A session is running it (or was killed without a chance to say otherwise).
+    Running,
+    /// Every planned cell has a summary row.
+    Complete,
+    /// Stopped by Ctrl-C; `--resume` continues it.
+    Interrupted,
+}
+
+/// The machine a session ran on.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Machine {
+    /// The CPU's model name from /proc/cpuinfo, or `unknown`.
+    pub cpu_model: String,
+    /// Hardware threads available to the process.
+    pub hardware_threads: usize,
+    /// The operating system's name (PRETTY_NAME of /etc/os-release), or the OS family.
+    pub os: String,
+    /// The kernel release (/proc/sys/kernel/osrelease), or `unknown`.
+    pub kernel: String,
+    /// The CPU architecture bench-sph was built for.
+    pub arch: String,
+}
+
+impl Machine {
+    /// Reads the machine's description (never fails: unknown parts say `unknown`).
+    pub fn detect() -> Machine {
+        let read = |path: &str| std::fs::read_to_string(path).unwrap_or_default();
+        let kernel = read("/proc/sys/kernel/osrelease").trim().to_owned();
+        Machine {
+            cpu_model: cpu_model(&read("/proc/cpuinfo")).unwrap_or_else(|| "unknown".to_owned()),
+            hardware_threads: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            os: pretty_name(&read("/etc/os-release"))
+                .unwrap_or_else(|| std::env::consts::OS.to_owned()),
+            kernel: if kernel.is_empty() {
+                "unknown".to_owned()
+            } else {
+                kernel
+            },
+            arch: std::env::consts::ARCH.to_owned(),
+        }
+    }
+}
+
+/// The first `model name` (x86) or, failing that, `Hardware`/`Processor`/`cpu model` value.
+fn cpu_model(cpuinfo: &str) -> Option<String> {
+    ["model name", "Hardware", "Processor", "cpu model"]
+        .iter()
+        .find_map(|key| {
+            cpuinfo.lines().find_map(|line| {
+                let (k, v) = line.split_once(':')?;
+                (k.trim() == *key && !v.trim().is_empty()).then(|| v.trim().to_owned())
+            })
+        })
+}
+
+/// PRETTY_NAME from os-release text, unquoted.
+fn pretty_name(os_release: &str) -> Option<String> {
+    os_release.lines().find_map(|line| {
+        let v = line.strip_prefix("PRETTY_NAME=")?;
+        Some(v.trim().trim_matches('"').to_owned())
+    })
+}
+
+/// One invocation of `bench-sph sweep` on a results directory.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Session {
+    /// The command line, program name first.
+    pub command_line: Vec<String>,
+    /// When it started, UTC, RFC 3339.
+    pub started_utc: String,
+    /// When it ended, UTC, RFC 3339 (`null` while running or if it was killed).
+    pub finished_utc: Option<String>,
+    /// How it ended.
+    pub status: SweepStatus,
+    /// Cells it measured.
+    pub cells_run: usize,
+    /// bench-sph version.
+    pub version: String,
+    /// bench-sph git commit.
+    pub git_commit: String,
+    /// The machine.
+    pub machine: Machine,
+}
+
+impl Session {
+    /// A session starting now.
+    pub fn start(command_line: Vec<String>, machine: Machine) -> Session {
+        Session {
+            command_line,
+            started_utc: now_utc(),
+            finished_utc: None,
+            status: SweepStatus::Running,
+            cells_run: 0,
+            version: VERSION.to_owned(),
+            git_commit: GIT_COMMIT.to_owned(),
+            machine,
+        }
+    }
+}
+
+/// The contents of `meta.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Meta {
+    /// Always `bench-sph sweep`.
+    pub tool: String,
+    /// bench-sph version of the first session.
+    pub version: String,
+    /// bench-sph git commit of the first session, or `unknown`.
+    pub git_commit: String,
+    /// `rustc --version` of the first session's build.
+    pub rustc: String,
+    /// The first session's machine.
+    pub machine: Machine,
+    /// The first session's command line.
+    pub command_line: Vec<String>,
+    /// When the first session started, UTC, RFC 3339.
+    pub started_utc: String,
+    /// When the last session ended, UTC, RFC 3339 (`null` while running).
+    pub finished_utc: Option<String>,
+    /// The sweep's state.
+    pub status: SweepStatus,
+    /// Cells in the plan.
+    pub planned_cells: usize,
+    /// Every parameter (read back by `--resume`).
+    pub params: SweepParams,
+    /// Every session, first to last.
+    pub sessions: Vec<Session>,
+}
+
+impl Meta {
+    /// The metadata of a new sweep whose first session is `session`.
+    pub fn new(params: SweepParams, planned_cells: usize, session: Session) -> Meta {
+        Meta {
+            tool: "bench-sph sweep".to_owned(),
+            version: session.version.clone(),
+            git_commit: session.git_commit.clone(),
+            rustc: RUSTC.to_owned(),
+            machine: session.machine.clone(),
+            command_line: session.command_line.clone(),
+            started_utc: session.started_utc.clone(),
+            finished_utc: None,
+            status: SweepStatus::Running,
+            planned_cells,
+            params,
+            sessions: vec![session],
+        }
+    }
+
+    /// Marks the latest session (and the sweep) ended now with `status`.
+    pub fn finish(&mut self, status: SweepStatus, cells_run: usize) {
+        let now = now_utc();
+        if let Some(s) = self.sessions.last_mut() {
+            s.finished_utc = Some(now.clone());
+            s.status = status;
+            s.cells_run = cells_run;
+        }
+        self.finished_utc = Some(now);
+        self.status = status;
+    }
+
+    /// Reads `path`.
+    pub fn read(path: &Path) -> anyhow::Result<Meta> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read '{}'", path.display()))?;
+        serde_json::from_str(&text)
+            .with_context(|| format!("'{}' is not a bench-sph sweep's meta.json", path.display()))
+    }
+
+    /// Writes `path` whole (through a temporary file renamed over it, so a crash never leaves
+    /// half a file).
+    pub fn write(&self, path: &Path) -> anyhow::Result<()> {
+        let tmp = path.with_extension("json.tmp");
+        let mut text = serde_json::to_string_pretty(self)?;
+        text.push('\n');
+        std::fs::write(&tmp, text).with_context(|| format!("cannot write '{}'", tmp.display()))?;
+        std::fs::rename(&tmp, path).with_context(|| format!("cannot write '{}'", path.display()))
+    }
+}
+
+/// Now, UTC, RFC 3339 to the second, e.g. `2026-11-22T03:15:00Z`.
+pub fn now_utc() -> String {
+    chrono::Utc::now().to_rfc3339_opts(chrono::SecondsFormat::Secs, true)
+}
+
+/// Now, UTC, as a directory name, e.g. `2026-11-22T031500Z`.
+pub fn timestamp_dir_name() -> String {
+    chrono::Utc::now().format("%Y-%m-%dT%H%M%SZ").to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cpu_model_comes_from_model_name_or_an_arm_style_field() {
+        let x86 = "processor\t: 0\nvendor_id\t: GenuineIntel\nmodel name\t: Intel(R) Xeon(R) CPU @ 2.20GHz\n";
+        assert_eq!(
+            cpu_model(x86).as_deref(),
+            Some("Intel(R) Xeon(R) CPU @ 2.20GHz")
+        );
+        assert_eq!(
+            cpu_model("Hardware\t: BCM2835\n").as_deref(),
+            Some("BCM2835")
+        );
+        assert_eq!(cpu_model("processor : 0\n"), None);
+    }
+
+    #[test]
+    fn the_os_name_is_pretty_name_unquoted() {
+        let text = "NAME=\"Ubuntu\"\nPRETTY_NAME=\"Ubuntu 24.04.1 LTS\"\nID=ubuntu\n";
+        assert_eq!(pretty_name(text).as_deref(), Some("Ubuntu 24.04.1 LTS"));
+        assert_eq!(pretty_name("ID=x\n"), None);
+    }
+
+    #[test]
+    fn the_build_facts_are_filled_in() {
+        assert!(RUSTC.starts_with("rustc ") || RUSTC == "unknown", "{RUSTC}");
+        assert!(!GIT_COMMIT.is_empty());
+        let m = Machine::detect();
+        assert!(m.hardware_threads >= 1);
+        assert!(!m.cpu_model.is_empty() && !m.os.is_empty() && !m.kernel.is_empty());
+    }
+
+    #[test]
+    fn timestamps_are_utc_and_directory_names_have_no_colons() {
+        assert!(now_utc().ends_with('Z'));
+        let dir = timestamp_dir_name();
+        assert!(dir.ends_with('Z') && !dir.contains(':'), "{dir}");
+        assert_eq!(dir.len(), "2026-11-22T031500Z".len());
+    }
+}

@@ -1,0 +1,324 @@
+//! `--resume DIR`: what an earlier session finished, and the repairs that make each trial
+//! appear exactly once.
+//!
+//! A cell counts as finished when `summary.csv` has its row and `trials.csv` has exactly
+//! `trials` rows for it (numbered 1, 2, …). Everything else of an unfinished cell — trial rows
+//! written just before a kill, a line cut off mid-write — is dropped, both files are written
+//! back without it, and the cell runs again. Failed cells are finished too: their failure is a
+//! result (delete their rows by hand to retry them).
+
+use std::collections::{HashMap, HashSet};
+use std::path::Path;
+
+use anyhow::Context;
+
+use super::export::{SUMMARY_COLUMNS, TRIAL_COLUMNS, to_csv};
+use super::plan::CellKey;
+use super::rows::{SummaryRow, TrialRow};
+
+/// A results file whose header is not this version's.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "{file} has the columns '{found}', not those bench-sph {} writes",
+    super::meta::VERSION
+)]
+pub struct UnexpectedColumns {
+    /// The file's name.
+    pub file: &'static str,
+    /// Its header line.
+    pub found: String,
+}
+
+/// The finished cells of a results directory, and its files with everything else removed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Repaired {
+    /// The summary rows of the finished cells, in file order.
+    pub finished: Vec<SummaryRow>,
+    /// `trials.csv` as it should be: header plus the finished cells' trial rows.
+    pub trials_csv: Vec<u8>,
+    /// `summary.csv` as it should be: header plus the finished cells' rows.
+    pub summary_csv: Vec<u8>,
+    /// Trial rows kept.
+    pub kept_trial_rows: usize,
+    /// Trial rows (or broken lines) dropped from `trials.csv`.
+    pub dropped_trial_rows: usize,
+    /// Summary rows (or broken lines) dropped from `summary.csv`.
+    pub dropped_summary_rows: usize,
+}
+
+/// Repairs the contents of `trials.csv` and `summary.csv` (either may be empty: no file).
+pub fn repair(trials: &[u8], summary: &[u8]) -> Result<Repaired, UnexpectedColumns> {
+    let (summary_rows, mut dropped_summary_rows) =
+        read_rows::<SummaryRow>(summary, "summary.csv", &SUMMARY_COLUMNS)?;
+    let (trial_rows, mut dropped_trial_rows) =
+        read_rows::<TrialRow>(trials, "trials.csv", &TRIAL_COLUMNS)?;
+
+    // The first summary row of each cell; the trial rows of each cell, once per number.
+    let mut seen = HashSet::new();
+    let mut candidates = Vec::new();
+    for row in summary_rows {
+        if seen.insert(row.key()) {
+            candidates.push(row);
+        } else {
+            dropped_summary_rows += 1;
+        }
+    }
+    let mut by_cell: HashMap<CellKey, Vec<TrialRow>> = HashMap::new();
+    for row in trial_rows {
+        let rows = by_cell.entry(row.key()).or_default();
+        if rows.iter().any(|r| r.trial == row.trial) {
+            dropped_trial_rows += 1;
+        } else {
+            rows.push(row);
+        }
+    }
+
+    // Finished = a summary row and trials numbered exactly 1..=trials.
+    let mut finished = Vec::new();
+    let mut kept = Vec::new();
+    for row in candidates {
+        let mut trials = by_cell.remove(&row.key()).unwrap_or_default();
+        trials.sort_by_key(|t| t.trial);
+        let complete =
+            trials.len() == row.trials && trials.iter().enumerate().all(|(i, t)| t.trial == i + 1);
+        if complete {
+            kept.extend(trials);
+            finished.push(row);
+        } else {
+            dropped_trial_rows += trials.len();
+            dropped_summary_rows += 1;
+        }
+    }
+    dropped_trial_rows += by_cell.values().map(Vec::len).sum::<usize>();
+
+    let csv_bytes = |result: csv::Result<Vec<u8>>| result.expect("CSV into memory cannot fail");
+    Ok(Repaired {
+        trials_csv: csv_bytes(to_csv(&TRIAL_COLUMNS, &kept)),
+        summary_csv: csv_bytes(to_csv(&SUMMARY_COLUMNS, &finished)),
+        kept_trial_rows: kept.len(),
+        finished,
+        dropped_trial_rows,
+        dropped_summary_rows,
+    })
+}
+
+/// The complete rows of a CSV file and the number of lines that were not: a last line
+/// without its newline (cut off by a kill) or a row that does not parse.
+fn read_rows<R: serde::de::DeserializeOwned>(
+    bytes: &[u8],
+    file: &'static str,
+    columns: &[&str],
+) -> Result<(Vec<R>, usize), UnexpectedColumns> {
+    let complete = match bytes.iter().rposition(|&b| b == b'\n') {
+        Some(last) => &bytes[..=last],
+        None => &[][..],
+    };
+    let mut dropped = usize::from(complete.len() < bytes.len());
+    if complete.is_empty() {
+        return Ok((Vec::new(), dropped));
+    }
+    let mut reader = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .flexible(true)
+        .from_reader(complete);
+    let header = reader
+        .headers()
+        .map(|h| h.iter().collect::<Vec<_>>().join(","));
+    match header {
+        Ok(h) if h == columns.join(",") => {}
+        Ok(h) => return Err(UnexpectedColumns { file, found: h }),
+        Err(_) => {
+            return Err(UnexpectedColumns {
+                file,
+                found: String::from_utf8_lossy(
+                    complete.split(|&b| b == b'\n').next().unwrap_or_default(),
+                )
+                .into_owned(),
+            });
+        }
+    }
+    let mut rows = Vec::new();
+    for record in reader.deserialize::<R>() {
+        match record {
+            Ok(row) => rows.push(row),
+            Err(_) => dropped += 1,
+        }
+    }
+    Ok((rows, dropped))
+}
+
+/// Reads `dir`'s CSV files (a missing one counts as empty), repairs them, and writes the
+/// repaired contents back (each through a temporary file renamed over the original).
+pub fn load_and_repair(dir: &Path) -> anyhow::Result<Repaired> {
+    let read = |name: &str| -> anyhow::Result<Vec<u8>> {
+        let path = dir.join(name);
+        match std::fs::read(&path) {
+            Ok(bytes) => Ok(bytes),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Vec::new()),
+            Err(e) => Err(e).with_context(|| format!("cannot read '{}'", path.display())),
+        }
+    };
+    let repaired = repair(&read("trials.csv")?, &read("summary.csv")?)
+        .with_context(|| format!("cannot resume '{}'", dir.display()))?;
+    for (name, bytes) in [
+        ("trials.csv", &repaired.trials_csv),
+        ("summary.csv", &repaired.summary_csv),
+    ] {
+        let path = dir.join(name);
+        let tmp = dir.join(format!("{name}.tmp"));
+        std::fs::write(&tmp, bytes).with_context(|| format!("cannot write '{}'", tmp.display()))?;
+        std::fs::rename(&tmp, &path)
+            .with_context(|| format!("cannot write '{}'", path.display()))?;
+    }
+    Ok(repaired)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::clock::Elapsed;
+    use crate::sph::neighbors::NeighborMode;
+    use crate::sph::params::Preset;
+    use crate::sweep::export::Exporter;
+    use crate::sweep::plan::{Cell, Group};
+    use crate::sweep::rows::{Measured, summary_row, trial_rows};
+    use sph_strategies::StrategyName;
+
+    fn cell(cores: usize) -> Cell {
+        Cell {
+            group: Group {
+                preset: Preset::Seed,
+                neighbors: NeighborMode::AllPairs,
+                n: 60,
+                steps: 3,
+            },
+            strategy: StrategyName::RayonIter,
+            cores,
+            chunks: None,
+        }
+    }
+
+    fn measured(k: usize) -> Vec<Measured> {
+        (1..=k)
+            .map(|i| Measured {
+                elapsed: Elapsed {
+                    wall_s: i as f64,
+                    cpu_s: i as f64,
+                },
+                checksum: "00000000000000ff".to_owned(),
+            })
+            .collect()
+    }
+
+    /// Two finished cells, as an uninterrupted session writes them.
+    fn two_cells() -> (Vec<u8>, Vec<u8>) {
+        let (mut t, mut s) = (Vec::new(), Vec::new());
+        let mut e = Exporter::new(&mut t, &mut s, true).unwrap();
+        for cores in [1, 2] {
+            let m = measured(3);
+            e.write_cell(
+                &trial_rows(&cell(cores), &m, None),
+                &summary_row(&cell(cores), &m, None, Some(1.0), 2),
+            )
+            .unwrap();
+        }
+        drop(e);
+        (t, s)
+    }
+
+    #[test]
+    fn intact_files_come_back_unchanged() {
+        let (t, s) = two_cells();
+        let r = repair(&t, &s).unwrap();
+        assert_eq!(r.finished.len(), 2);
+        assert_eq!(
+            (
+                r.kept_trial_rows,
+                r.dropped_trial_rows,
+                r.dropped_summary_rows
+            ),
+            (6, 0, 0)
+        );
+        assert_eq!(r.trials_csv, t);
+        assert_eq!(r.summary_csv, s);
+    }
+
+    #[test]
+    fn trial_rows_of_a_cell_without_a_summary_row_are_dropped() {
+        let (mut t, s) = two_cells();
+        let mut e = Exporter::new(&mut t, Vec::new(), false).unwrap();
+        e.write_cell(
+            &trial_rows(&cell(3), &measured(2), None),
+            &summary_row(&cell(3), &measured(2), None, None, 2),
+        )
+        .unwrap();
+        drop(e);
+        let r = repair(&t, &s).unwrap();
+        assert_eq!(r.finished.len(), 2);
+        assert_eq!(r.dropped_trial_rows, 2);
+        assert_eq!(r.trials_csv, two_cells().0);
+    }
+
+    #[test]
+    fn a_line_cut_off_mid_write_is_dropped() {
+        let (t, mut s) = two_cells();
+        let mut t_cut = t.clone();
+        t_cut.extend_from_slice(b"rayon-iter,all-pairs,seed,60,3,4,,,1,0.5");
+        s.extend_from_slice(
+            b"rayon-iter,all-pairs,seed,60,3,4,,,3,1.0,1.0,1.0,1.0,1.0,1.0,1.0,1.0,0,fa",
+        );
+        let r = repair(&t_cut, &s).unwrap();
+        assert_eq!(r.finished.len(), 2);
+        assert_eq!((r.dropped_trial_rows, r.dropped_summary_rows), (1, 1));
+        assert_eq!(r.trials_csv, t);
+    }
+
+    #[test]
+    fn a_summary_row_whose_trials_are_incomplete_makes_the_cell_run_again() {
+        let (t, s) = two_cells();
+        let text = String::from_utf8(t).unwrap();
+        // Remove the last trial row of the second cell.
+        let mut lines: Vec<&str> = text.lines().collect();
+        lines.pop();
+        let t = format!("{}\n", lines.join("\n"));
+        let r = repair(t.as_bytes(), &s).unwrap();
+        assert_eq!(r.finished.len(), 1);
+        assert_eq!(r.finished[0].cores, 1);
+        assert_eq!(
+            (
+                r.kept_trial_rows,
+                r.dropped_trial_rows,
+                r.dropped_summary_rows
+            ),
+            (3, 2, 1)
+        );
+    }
+
+    #[test]
+    fn repeated_rows_are_kept_once() {
+        let (t, s) = two_cells();
+        let text = String::from_utf8(t.clone()).unwrap();
+        let last = text.lines().last().unwrap();
+        let t2 = format!("{text}{last}\n");
+        let stext = String::from_utf8(s.clone()).unwrap();
+        let s2 = format!("{stext}{}\n", stext.lines().last().unwrap());
+        let r = repair(t2.as_bytes(), s2.as_bytes()).unwrap();
+        assert_eq!(r.finished.len(), 2);
+        assert_eq!(r.trials_csv, t);
+        assert_eq!(r.summary_csv, s);
+    }
+
+    #[test]
+    fn missing_files_mean_nothing_is_finished() {
+        let r = repair(b"", b"").unwrap();
+        assert!(r.finished.is_empty());
+        assert!(r.trials_csv.starts_with(b"strategy,"));
+    }
+
+    #[test]
+    fn a_foreign_header_is_an_error() {
+        let err = repair(b"a,b\n1,2\n", b"").unwrap_err();
+        assert_eq!(err.file, "trials.csv");
+        assert!(err.to_string().contains("'a,b'"), "{err}");
+    }
+}
