@@ -6,6 +6,8 @@
 //! - [`scene`]: initial dam-break states; [`io`]: CSV in and out;
 //! - [`run`]: timed runs; [`clock`], [`checksum`]: what a run reports;
 //! - [`plot`]: the bundled font shared by charts and animations;
+//! - [`render`]: animations of the dam break (GIF or PNG frames); `viewer` (cargo feature
+//!   `viewer`): the same, live in a window;
 //! - [`sweep`]: the cores × chunks study (`bench-sph sweep`) and its result files;
 //! - [`cli`]: the `bench-sph` command line.
 
@@ -14,8 +16,11 @@ pub mod cli;
 pub mod clock;
 pub mod io;
 pub mod plot;
+pub mod render;
 pub mod run;
 pub mod scene;
 pub mod solver;
 pub mod sph;
 pub mod sweep;
+#[cfg(feature = "viewer")]
+pub mod viewer;

@@ -1,12 +1,16 @@
 //! The `bench-sph` command line (clap derive): one module for the definitions, one per command.
 
 mod list;
+mod render;
 mod simulate;
 mod sweep;
+#[cfg(feature = "viewer")]
+mod view;
 
 use clap::{Parser, Subcommand};
 use sph_strategies::StrategyName;
 
+pub use render::RenderArgs;
 pub use simulate::SimulateArgs;
 pub use sweep::SweepArgs;
 
@@ -30,6 +34,15 @@ pub enum Command {
     Simulate(SimulateArgs),
     /// List the parallel strategies, one per line: name, then what it does.
     List,
+    /// Animate the dam break: an animated GIF (or PNG frames), one frame every K steps.
+    #[command(
+        after_help = "Frame 0 is the initial state; --steps S --every K gives floor(S/K) + 1 frames.\n\n\
+        Examples:\n  \
+        bench-sph render                                 # seed preset, N = 1000, 1000 steps -> dambreak.gif\n  \
+        bench-sph render --every 15 --color density --out density.gif\n  \
+        bench-sph render --n 100 --steps 200 --frames frames/  # PNG frames instead"
+    )]
+    Render(RenderArgs),
     /// Measure every strategy over a cores × chunks grid: trials.csv, summary.csv, meta.json.
     #[command(
         after_help = "Each cell (strategy, cores, chunks) gets --warmup untimed runs, then --trials timed runs \
@@ -42,6 +55,16 @@ pub enum Command {
         bench-sph sweep --resume results/2026-11-22T031500Z"
     )]
     Sweep(SweepArgs),
+    /// Watch the dam break live in a window (cargo feature `viewer`).
+    #[cfg(feature = "viewer")]
+    #[command(
+        after_help = "Keys: space pauses, r resets, + and - double and halve N, s moves to the next \
+        strategy, c switches the colour between speed and density, q or Esc quits.\n\n\
+        Examples:\n  \
+        bench-sph view\n  \
+        bench-sph view --n 4000 --strategy rayon-chunks --cores 4"
+    )]
+    View(view::ViewArgs),
 }
 
 /// Parses the command line and runs the command.
@@ -49,7 +72,10 @@ pub fn run() -> anyhow::Result<()> {
     match Cli::parse().command {
         Command::Simulate(args) => simulate::run(&args),
         Command::List => list::run(&mut std::io::stdout().lock()),
+        Command::Render(args) => render::run(&args),
         Command::Sweep(args) => sweep::run(&args),
+        #[cfg(feature = "viewer")]
+        Command::View(args) => view::run(&args),
     }
 }
 

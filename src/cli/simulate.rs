@@ -80,7 +80,7 @@ struct Report {
 
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
-    let (state, domain) = initial_state(args)?;
+    let (state, domain) = initial_state(args.preset, args.n, args.seed, args.init.as_deref())?;
     let n = state.len();
     // Open the dump file before the run, so a bad path costs nothing.
     let mut dump = match &args.dump {
@@ -136,24 +136,30 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     print_report(&report, args.json)
 }
 
-/// The initial state and its tank, from --init or the preset's dam break.
-fn initial_state(args: &SimulateArgs) -> anyhow::Result<(State, Domain)> {
-    let Some(path) = &args.init else {
-        let n = args.n.unwrap_or(1000);
+/// The initial state and its tank, from `init` (a CSV file) or the preset's dam break of `n`
+/// particles (default 1000) jittered with `seed`. Shared by every command that runs the solver.
+pub(super) fn initial_state(
+    preset: Preset,
+    n: Option<usize>,
+    seed: u64,
+    init: Option<&Path>,
+) -> anyhow::Result<(State, Domain)> {
+    let Some(path) = init else {
+        let n = n.unwrap_or(1000);
         return Ok((
-            dam_break::initial_state(args.preset, n, args.seed),
-            dam_break::domain(args.preset, n),
+            dam_break::initial_state(preset, n, seed),
+            dam_break::domain(preset, n),
         ));
     };
     let rows = init_csv::read(path)?;
-    let n = rows.state.len();
-    if let Some(asked) = args.n.filter(|&asked| asked != n) {
+    let count = rows.state.len();
+    if let Some(asked) = n.filter(|&asked| asked != count) {
         anyhow::bail!(
-            "--n {asked} conflicts with init file '{}', which holds {n} particles",
+            "--n {asked} conflicts with init file '{}', which holds {count} particles",
             path.display()
         );
     }
-    let domain = dam_break::domain(args.preset, n);
+    let domain = dam_break::domain(preset, count);
     init_csv::check_walls(path, &rows, domain)?;
     Ok((rows.state, domain))
 }

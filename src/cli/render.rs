@@ -1,0 +1,155 @@
+//! `bench-sph render`: the dam break as an animated GIF or PNG frames.
+//!
+//! Frame 0 is the initial state; then one frame every `--every` steps, so `--steps S
+//! --every K` gives `floor(S / K) + 1` frames and runs `floor(S / K) · K` steps (steps past
+//! the last frame would not be seen, so they are not run).
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+
+use clap::Args;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use sph_strategies::{Config, StrategyName};
+
+use crate::render::frame::{Caption, MAX_WIDTH, MIN_WIDTH, Painter};
+use crate::render::output::Output;
+use crate::render::scale::{ColorBy, Scale};
+use crate::run::run_timed;
+use crate::solver::Simulation;
+use crate::sph::neighbors::NeighborMode;
+use crate::sph::params::Preset;
+
+/// Where the GIF goes when neither `--out` nor `--frames` is given.
+const DEFAULT_OUT: &str = "dambreak.gif";
+
+/// Renders below this many particle-steps finish too fast to need a progress bar.
+const PROGRESS_FROM_PARTICLE_STEPS: usize = 1_000_000;
+
+/// Options of `render`.
+#[derive(Debug, Clone, Args)]
+pub struct RenderArgs {
+    /// Constants and integration order to reproduce.
+    #[arg(long, value_enum, default_value_t = Preset::Seed)]
+    pub preset: Preset,
+    /// Number of particles [default: 1000, or the row count of --init].
+    #[arg(long, value_parser = super::positive)]
+    pub n: Option<usize>,
+    /// Number of steps to show (frames at steps 0, K, 2K, … up to this).
+    #[arg(long, default_value_t = 1000, value_parser = super::positive)]
+    pub steps: usize,
+    /// One frame every K steps.
+    #[arg(long, value_name = "K", default_value_t = 10, value_parser = super::positive)]
+    pub every: usize,
+    /// Neighbour search.
+    #[arg(long, value_enum, default_value_t = NeighborMode::AllPairs)]
+    pub neighbors: NeighborMode,
+    /// Parallel strategy (see `bench-sph list`); every strategy gives the same frames.
+    #[arg(long, default_value = "seq", value_parser = super::strategy)]
+    pub strategy: StrategyName,
+    /// Worker threads [default: the machine's hardware threads].
+    #[arg(long, value_parser = super::positive)]
+    pub cores: Option<usize>,
+    /// Chunks per pass, for strategies that use chunks.
+    #[arg(long, default_value_t = 10, value_parser = super::positive)]
+    pub chunks: usize,
+    /// Seed of the initial jitter.
+    #[arg(long, default_value_t = 2019)]
+    pub seed: u64,
+    /// Initial state from CSV (header row; columns x,y required, vx,vy optional).
+    #[arg(long, value_name = "FILE.csv")]
+    pub init: Option<PathBuf>,
+    /// What the particles' colour shows (the range is fixed for the whole animation).
+    #[arg(long, value_enum, default_value_t = ColorBy::Speed)]
+    pub color: ColorBy,
+    /// Image width, px (the height follows the tank's aspect ratio).
+    #[arg(long, default_value_t = 600,
+          value_parser = clap::value_parser!(u32).range(i64::from(MIN_WIDTH)..=i64::from(MAX_WIDTH)))]
+    pub width: u32,
+    /// GIF frames per second.
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=50))]
+    pub fps: u32,
+    /// Write an animated GIF here [default: dambreak.gif].
+    #[arg(long, value_name = "FILE.gif", conflicts_with = "frames")]
+    pub out: Option<PathBuf>,
+    /// Write PNG frames (frame_00000.png, …) into this folder instead of a GIF.
+    #[arg(long, value_name = "DIR")]
+    pub frames: Option<PathBuf>,
+}
+
+/// Runs `render`.
+pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
+    let (state, domain) =
+        super::simulate::initial_state(args.preset, args.n, args.seed, args.init.as_deref())?;
+    let params = args.preset.params();
+    let scale = Scale::new(args.color, &params, &state);
+    let painter = Painter::new(domain, params.h, scale, args.width);
+    let (width, height) = (painter.layout().width, painter.layout().height);
+
+    // Open the output before simulating, so a bad path costs nothing.
+    let mut output = match &args.frames {
+        Some(dir) => Output::png_frames(dir)?,
+        None => {
+            let path = args.out.clone().unwrap_or_else(|| DEFAULT_OUT.into());
+            Output::gif(&path, (width, height), &painter.palette(), args.fps)?
+        }
+    };
+
+    let frames = args.steps / args.every + 1;
+    let n = state.len();
+    let config = Config {
+        cores: args.cores.unwrap_or_else(super::hardware_threads),
+        chunks: args.chunks,
+    };
+    let mut sim = Simulation::new(params, domain, state, args.neighbors);
+    let caption = |sim: &Simulation| Caption {
+        step: sim.steps_done,
+        time_s: sim.steps_done as f64 * sim.params.dt,
+        n,
+        preset: args.preset,
+    };
+    let bar = progress_bar(frames, n * args.steps);
+    let started = std::time::Instant::now();
+    let mut simulating_s = 0.0;
+
+    output.push(&painter.draw(&sim.state, &caption(&sim)))?;
+    bar.inc(1);
+    for _ in 1..frames {
+        let shown = sim.steps_done;
+        match run_timed(&mut sim, args.strategy, &config, args.every) {
+            Ok(elapsed) => simulating_s += elapsed.wall_s,
+            Err(err) => {
+                bar.finish_and_clear();
+                let place = output.describe();
+                output.finish()?;
+                anyhow::bail!("{err} (the frames up to step {shown} are in {place})");
+            }
+        }
+        output.push(&painter.draw(&sim.state, &caption(&sim)))?;
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    let place = output.describe();
+    output.finish()?;
+    println!(
+        "{frames} frames of {width} × {height} px (steps 0 to {}, one every {}) written to {place}",
+        sim.steps_done, args.every
+    );
+    println!(
+        "{:.2} s in all, {simulating_s:.2} s of it simulating",
+        started.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+/// A bar counting frames on stderr; hidden when stderr is not a terminal or the render is tiny.
+fn progress_bar(frames: usize, particle_steps: usize) -> ProgressBar {
+    if particle_steps < PROGRESS_FROM_PARTICLE_STEPS || !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::with_draw_target(Some(frames as u64), ProgressDrawTarget::stderr());
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {elapsed} (eta {eta})")
+            .expect("the template is valid"),
+    );
+    bar
+}

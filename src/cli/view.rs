@@ -1,0 +1,64 @@
+//! `bench-sph view` (cargo feature `viewer`): the dam break live in a window.
+
+use clap::Args;
+use sph_strategies::{Config, StrategyName};
+
+use crate::render::frame::{MAX_WIDTH, MIN_WIDTH};
+use crate::render::scale::ColorBy;
+use crate::sph::neighbors::NeighborMode;
+use crate::sph::params::Preset;
+use crate::viewer::scene::Settings;
+
+/// Options of `view`.
+#[derive(Debug, Clone, Args)]
+pub struct ViewArgs {
+    /// Constants and integration order to reproduce.
+    #[arg(long, value_enum, default_value_t = Preset::Seed)]
+    pub preset: Preset,
+    /// Number of particles at start (+ and - double and halve it).
+    #[arg(long, default_value_t = 1000, value_parser = super::positive)]
+    pub n: usize,
+    /// Steps between two frames on screen.
+    #[arg(long, value_name = "K", default_value_t = 5, value_parser = super::positive)]
+    pub every: usize,
+    /// Neighbour search.
+    #[arg(long, value_enum, default_value_t = NeighborMode::Grid)]
+    pub neighbors: NeighborMode,
+    /// Parallel strategy at start (s moves to the next).
+    #[arg(long, default_value = "seq", value_parser = super::strategy)]
+    pub strategy: StrategyName,
+    /// Worker threads [default: the machine's hardware threads].
+    #[arg(long, value_parser = super::positive)]
+    pub cores: Option<usize>,
+    /// Chunks per pass, for strategies that use chunks.
+    #[arg(long, default_value_t = 10, value_parser = super::positive)]
+    pub chunks: usize,
+    /// Seed of the initial jitter.
+    #[arg(long, default_value_t = 2019)]
+    pub seed: u64,
+    /// What the particles' colour shows at start (c switches).
+    #[arg(long, value_enum, default_value_t = ColorBy::Speed)]
+    pub color: ColorBy,
+    /// Window width, px.
+    #[arg(long, default_value_t = 800,
+          value_parser = clap::value_parser!(u32).range(i64::from(MIN_WIDTH)..=i64::from(MAX_WIDTH)))]
+    pub width: u32,
+}
+
+/// Runs `view`.
+pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
+    crate::viewer::run(Settings {
+        preset: args.preset,
+        n: args.n,
+        seed: args.seed,
+        neighbors: args.neighbors,
+        strategy: args.strategy,
+        config: Config {
+            cores: args.cores.unwrap_or_else(super::hardware_threads),
+            chunks: args.chunks,
+        },
+        every: args.every,
+        color: args.color,
+        width: args.width,
+    })
+}

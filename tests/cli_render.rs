@@ -1,0 +1,268 @@
+//! `bench-sph render` driven through the built binary: the GIF and the PNG frames it writes
+//! (decoded and measured), the frame-count rule, and a clear `Error: ...` with a non-zero exit
+//! for each kind of bad input.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn bench_sph_in(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("binary runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Runs in `dir` and expects success.
+fn succeeds(dir: &Path, args: &[&str]) -> String {
+    let o = bench_sph_in(dir, args);
+    assert!(o.status.success(), "{args:?} failed:\n{}", stderr(&o));
+    stdout(&o)
+}
+
+/// Runs in `dir` and expects failure whose message contains every one of `needles`.
+fn fails_with(dir: &Path, args: &[&str], needles: &[&str]) {
+    let o = bench_sph_in(dir, args);
+    let err = stderr(&o);
+    assert!(!o.status.success(), "{args:?} succeeded: {}", stdout(&o));
+    for needle in needles {
+        assert!(
+            err.contains(needle),
+            "{args:?}: stderr lacks {needle:?}:\n{err}"
+        );
+    }
+    assert!(
+        !err.contains("panicked") && !err.contains("RUST_BACKTRACE"),
+        "{args:?} panicked:\n{err}"
+    );
+}
+
+/// The image size the render reports: "… of W × H px …".
+fn reported_size(out: &str) -> (u32, u32) {
+    let (_, rest) = out.split_once(" frames of ").expect("a summary line");
+    let mut words = rest.split_whitespace();
+    let width = words.next().unwrap().parse().unwrap();
+    assert_eq!(words.next(), Some("×"));
+    let height = words.next().unwrap().parse().unwrap();
+    (width, height)
+}
+
+/// What a GIF holds, as far as these tests look.
+struct Gif {
+    /// Screen width and height.
+    size: (u16, u16),
+    /// Each frame's left, top, width and height.
+    frames: Vec<[u16; 4]>,
+}
+
+fn decode_gif(path: &Path) -> Gif {
+    let file = std::fs::File::open(path).expect("the GIF exists");
+    let mut decoder = gif::DecodeOptions::new()
+        .read_info(std::io::BufReader::new(file))
+        .expect("a GIF header");
+    let size = (decoder.width(), decoder.height());
+    let mut frames = Vec::new();
+    while let Some(f) = decoder.read_next_frame().expect("a valid frame") {
+        frames.push([f.left, f.top, f.width, f.height]);
+    }
+    Gif { size, frames }
+}
+
+const SMALL: [&str; 8] = [
+    "--n", "100", "--steps", "40", "--every", "20", "--width", "400",
+];
+
+#[test]
+fn three_frames_at_n_100_decode_to_a_gif_of_three_frames_of_the_set_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = succeeds(
+        dir.path(),
+        &[&["render", "--out", "small.gif"][..], &SMALL].concat(),
+    );
+    assert!(out.contains("3 frames"), "{out}");
+    let (width, height) = reported_size(&out);
+    assert_eq!(width, 400);
+
+    let gif = decode_gif(&dir.path().join("small.gif"));
+    assert_eq!(gif.size, (400, height as u16));
+    assert_eq!(gif.frames.len(), 3);
+    for frame in gif.frames {
+        assert_eq!(frame, [0, 0, 400, height as u16]);
+    }
+    // The tank's aspect ratio (1200 × 900) sets the height: more than half the width.
+    assert!(height > 200 && height < 400, "{height}");
+}
+
+#[test]
+fn png_frames_are_written_one_per_frame_with_the_set_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = succeeds(
+        dir.path(),
+        &[
+            &["render", "--frames", "shots/run1", "--color", "density"][..],
+            &SMALL,
+        ]
+        .concat(),
+    );
+    let size = reported_size(&out);
+    let shots = dir.path().join("shots/run1");
+    let mut names: Vec<String> = std::fs::read_dir(&shots)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["frame_00000.png", "frame_00001.png", "frame_00002.png"]
+    );
+    for name in names {
+        let file = std::io::BufReader::new(std::fs::File::open(shots.join(&name)).unwrap());
+        let reader = png::Decoder::new(file).read_info().expect("a PNG");
+        let info = reader.info();
+        assert_eq!((info.width, info.height), size, "{name}");
+        assert_eq!(info.color_type, png::ColorType::Rgb, "{name}");
+    }
+}
+
+#[test]
+fn steps_past_the_last_whole_interval_make_no_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = succeeds(
+        dir.path(),
+        &[
+            "render", "--n", "30", "--steps", "50", "--every", "20", "--out", "a.gif",
+        ],
+    );
+    assert!(out.contains("3 frames"), "{out}");
+    assert!(out.contains("steps 0 to 40"), "{out}");
+    assert_eq!(decode_gif(&dir.path().join("a.gif")).frames.len(), 3);
+}
+
+#[test]
+fn without_out_or_frames_the_gif_goes_to_dambreak_gif() {
+    let dir = tempfile::tempdir().unwrap();
+    succeeds(
+        dir.path(),
+        &["render", "--n", "20", "--steps", "2", "--every", "1"],
+    );
+    assert_eq!(decode_gif(&dir.path().join("dambreak.gif")).frames.len(), 3);
+}
+
+#[test]
+fn every_strategy_renders_the_same_gif() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |strategy: &str| {
+        let name = format!("{strategy}.gif");
+        succeeds(
+            dir.path(),
+            &[
+                "render",
+                "--n",
+                "60",
+                "--steps",
+                "30",
+                "--every",
+                "10",
+                "--cores",
+                "2",
+                "--chunks",
+                "3",
+                "--strategy",
+                strategy,
+                "--out",
+                &name,
+            ],
+        );
+        std::fs::read(dir.path().join(name)).unwrap()
+    };
+    let seq = render("seq");
+    for strategy in ["rayon-chunks", "std-static"] {
+        assert!(render(strategy) == seq, "{strategy} drew different frames");
+    }
+}
+
+#[test]
+fn a_diverging_run_is_an_error_and_keeps_the_frames_before_it() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("boom.csv"),
+        "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n",
+    )
+    .unwrap();
+    fails_with(
+        dir.path(),
+        &[
+            "render", "--init", "boom.csv", "--steps", "5", "--every", "1", "--out", "b.gif",
+        ],
+        &[
+            "Error:",
+            "diverged at step 1",
+            "frames up to step 0",
+            "b.gif",
+        ],
+    );
+    assert_eq!(decode_gif(&dir.path().join("b.gif")).frames.len(), 1);
+}
+
+#[test]
+fn zero_counts_and_bad_sizes_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    fails_with(d, &["render", "--every", "0"], &["--every", "at least 1"]);
+    fails_with(d, &["render", "--steps", "0"], &["--steps", "at least 1"]);
+    fails_with(d, &["render", "--n", "0"], &["--n", "at least 1"]);
+    fails_with(d, &["render", "--width", "10"], &["--width"]);
+    fails_with(d, &["render", "--fps", "0"], &["--fps"]);
+    fails_with(d, &["render", "--color", "pressure"], &["--color"]);
+    assert!(!d.join("dambreak.gif").exists());
+}
+
+#[test]
+fn out_and_frames_together_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    fails_with(
+        dir.path(),
+        &["render", "--out", "a.gif", "--frames", "f"],
+        &["--out", "--frames", "cannot be used with"],
+    );
+    assert!(!dir.path().join("a.gif").exists());
+    assert!(!dir.path().join("f").exists());
+}
+
+#[test]
+fn an_unwritable_output_fails_before_anything_is_simulated() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("plain-file"), "not a folder").unwrap();
+    // A long render: were it simulated before the path is checked, this test would crawl.
+    let long = ["--n", "1000", "--steps", "20000", "--every", "1"];
+    fails_with(
+        d,
+        &[&["render", "--out", "no/such/dir/a.gif"][..], &long].concat(),
+        &["Error:", "cannot write GIF file 'no/such/dir/a.gif'"],
+    );
+    fails_with(
+        d,
+        &[&["render", "--frames", "plain-file/frames"][..], &long].concat(),
+        &["Error:", "cannot create frames folder 'plain-file/frames'"],
+    );
+}
+
+#[test]
+fn a_missing_init_file_is_one_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    fails_with(
+        dir.path(),
+        &["render", "--init", "nope.csv"],
+        &["Error:", "cannot read init file 'nope.csv'"],
+    );
+    assert!(!dir.path().join("dambreak.gif").exists());
+}
