@@ -9,6 +9,7 @@
 //! - [`render`]: animations of the dam break (GIF or PNG frames); `viewer` (cargo feature
 //!   `viewer`): the same, live in a window;
 //! - [`sweep`]: the cores × chunks study (`bench-sph sweep`) and its result files;
+//! - [`report`]: charts and REPORT.md from results directories (`bench-sph report`);
 //! - [`cli`]: the `bench-sph` command line.
 
 pub mod checksum;
@@ -17,6 +18,7 @@ pub mod clock;
 pub mod io;
 pub mod plot;
 pub mod render;
+pub mod report;
 pub mod run;
 pub mod scene;
 pub mod solver;

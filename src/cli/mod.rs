@@ -2,6 +2,7 @@
 
 mod list;
 mod render;
+mod report;
 mod simulate;
 mod sweep;
 #[cfg(feature = "viewer")]
@@ -11,6 +12,7 @@ use clap::{Parser, Subcommand};
 use sph_strategies::StrategyName;
 
 pub use render::RenderArgs;
+pub use report::ReportArgs;
 pub use simulate::SimulateArgs;
 pub use sweep::SweepArgs;
 
@@ -43,6 +45,18 @@ pub enum Command {
         bench-sph render --n 100 --steps 200 --frames frames/  # PNG frames instead"
     )]
     Render(RenderArgs),
+    /// Turn results directories into PNG charts and REPORT.md (also run at the end of a sweep).
+    #[command(
+        after_help = "Charts: runtime and CPU time against chunks per core count, best runtime and speedup \
+        against cores (with the paper's speedups where comparable), every strategy's speedup with error bars, \
+        efficiency and Karp–Flatt serial fraction, all-pairs against grid. Trace directories (timeline.png + \
+        stats.csv) under the results or output directory are embedded; --trace adds others.\n\n\
+        Examples:\n  \
+        bench-sph report results/2026-11-22T031500Z                 # writes the charts and REPORT.md there\n  \
+        bench-sph report results/paper results/grid --out report    # several sweeps as one study\n  \
+        bench-sph report results/paper --out report --trace trace-chunks"
+    )]
+    Report(ReportArgs),
     /// Measure every strategy over a cores × chunks grid: trials.csv, summary.csv, meta.json.
     #[command(
         after_help = "Each cell (strategy, cores, chunks) gets --warmup untimed runs, then --trials timed runs \
@@ -73,6 +87,7 @@ pub fn run() -> anyhow::Result<()> {
         Command::Simulate(args) => simulate::run(&args),
         Command::List => list::run(&mut std::io::stdout().lock()),
         Command::Render(args) => render::run(&args),
+        Command::Report(args) => report::run(&args),
         Command::Sweep(args) => sweep::run(&args),
         #[cfg(feature = "viewer")]
         Command::View(args) => view::run(&args),

@@ -230,16 +230,26 @@ pub fn run(request: Request) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The one place where a finished sweep's charts are made. Drawing belongs to
-/// `bench-sph report`; here the sweep only says how to get them (or that they were skipped).
+/// The one place where a finished sweep's charts are made: `bench-sph report` on the sweep's
+/// directory, writing into it. A drawing failure is an error, but the CSVs and meta.json are
+/// already complete by then.
 fn render_charts(dir: &Path, no_plots: bool) -> anyhow::Result<String> {
     if no_plots {
         return Ok("Charts: skipped (--no-plots).".to_owned());
     }
-    Ok(format!(
-        "Charts: drawn by `bench-sph report {}` (sweep itself does not draw them).",
-        dir.display()
-    ))
+    let written = crate::report::generate(&[dir.to_path_buf()], dir, &[]).with_context(|| {
+        format!(
+            "the charts and REPORT.md could not be made (the results in '{}' are complete; \
+             retry with `bench-sph report {}`)",
+            dir.display(),
+            dir.display()
+        )
+    })?;
+    let mut text = format!("Charts and report ({} files):", written.len());
+    for p in &written {
+        text.push_str(&format!("\n  {}", p.display()));
+    }
+    Ok(text)
 }
 
 /// Creates (or, with `force`, reclaims) the directory of a new sweep and writes its

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Reproduces the whole bench-sph study from a fresh clone: build, sweeps, traces, report.
+#
+# Usage: scripts/reproduce-study.sh [CORES]
+#   CORES  worker-thread counts for every sweep, as `bench-sph sweep --cores` takes them
+#          (default 1..2; on a 16-core machine: scripts/reproduce-study.sh 1..16).
+#
+# Writes (replacing earlier results of the same names):
+#   results/paper/            the paper's study: seed preset, all-pairs, N = 1000, 1000 steps,
+#                             every strategy, chunks 10..200 in steps of 10
+#   results/grid/             grid search at N = 1000, 10 000, 100 000, 20 steps
+#   results/all-pairs-small/  all-pairs at N = 1000, 3000, 20 steps (chart 6 beside the grid)
+#   report/                   charts, REPORT.md and two traces (rayon-chunks, rayon-spawn)
+# Run it on a quiet machine: nothing else should compete for the cores while it measures.
+set -euo pipefail
+
+CORES="${1:-1..2}"
+cd "$(dirname "$0")/.."
+
+cargo build --release
+BIN=target/release/bench-sph
+
+"$BIN" sweep --preset seed --neighbors all-pairs --n 1000 --steps 1000 \
+    --cores "$CORES" --chunks 10..200:10 --out results/paper --force --no-plots
+"$BIN" sweep --preset seed --neighbors grid --n 1000,10000,100000 --steps 20 \
+    --cores "$CORES" --chunks 10,50,200 --out results/grid --force --no-plots
+"$BIN" sweep --preset seed --neighbors all-pairs --n 1000,3000 --steps 20 \
+    --strategies rayon-chunks --cores "$CORES" --chunks 50 \
+    --out results/all-pairs-small --force --no-plots
+
+mkdir -p report
+"$BIN" trace --strategy rayon-chunks --cores 2 --chunks 45 --n 1000 --steps 3 \
+    --out report/trace-rayon-chunks-2c
+"$BIN" trace --strategy rayon-spawn --cores 2 --chunks 45 --n 1000 --steps 3 \
+    --out report/trace-rayon-spawn-2c
+
+# The report finds the traces under report/ itself.
+"$BIN" report results/paper results/grid results/all-pairs-small --out report
+echo "Done: report/REPORT.md"

@@ -1,0 +1,141 @@
+//! Chart 3 (the paper's Figures 9 and 10): one strategy's best runtime against cores (above,
+//! with the ideal `T_seq / p`) and its best speedup against cores (below, with the ideal
+//! `S = p` and, where comparable, the paper's published speedups as a reference series).
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use super::{
+    Area, CoresAxis, DrawResult, LegendEntry, Mark, axis_styles, cores_range, draw_dashed,
+    draw_line, integer_label, oversubscribed_entry, strategy_color, tick_label, y_max,
+};
+use crate::report::paper;
+use crate::report::series::Line;
+
+/// What chart 3 shows.
+#[derive(Debug, Clone)]
+pub struct BestChart<'a> {
+    /// The strategy.
+    pub strategy: &'a str,
+    /// Best runtime against cores.
+    pub runtime: Line,
+    /// Best speedup against cores.
+    pub speedup: Line,
+    /// The group's `seq` mean, seconds.
+    pub seq_s: f64,
+    /// Whether to show the paper's speedups.
+    pub paper: bool,
+}
+
+/// Draws `chart` into `path`.
+pub fn draw(path: &Path, title: &str, subtitle: &str, chart: &BestChart<'_>) -> anyhow::Result<()> {
+    let c = strategy_color(chart.strategy);
+    let mut legend = vec![
+        LegendEntry::new(
+            format!("{} (best chunks;\nbars: trial spread)", chart.strategy),
+            Mark::Line(c),
+        ),
+        LegendEntry::new(
+            "ideal: T_seq / p, S = p",
+            Mark::Dashed(RGBColor(90, 90, 90)),
+        ),
+    ];
+    if chart.paper {
+        legend.push(LegendEntry::new(
+            format!(
+                "paper's speedups (Haskell,\n{},\nN = {}, {} steps)",
+                paper::MACHINE,
+                paper::N,
+                paper::STEPS
+            ),
+            Mark::Triangle(RGBColor(110, 110, 110)),
+        ));
+    }
+    legend.extend(oversubscribed_entry(std::slice::from_ref(&chart.runtime)));
+    super::render(path, title, subtitle, &legend, |area| plot(area, chart, c))
+}
+
+fn plot(area: &Area<'_>, chart: &BestChart<'_>, c: RGBColor) -> DrawResult {
+    let (top, bottom) = area.split_vertically(area.dim_in_pixel().1 / 2);
+    let (labels, descs) = axis_styles();
+    let grey = RGBColor(90, 90, 90);
+
+    let mut lines = vec![chart.speedup.clone()];
+    if chart.paper {
+        lines.push(Line {
+            label: String::new(),
+            points: paper::TABLE
+                .iter()
+                .map(|r| crate::report::series::Point {
+                    x: r.cores as f64,
+                    y: r.speedup,
+                    lo: r.speedup,
+                    hi: r.speedup,
+                    oversubscribed: false,
+                })
+                .collect(),
+        });
+    }
+    let (x0, x1) = cores_range(&lines);
+    let (x0, x1) = (x0.min(0.6), x1);
+
+    // Runtime.
+    let y1 = y_max(std::slice::from_ref(&chart.runtime)).max(chart.seq_s) * 1.1;
+    let mut ch = ChartBuilder::on(&top)
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(76)
+        .build_cartesian_2d(CoresAxis::new(x0, x1), 0f64..y1)?;
+    ch.configure_mesh()
+        .disable_x_mesh()
+        .x_label_formatter(&integer_label)
+        .y_label_formatter(&tick_label)
+        .x_desc("cores")
+        .y_desc("best runtime (s)")
+        .label_style(labels.clone())
+        .axis_desc_style(descs.clone())
+        .draw()?;
+    let ideal: Vec<(f64, f64)> = chart
+        .runtime
+        .points
+        .iter()
+        .map(|p| (p.x, chart.seq_s / p.x))
+        .collect();
+    draw_dashed(&mut ch, ideal, grey)?;
+    draw_line(&mut ch, &chart.runtime, c, true)?;
+
+    // Speedup.
+    let s1 = (y_max(&lines).max(x1 - 0.4)) * 1.1;
+    let mut ch = ChartBuilder::on(&bottom)
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(76)
+        .build_cartesian_2d(CoresAxis::new(x0, x1), 0f64..s1)?;
+    ch.configure_mesh()
+        .disable_x_mesh()
+        .x_label_formatter(&integer_label)
+        .y_label_formatter(&tick_label)
+        .x_desc("cores")
+        .y_desc("best speedup (×)")
+        .label_style(labels)
+        .axis_desc_style(descs)
+        .draw()?;
+    draw_dashed(&mut ch, vec![(1.0, 1.0), (x1 - 0.4, x1 - 0.4)], grey)?;
+    if chart.paper {
+        let pts: Vec<(f64, f64)> = paper::TABLE
+            .iter()
+            .map(|r| (r.cores as f64, r.speedup))
+            .collect();
+        ch.draw_series(LineSeries::new(
+            pts.clone(),
+            RGBColor(170, 170, 170).stroke_width(1),
+        ))?;
+        ch.draw_series(
+            pts.into_iter()
+                .map(|p| TriangleMarker::new(p, 7, RGBColor(110, 110, 110).filled())),
+        )?;
+    }
+    draw_line(&mut ch, &chart.speedup, c, true)?;
+    Ok(())
+}

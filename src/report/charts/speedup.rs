@@ -1,0 +1,60 @@
+//! Chart 4: every strategy's best speedup against cores, error bars from the trial spread of
+//! the best cell (`T_seq / slowest` to `T_seq / fastest`), with the ideal `S = p`.
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+use super::{
+    Area, CoresAxis, DrawResult, LegendEntry, Mark, axis_styles, cores_range, draw_dashed,
+    draw_line, integer_label, oversubscribed_entry, strategy_color, tick_label, y_max,
+};
+use crate::report::series::Line;
+
+/// Draws `lines` (one per strategy) into `path`.
+pub fn draw(path: &Path, title: &str, subtitle: &str, lines: &[Line]) -> anyhow::Result<()> {
+    let mut legend: Vec<LegendEntry> = lines
+        .iter()
+        .map(|l| LegendEntry::new(l.label.clone(), Mark::Line(strategy_color(&l.label))))
+        .collect();
+    legend.push(LegendEntry::new(
+        "ideal: S = p",
+        Mark::Dashed(RGBColor(90, 90, 90)),
+    ));
+    legend.push(LegendEntry::new(
+        "bars: fastest to slowest\ntrial of the best cell",
+        Mark::Line(BLACK),
+    ));
+    legend.extend(oversubscribed_entry(lines));
+    super::render(path, title, subtitle, &legend, |area| plot(area, lines))
+}
+
+fn plot(area: &Area<'_>, lines: &[Line]) -> DrawResult {
+    let (x0, x1) = cores_range(lines);
+    let y1 = y_max(lines).max(x1 - 0.4) * 1.08;
+    let mut chart = ChartBuilder::on(area)
+        .margin(16)
+        .x_label_area_size(52)
+        .y_label_area_size(70)
+        .build_cartesian_2d(CoresAxis::new(x0, x1), 0f64..y1)?;
+    let (labels, descs) = axis_styles();
+    chart
+        .configure_mesh()
+        .disable_x_mesh()
+        .x_label_formatter(&integer_label)
+        .y_label_formatter(&tick_label)
+        .x_desc("cores")
+        .y_desc("speedup over seq (×)")
+        .label_style(labels)
+        .axis_desc_style(descs)
+        .draw()?;
+    draw_dashed(
+        &mut chart,
+        vec![(x0 + 0.4, x0 + 0.4), (x1 - 0.4, x1 - 0.4)],
+        RGBColor(90, 90, 90),
+    )?;
+    for line in lines {
+        draw_line(&mut chart, line, strategy_color(&line.label), true)?;
+    }
+    Ok(())
+}

@@ -1,0 +1,275 @@
+//! `bench-sph report` driven through the built binary on a committed fixture results
+//! directory (`tests/fixtures/report-results`: a tiny sweep under `--fake-timings`, so every
+//! number is known): every chart is a PNG of the documented size, REPORT.md carries the
+//! fixture's numbers, a chart that does not apply is skipped and said so, trace directories
+//! are embedded, bad input is one `Error: ...` line, and a sweep draws its own report.
+//! No test asserts a duration.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const WIDTH: u32 = 1000;
+const HEIGHT: u32 = 650;
+
+fn fixture() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/report-results")
+}
+
+fn bench_sph(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Runs `report` and expects success.
+fn report(args: &[&str]) -> Output {
+    let mut all = vec!["report"];
+    all.extend(args);
+    let o = bench_sph(&all);
+    assert!(
+        o.status.success(),
+        "{all:?}:\n{}\n{}",
+        text(&o.stdout),
+        text(&o.stderr)
+    );
+    o
+}
+
+/// Runs `report` and expects a single `Error: ...` line containing `needle`.
+fn report_fails(args: &[&str], needle: &str) {
+    let mut all = vec!["report"];
+    all.extend(args);
+    let o = bench_sph(&all);
+    let err = text(&o.stderr);
+    assert!(!o.status.success(), "{all:?} succeeded");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.starts_with("Error: ") && err.contains(needle), "{err}");
+}
+
+fn png_size(path: &Path) -> (u32, u32) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().expect("a PNG header");
+    let mut buf = vec![0; reader.output_buffer_size().expect("a buffer size")];
+    let info = reader.next_frame(&mut buf).expect("the PNG decodes");
+    (info.width, info.height)
+}
+
+fn pngs(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "png"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// A copy of the fixture's meta.json and only the summary rows for which `keep` holds.
+fn filtered_fixture(dir: &Path, keep: impl Fn(&str) -> bool) {
+    std::fs::create_dir_all(dir).unwrap();
+    std::fs::copy(fixture().join("meta.json"), dir.join("meta.json")).unwrap();
+    let summary = std::fs::read_to_string(fixture().join("summary.csv")).unwrap();
+    let mut lines = summary.lines();
+    let mut out = format!("{}\n", lines.next().unwrap());
+    for l in lines.filter(|l| keep(l)) {
+        out.push_str(l);
+        out.push('\n');
+    }
+    std::fs::write(dir.join("summary.csv"), out).unwrap();
+}
+
+#[test]
+fn every_chart_of_the_fixture_is_a_png_of_the_documented_size() {
+    let out = tempfile::tempdir().unwrap();
+    let o = report(&[
+        fixture().to_str().unwrap(),
+        "--out",
+        out.path().to_str().unwrap(),
+    ]);
+    let files = pngs(out.path());
+    // Per group (4): charts 1 and 2 for 2 chunked strategies, chart 3 for 3 strategies,
+    // charts 4 and 5; chart 6 once for the preset.
+    assert_eq!(files.len(), 4 * (2 * 2 + 3 + 2) + 1, "{files:?}");
+    for name in [
+        "seed-all-pairs-n60-s3-1-runtime-vs-chunks-rayon-chunks.png",
+        "seed-all-pairs-n60-s3-2-cpu-vs-chunks-crossbeam-pool.png",
+        "seed-grid-n120-s3-3-best-rayon-iter.png",
+        "seed-all-pairs-n120-s3-4-speedup.png",
+        "seed-grid-n60-s3-5-efficiency.png",
+        "seed-6-neighbors.png",
+    ] {
+        assert!(out.path().join(name).is_file(), "{name} missing");
+    }
+    for f in &files {
+        assert_eq!(png_size(f), (WIDTH, HEIGHT), "{}", f.display());
+        assert!(
+            text(&o.stdout).contains(&f.display().to_string()),
+            "{} not listed",
+            f.display()
+        );
+    }
+    let md = std::fs::read_to_string(out.path().join("REPORT.md")).unwrap();
+    for f in &files {
+        let name = f.file_name().unwrap().to_str().unwrap();
+        assert!(md.contains(&format!("]({name})")), "{name} not embedded");
+    }
+}
+
+#[test]
+fn the_report_carries_the_fixture_best_cells_speedups_and_the_paper_beside_them() {
+    let out = tempfile::tempdir().unwrap();
+    report(&[
+        fixture().to_str().unwrap(),
+        "--out",
+        out.path().to_str().unwrap(),
+    ]);
+    let md = std::fs::read_to_string(out.path().join("REPORT.md")).unwrap();
+    for needle in [
+        "| CPU |",
+        "| hardware threads | 2 |",
+        "--fake-timings",
+        "## seed preset, all-pairs, N = 60, 3 steps",
+        "Reference: `seq` at 1 core, 2.000 ± 0.040 s over 3 trials.",
+        // rayon-chunks, all-pairs N = 60: best cells beside the paper's Table 1.
+        "| 2 | 2 | 1.089 ± 0.022 | 1.84× | 0.92 | 45 | 14.904 | 2.00× |",
+        "| 3 ⚠ oversubscribed | 5 | 1.310 ± 0.026 | 1.53× | 0.51 | 90 | 10.39 | 2.87× |",
+        "| 6 | — | — | — | — | 150 | 5.816 | 5.13× |",
+        // rayon-iter has no chunks and so no paper columns.
+        "| 2 | — | 1.145 ± 0.023 | 1.75× | 0.87 |",
+        // The grid groups are not comparable with the paper: plain tables.
+        "| 2 | 2 | 0.5443 ± 0.0109 | 1.84× | 0.92 |",
+        "At 2 cores, **rayon-chunks** with 2 chunks is fastest: 1.089 s, 1.84× over seq, \
+         4.9 % less time than the runner-up crossbeam-pool (1.145 s).",
+        "e = 0.089",
+        "Speedups compare; absolute times do not",
+        "None: every cell reproduced its group's `seq` checksum.",
+    ] {
+        assert!(md.contains(needle), "REPORT.md lacks {needle:?}:\n{md}");
+    }
+}
+
+#[test]
+fn a_results_directory_with_one_neighbour_search_skips_chart_six_and_says_so() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("results");
+    filtered_fixture(&dir, |l| l.contains(",all-pairs,seed,60,"));
+    report(&[dir.to_str().unwrap()]);
+    assert!(!dir.join("seed-6-neighbors.png").exists());
+    assert_eq!(pngs(&dir).len(), 2 * 2 + 3 + 2);
+    let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
+    assert!(
+        md.contains("Chart 6 (all-pairs against grid) is not drawn for the seed preset"),
+        "{md}"
+    );
+}
+
+#[test]
+fn a_single_core_count_skips_the_charts_against_cores_and_says_so() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("results");
+    filtered_fixture(&dir, |l| l.contains(",grid,seed,60,3,1,"));
+    report(&[dir.to_str().unwrap()]);
+    let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
+    assert!(
+        md.contains("Charts 3–5 (against cores) are not drawn: only 1 core was measured."),
+        "{md}"
+    );
+    assert_eq!(pngs(&dir).len(), 2 * 2);
+}
+
+#[test]
+fn trace_directories_under_the_results_or_given_with_trace_are_embedded() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("results");
+    filtered_fixture(&dir, |l| l.contains(",all-pairs,seed,60,"));
+    let stats = "kind,name,threads,kernel_calls,busy_ms,span_ms,idle_pct,imbalance\n\
+                 worker,0,1,90,10.0,12.0,16.7,\npass,density,,90,9.5,5.0,5.0,1.10\n\
+                 total,all,2,180,19.0,12.0,20.8,\n";
+    for t in [dir.join("trace-inside"), tmp.path().join("trace-outside")] {
+        std::fs::create_dir_all(&t).unwrap();
+        std::fs::write(t.join("timeline.png"), b"not checked").unwrap();
+        std::fs::write(t.join("stats.csv"), stats).unwrap();
+    }
+    let outside = tmp.path().join("trace-outside");
+    report(&[dir.to_str().unwrap(), "--trace", outside.to_str().unwrap()]);
+    let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
+    assert!(md.contains("## Traces"), "{md}");
+    assert!(md.contains("](trace-inside/timeline.png)"), "{md}");
+    assert!(md.contains("](trace-outside-timeline.png)"), "{md}");
+    assert!(dir.join("trace-outside-timeline.png").is_file());
+    assert!(
+        md.contains("| density | 90 | 9.500 | 5.000 | 5.0 | 1.10 |"),
+        "{md}"
+    );
+    report_fails(
+        &[
+            dir.to_str().unwrap(),
+            "--trace",
+            tmp.path().to_str().unwrap(),
+        ],
+        "is not a trace directory",
+    );
+}
+
+#[test]
+fn a_missing_or_garbled_summary_or_meta_is_one_error_line_and_a_failure() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("results");
+    let d = dir.to_str().unwrap();
+    report_fails(&[d], "does not exist");
+    filtered_fixture(&dir, |_| true);
+    std::fs::remove_file(dir.join("summary.csv")).unwrap();
+    report_fails(&[d], "summary.csv");
+    filtered_fixture(&dir, |_| true);
+    std::fs::write(dir.join("summary.csv"), "strategy,cores\nseq,1\n").unwrap();
+    report_fails(&[d], "is not a bench-sph summary.csv");
+    filtered_fixture(&dir, |_| true);
+    std::fs::write(dir.join("meta.json"), "{ not json").unwrap();
+    report_fails(&[d], "meta.json");
+    assert!(!dir.join("REPORT.md").exists());
+}
+
+#[test]
+fn a_sweep_without_no_plots_writes_its_charts_and_report() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("sweep");
+    let o = bench_sph(&[
+        "sweep",
+        "--strategies",
+        "rayon-chunks",
+        "--cores",
+        "1..2",
+        "--chunks",
+        "2,5",
+        "--n",
+        "60",
+        "--steps",
+        "3",
+        "--trials",
+        "2",
+        "--warmup",
+        "0",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        o.status.success(),
+        "{}\n{}",
+        text(&o.stdout),
+        text(&o.stderr)
+    );
+    assert!(text(&o.stdout).contains("REPORT.md"), "{}", text(&o.stdout));
+    let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
+    assert!(md.contains("**rayon-chunks**"), "{md}");
+    for name in [
+        "seed-all-pairs-n60-s3-1-runtime-vs-chunks-rayon-chunks.png",
+        "seed-all-pairs-n60-s3-4-speedup.png",
+    ] {
+        assert_eq!(png_size(&dir.join(name)), (WIDTH, HEIGHT), "{name}");
+    }
+}
