@@ -10,6 +10,7 @@
 //!   `viewer`): the same, live in a window;
 //! - [`sweep`]: the cores × chunks study (`bench-sph sweep`) and its result files;
 //! - [`report`]: charts and REPORT.md from results directories (`bench-sph report`);
+//! - [`trace`]: per-worker timelines of a few steps (`bench-sph trace`);
 //! - [`cli`]: the `bench-sph` command line.
 
 pub mod checksum;
@@ -24,5 +25,6 @@ pub mod scene;
 pub mod solver;
 pub mod sph;
 pub mod sweep;
+pub mod trace;
 #[cfg(feature = "viewer")]
 pub mod viewer;

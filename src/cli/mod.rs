@@ -5,6 +5,7 @@ mod render;
 mod report;
 mod simulate;
 mod sweep;
+mod trace;
 #[cfg(feature = "viewer")]
 mod view;
 
@@ -15,6 +16,7 @@ pub use render::RenderArgs;
 pub use report::ReportArgs;
 pub use simulate::SimulateArgs;
 pub use sweep::SweepArgs;
+pub use trace::TraceArgs;
 
 /// bench-sph: which parallel strategy wins for a 2D SPH fluid, by how much and why.
 #[derive(Debug, Parser)]
@@ -45,18 +47,6 @@ pub enum Command {
         bench-sph render --n 100 --steps 200 --frames frames/  # PNG frames instead"
     )]
     Render(RenderArgs),
-    /// Turn results directories into PNG charts and REPORT.md (also run at the end of a sweep).
-    #[command(
-        after_help = "Charts: runtime and CPU time against chunks per core count, best runtime and speedup \
-        against cores (with the paper's speedups where comparable), every strategy's speedup with error bars, \
-        efficiency and Karp–Flatt serial fraction, all-pairs against grid. Trace directories (timeline.png + \
-        stats.csv) under the results or output directory are embedded; --trace adds others.\n\n\
-        Examples:\n  \
-        bench-sph report results/2026-11-22T031500Z                 # writes the charts and REPORT.md there\n  \
-        bench-sph report results/paper results/grid --out report    # several sweeps as one study\n  \
-        bench-sph report results/paper --out report --trace trace-chunks"
-    )]
-    Report(ReportArgs),
     /// Measure every strategy over a cores × chunks grid: trials.csv, summary.csv, meta.json.
     #[command(
         after_help = "Each cell (strategy, cores, chunks) gets --warmup untimed runs, then --trials timed runs \
@@ -69,6 +59,29 @@ pub enum Command {
         bench-sph sweep --resume results/2026-11-22T031500Z"
     )]
     Sweep(SweepArgs),
+    /// Turn results directories into PNG charts and REPORT.md (also run at the end of a sweep).
+    #[command(
+        after_help = "Charts: runtime and CPU time against chunks per core count, best runtime and speedup \
+        against cores (with the paper's speedups where comparable), every strategy's speedup with error bars, \
+        efficiency and Karp–Flatt serial fraction, all-pairs against grid. Trace directories (timeline.png + \
+        stats.csv) under the results or output directory are embedded; --trace adds others.\n\n\
+        Examples:\n  \
+        bench-sph report results/2026-11-22T031500Z                 # writes the charts and REPORT.md there\n  \
+        bench-sph report results/paper results/grid --out report    # several sweeps as one study\n  \
+        bench-sph report results/paper --out report --trace trace-chunks"
+    )]
+    Report(ReportArgs),
+    /// Record where each worker spends its time over a few steps: trace.json (Perfetto),
+    /// timeline.png, stats.csv, meta.json and a summary.
+    #[command(
+        after_help = "One event per kernel call (per chunk, per task for rayon-spawn, per leaf for rayon-iter), \
+        never per particle; trace.json opens in https://ui.perfetto.dev or chrome://tracing.\n\n\
+        Examples:\n  \
+        bench-sph trace --strategy rayon-chunks --cores 2 --chunks 45 --out trace-chunks\n  \
+        bench-sph trace --strategy rayon-spawn --cores 2 --steps 2 --out trace-spawn\n  \
+        bench-sph trace --strategy rayon-chunks --cores 2 --chunks 45 --steps 300 --compare 5 --out /tmp/t  # tracing's cost"
+    )]
+    Trace(TraceArgs),
     /// Watch the dam break live in a window (cargo feature `viewer`).
     #[cfg(feature = "viewer")]
     #[command(
@@ -87,8 +100,9 @@ pub fn run() -> anyhow::Result<()> {
         Command::Simulate(args) => simulate::run(&args),
         Command::List => list::run(&mut std::io::stdout().lock()),
         Command::Render(args) => render::run(&args),
-        Command::Report(args) => report::run(&args),
         Command::Sweep(args) => sweep::run(&args),
+        Command::Report(args) => report::run(&args),
+        Command::Trace(args) => trace::run(&args),
         #[cfg(feature = "viewer")]
         Command::View(args) => view::run(&args),
     }

@@ -531,8 +531,30 @@ fn traces(md: &mut String, traces: &[TraceDir]) {
                 total.idle_pct,
                 total.span_ms
             );
+            let _ = writeln!(md, "\n{}", trace_reading(total));
         }
         md.push('\n');
+    }
+}
+
+/// One sentence on what a timeline shows: how much work a kernel call carries and what the
+/// idle share says about per-call overhead.
+fn trace_reading(total: &super::traces::StatsRow) -> String {
+    let per_call_us = 1000.0 * total.busy_ms / total.kernel_calls.max(1) as f64;
+    let grain = format!("a kernel call carries {per_call_us:.1} µs of work on average");
+    if total.idle_pct > 50.0 {
+        format!(
+            "What it shows: {grain}, too little to pay for scheduling it — the workers spend most \
+             of the loop ({:.0} %) between calls, which is why this strategy loses to larger chunks.",
+            total.idle_pct
+        )
+    } else {
+        format!(
+            "What it shows: {grain}, enough to hide the scheduling cost — the workers stay busy \
+             {:.0} % of the loop, and the gaps are the short forces and integrate passes and the \
+             waits at the end of each pass.",
+            100.0 - total.idle_pct
+        )
     }
 }
 

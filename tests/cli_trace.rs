@@ -1,0 +1,400 @@
+//! `bench-sph trace` driven through the built binary: for every strategy, trace.json holds
+//! exactly one complete event per kernel call, covering every particle of every pass of every
+//! step once, on at most `cores` workers whose events never overlap; timeline.png and
+//! stats.csv are there and well formed; bad input is one `Error: ...` line and a non-zero
+//! exit. No test asserts a duration.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+use sph_strategies::StrategyName;
+
+const N: usize = 200;
+const STEPS: usize = 2;
+const CORES: usize = 2;
+const CHUNKS: usize = 7;
+const PASSES: [&str; 3] = ["density", "forces", "integrate"];
+const STATS_HEADER: &str = "kind,name,threads,kernel_calls,busy_ms,span_ms,idle_pct,imbalance";
+
+fn bench_sph(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn trace(strategy: StrategyName, out: &Path, extra: &[&str]) -> Output {
+    let (n, steps, cores, chunks) = (
+        N.to_string(),
+        STEPS.to_string(),
+        CORES.to_string(),
+        CHUNKS.to_string(),
+    );
+    let mut args = vec![
+        "trace",
+        "--strategy",
+        strategy.as_str(),
+        "--n",
+        &n,
+        "--steps",
+        &steps,
+        "--cores",
+        &cores,
+        "--chunks",
+        &chunks,
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    bench_sph(&args)
+}
+
+/// Kernel calls per pass, where the strategy fixes it (rayon-iter lets rayon decide).
+fn expected_calls(strategy: StrategyName) -> Option<usize> {
+    if strategy.info().uses_chunks {
+        return Some(CHUNKS.min(N));
+    }
+    match strategy {
+        StrategyName::Seq => Some(1),
+        StrategyName::StdStatic => Some(CORES.min(N)),
+        StrategyName::RayonSpawn => Some(N),
+        _ => None,
+    }
+}
+
+fn workers(strategy: StrategyName) -> usize {
+    if strategy == StrategyName::Seq {
+        1
+    } else {
+        CORES
+    }
+}
+
+/// A complete kernel event: (step, pass, worker, tid, first, len, ts, dur).
+#[derive(Debug, Clone)]
+struct Kernel {
+    step: u64,
+    pass: String,
+    worker: u64,
+    tid: u64,
+    first: usize,
+    len: usize,
+    ts: f64,
+    dur: f64,
+}
+
+/// The complete events of the worker tracks whose category is one of `cats` (`pass` for the
+/// three passes, `rebuild` for the grid rebuild's kernel calls).
+fn kernels(json: &Value, cats: &[&str]) -> Vec<Kernel> {
+    json["traceEvents"]
+        .as_array()
+        .expect("traceEvents is an array")
+        .iter()
+        .filter(|e| cats.iter().any(|c| e["cat"] == *c))
+        .map(|e| {
+            assert_eq!(e["ph"], "X", "{e}");
+            let args = &e["args"];
+            Kernel {
+                step: args["step"].as_u64().unwrap(),
+                pass: e["name"].as_str().unwrap().to_owned(),
+                worker: args["worker"].as_u64().unwrap(),
+                tid: e["tid"].as_u64().unwrap(),
+                first: args["first"].as_u64().unwrap() as usize,
+                len: args["len"].as_u64().unwrap() as usize,
+                ts: e["ts"].as_f64().unwrap(),
+                dur: e["dur"].as_f64().unwrap(),
+            }
+        })
+        .collect()
+}
+
+/// Checks trace.json in `dir`; returns the number of kernel calls (passes and rebuilds).
+fn check_trace_json(strategy: StrategyName, dir: &Path) -> usize {
+    let text = std::fs::read_to_string(dir.join("trace.json")).unwrap();
+    let json: Value = serde_json::from_str(&text).expect("trace.json is valid JSON");
+    let events = kernels(&json, &["pass"]);
+
+    let mut by_pass: BTreeMap<(u64, String), Vec<&Kernel>> = BTreeMap::new();
+    for e in &events {
+        by_pass.entry((e.step, e.pass.clone())).or_default().push(e);
+    }
+    let expected_keys: Vec<(u64, String)> = (1..=STEPS as u64)
+        .flat_map(|s| PASSES.map(|p| (s, p.to_owned())))
+        .collect();
+    assert_eq!(
+        by_pass.keys().cloned().collect::<Vec<_>>(),
+        expected_keys,
+        "{strategy}: every pass of every step"
+    );
+    for ((step, pass), mut calls) in by_pass {
+        if let Some(expected) = expected_calls(strategy) {
+            assert_eq!(calls.len(), expected, "{strategy}: step {step} {pass}");
+        }
+        calls.sort_by_key(|e| e.first);
+        let mut next = 0;
+        for e in calls {
+            assert_eq!(
+                e.first, next,
+                "{strategy}: step {step} {pass}: gap or overlap"
+            );
+            assert!(e.len > 0);
+            next += e.len;
+        }
+        assert_eq!(
+            next, N,
+            "{strategy}: step {step} {pass} covers every particle"
+        );
+    }
+
+    let all = kernels(&json, &["pass", "rebuild"]);
+    let mut per_worker: BTreeMap<u64, Vec<&Kernel>> = BTreeMap::new();
+    for e in &all {
+        assert!(
+            (e.worker as usize) < workers(strategy),
+            "{strategy}: worker {}",
+            e.worker
+        );
+        assert_eq!(e.tid, e.worker, "{strategy}: one track per worker");
+        assert!(e.dur >= 0.0);
+        per_worker.entry(e.worker).or_default().push(e);
+    }
+    for (worker, mut list) in per_worker {
+        list.sort_by(|a, b| a.ts.total_cmp(&b.ts));
+        for pair in list.windows(2) {
+            // 1 ns of slack for the microsecond conversion's rounding.
+            assert!(
+                pair[0].ts + pair[0].dur <= pair[1].ts + 1e-3,
+                "{strategy}: worker {worker}: {:?} overlaps {:?}",
+                pair[0],
+                pair[1]
+            );
+        }
+    }
+
+    let track_names: Vec<&str> = json["traceEvents"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["name"] == "thread_name")
+        .map(|e| e["args"]["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(track_names.len(), workers(strategy) + 1, "{track_names:?}");
+    assert!(track_names[0].starts_with("worker 0"), "{track_names:?}");
+    all.len()
+}
+
+fn check_timeline_png(strategy: StrategyName, dir: &Path) {
+    let bytes = std::fs::read(dir.join("timeline.png")).unwrap();
+    let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+    let reader = decoder.read_info().expect("timeline.png decodes");
+    let info = reader.info();
+    let tracks = workers(strategy) as u32 + 1;
+    assert_eq!(
+        (info.width, info.height),
+        (1600, 84 + 2 * (104 + 56 * tracks)),
+        "{strategy}"
+    );
+}
+
+fn check_stats_csv(strategy: StrategyName, dir: &Path, kernel_events: usize, grid: bool) {
+    let text = std::fs::read_to_string(dir.join("stats.csv")).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some(STATS_HEADER));
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let kinds: Vec<&str> = rows.iter().map(|r| r[0]).collect();
+    let mut expected = vec!["worker"; workers(strategy)];
+    expected.extend(vec!["pass"; if grid { 4 } else { 3 }]);
+    expected.push("total");
+    assert_eq!(kinds, expected, "{strategy}");
+    assert!(rows.iter().all(|r| r.len() == 8));
+    let total = rows.last().unwrap();
+    assert_eq!(total[3].parse::<usize>().unwrap(), kernel_events);
+    let worker_calls: usize = rows
+        .iter()
+        .filter(|r| r[0] == "worker")
+        .map(|r| r[3].parse::<usize>().unwrap())
+        .sum();
+    assert_eq!(worker_calls, kernel_events);
+}
+
+#[test]
+fn every_strategy_records_one_event_per_kernel_call_on_at_most_cores_workers_without_overlap() {
+    let tmp = tempfile::tempdir().unwrap();
+    for &strategy in StrategyName::ALL {
+        let dir = tmp.path().join(strategy.as_str());
+        let o = trace(strategy, &dir, &[]);
+        assert!(o.status.success(), "{strategy}: {}", stderr(&o));
+        let events = check_trace_json(strategy, &dir);
+        check_timeline_png(strategy, &dir);
+        check_stats_csv(strategy, &dir, events, false);
+        let out = stdout(&o);
+        assert!(
+            out.contains(&format!("TASKS: {events} kernel calls")),
+            "{out}"
+        );
+    }
+}
+
+#[test]
+fn with_the_grid_the_rebuild_s_kernel_calls_are_traced_beside_the_passes() {
+    let tmp = tempfile::tempdir().unwrap();
+    for strategy in [StrategyName::RayonChunks, StrategyName::StdStatic] {
+        let dir = tmp.path().join(strategy.as_str());
+        let o = trace(strategy, &dir, &["--neighbors", "grid"]);
+        assert!(o.status.success(), "{strategy}: {}", stderr(&o));
+        let events = check_trace_json(strategy, &dir);
+        check_stats_csv(strategy, &dir, events, true);
+        let json: Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.join("trace.json")).unwrap())
+                .unwrap();
+        let rebuilds = kernels(&json, &["rebuild"]);
+        assert!(!rebuilds.is_empty(), "{strategy}");
+        assert!(rebuilds.iter().all(|e| e.pass == "grid rebuild"));
+    }
+}
+
+#[test]
+fn a_traced_run_ends_in_the_same_state_as_simulate() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = trace(StrategyName::RayonChunks, tmp.path(), &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let meta: Value =
+        serde_json::from_str(&std::fs::read_to_string(tmp.path().join("meta.json")).unwrap())
+            .unwrap();
+    let s = bench_sph(&[
+        "simulate",
+        "--n",
+        "200",
+        "--steps",
+        "2",
+        "--json",
+        "--strategy",
+        "seq",
+    ]);
+    assert!(s.status.success(), "{}", stderr(&s));
+    let sim: Value = serde_json::from_str(stdout(&s).trim()).unwrap();
+    assert_eq!(meta["checksum"], sim["checksum"]);
+    assert_eq!(meta["strategy"], "rayon-chunks");
+    assert_eq!(meta["chunks"], CHUNKS);
+    assert_eq!(meta["n"], N);
+}
+
+#[test]
+fn compare_times_untraced_and_traced_runs_and_prints_both() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = trace(StrategyName::CrossbeamPool, tmp.path(), &["--compare", "2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(out.contains("compare (2 runs each"), "{out}");
+    assert!(
+        out.contains("untraced min") && out.contains("traced min"),
+        "{out}"
+    );
+    assert!(tmp.path().join("trace.json").is_file());
+}
+
+#[test]
+fn the_timeline_can_show_only_the_last_steps() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = trace(StrategyName::Seq, tmp.path(), &["--timeline-steps", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let meta: Value =
+        serde_json::from_str(&std::fs::read_to_string(tmp.path().join("meta.json")).unwrap())
+            .unwrap();
+    assert_eq!(meta["timeline_steps"], serde_json::json!([2, 2]));
+}
+
+/// Runs and expects failure whose message contains `needle`.
+fn fails_with(args: &[&str], needle: &str) {
+    let o = bench_sph(args);
+    let err = stderr(&o);
+    assert!(!o.status.success(), "{args:?} succeeded: {}", stdout(&o));
+    assert!(
+        err.contains(needle),
+        "{args:?}: stderr lacks {needle:?}:\n{err}"
+    );
+    assert!(!err.contains("panicked"), "{args:?} panicked:\n{err}");
+}
+
+#[test]
+fn an_unwritable_output_directory_is_an_error_before_anything_runs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tmp.path().join("a-file");
+    std::fs::write(&file, "x").unwrap();
+    let out = file.join("sub");
+    let o = bench_sph(&[
+        "trace",
+        "--strategy",
+        "seq",
+        "--n",
+        "10",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert!(
+        err.starts_with("Error: cannot create output directory"),
+        "{err}"
+    );
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+}
+
+#[test]
+fn a_diverging_run_is_an_error_and_leaves_no_trace_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let init = tmp.path().join("boom.csv");
+    std::fs::write(&init, "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n").unwrap();
+    let out = tmp.path().join("t");
+    let o = bench_sph(&[
+        "trace",
+        "--strategy",
+        "rayon-chunks",
+        "--cores",
+        "2",
+        "--init",
+        init.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = stderr(&o);
+    assert!(!o.status.success());
+    assert!(
+        err.starts_with("Error: the simulation diverged at step 1"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 0);
+}
+
+#[test]
+fn bad_counts_and_names_are_rejected() {
+    let base = ["trace", "--out", "unused-dir", "--strategy"];
+    fails_with(
+        &[&base[..], &["turbo"]].concat(),
+        "unknown strategy 'turbo'",
+    );
+    fails_with(
+        &[&base[..], &["seq", "--steps", "0"]].concat(),
+        "at least 1",
+    );
+    fails_with(
+        &[&base[..], &["seq", "--cores", "0"]].concat(),
+        "at least 1",
+    );
+    fails_with(
+        &[&base[..], &["seq", "--compare", "x"]].concat(),
+        "whole number",
+    );
+    fails_with(&["trace", "--strategy", "seq"], "--out");
+    assert!(!Path::new("unused-dir").exists());
+}
