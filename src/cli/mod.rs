@@ -3,6 +3,7 @@
 mod list;
 mod render;
 mod report;
+mod scene;
 mod simulate;
 mod sweep;
 mod trace;

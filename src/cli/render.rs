@@ -16,8 +16,6 @@ use crate::render::output::Output;
 use crate::render::scale::{ColorBy, Scale};
 use crate::run::run_timed;
 use crate::solver::Simulation;
-use crate::sph::neighbors::NeighborMode;
-use crate::sph::params::Preset;
 
 /// Where the GIF goes when neither `--out` nor `--frames` is given.
 const DEFAULT_OUT: &str = "dambreak.gif";
@@ -28,21 +26,15 @@ const PROGRESS_FROM_PARTICLE_STEPS: usize = 1_000_000;
 /// Options of `render`.
 #[derive(Debug, Clone, Args)]
 pub struct RenderArgs {
-    /// Constants and integration order to reproduce.
-    #[arg(long, value_enum, default_value_t = Preset::Seed)]
-    pub preset: Preset,
-    /// Number of particles [default: 1000, or the row count of --init].
-    #[arg(long, value_parser = super::positive)]
-    pub n: Option<usize>,
+    /// The scene: preset, N, neighbour search, seed, initial state.
+    #[command(flatten)]
+    pub scene: super::scene::SceneArgs,
     /// Number of steps to show (frames at steps 0, K, 2K, … up to this).
     #[arg(long, default_value_t = 1000, value_parser = super::positive)]
     pub steps: usize,
     /// One frame every K steps.
     #[arg(long, value_name = "K", default_value_t = 10, value_parser = super::positive)]
     pub every: usize,
-    /// Neighbour search.
-    #[arg(long, value_enum, default_value_t = NeighborMode::AllPairs)]
-    pub neighbors: NeighborMode,
     /// Parallel strategy (see `bench-sph list`); every strategy gives the same frames.
     #[arg(long, default_value = "seq", value_parser = super::strategy)]
     pub strategy: StrategyName,
@@ -52,12 +44,6 @@ pub struct RenderArgs {
     /// Chunks per pass, for strategies that use chunks.
     #[arg(long, default_value_t = 10, value_parser = super::positive)]
     pub chunks: usize,
-    /// Seed of the initial jitter.
-    #[arg(long, default_value_t = 2019)]
-    pub seed: u64,
-    /// Initial state from CSV (header row; columns x,y required, vx,vy optional).
-    #[arg(long, value_name = "FILE.csv")]
-    pub init: Option<PathBuf>,
     /// What the particles' colour shows (the range is fixed for the whole animation).
     #[arg(long, value_enum, default_value_t = ColorBy::Speed)]
     pub color: ColorBy,
@@ -78,9 +64,8 @@ pub struct RenderArgs {
 
 /// Runs `render`.
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
-    let (state, domain) =
-        super::simulate::initial_state(args.preset, args.n, args.seed, args.init.as_deref())?;
-    let params = args.preset.params();
+    let (state, domain) = args.scene.initial_state()?;
+    let params = args.scene.preset.params();
     let scale = Scale::new(args.color, &params, &state);
     let painter = Painter::new(domain, params.h, scale, args.width);
     let (width, height) = (painter.layout().width, painter.layout().height);
@@ -100,12 +85,12 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         cores: args.cores.unwrap_or_else(super::hardware_threads),
         chunks: args.chunks,
     };
-    let mut sim = Simulation::new(params, domain, state, args.neighbors);
+    let mut sim = Simulation::new(params, domain, state, args.scene.neighbors);
     let caption = |sim: &Simulation| Caption {
         step: sim.steps_done,
         time_s: sim.steps_done as f64 * sim.params.dt,
         n,
-        preset: args.preset,
+        preset: args.scene.preset,
     };
     let bar = progress_bar(frames, n * args.steps);
     let started = std::time::Instant::now();

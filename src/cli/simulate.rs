@@ -10,29 +10,21 @@ use serde::Serialize;
 use sph_strategies::{Config, StrategyName};
 
 use crate::checksum::checksum_hex;
-use crate::io::{dump_csv, init_csv};
+use crate::io::dump_csv;
 use crate::run::{RunError, run_timed};
-use crate::scene::dam_break;
 use crate::solver::{Simulation, StepError};
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
-use crate::sph::state::{Domain, State};
 
 /// Options of `simulate`.
 #[derive(Debug, Clone, Args)]
 pub struct SimulateArgs {
-    /// Constants and integration order to reproduce.
-    #[arg(long, value_enum, default_value_t = Preset::Seed)]
-    pub preset: Preset,
-    /// Number of particles [default: 1000, or the row count of --init].
-    #[arg(long, value_parser = super::positive)]
-    pub n: Option<usize>,
+    /// The scene: preset, N, neighbour search, seed, initial state.
+    #[command(flatten)]
+    pub scene: super::scene::SceneArgs,
     /// Number of steps.
     #[arg(long, default_value_t = 1000, value_parser = super::positive)]
     pub steps: usize,
-    /// Neighbour search.
-    #[arg(long, value_enum, default_value_t = NeighborMode::AllPairs)]
-    pub neighbors: NeighborMode,
     /// Parallel strategy (see `bench-sph list`).
     #[arg(long, default_value = "seq", value_parser = super::strategy)]
     pub strategy: StrategyName,
@@ -42,12 +34,6 @@ pub struct SimulateArgs {
     /// Chunks per pass, for strategies that use chunks.
     #[arg(long, default_value_t = 10, value_parser = super::positive)]
     pub chunks: usize,
-    /// Seed of the initial jitter.
-    #[arg(long, default_value_t = 2019)]
-    pub seed: u64,
-    /// Initial state from CSV (header row; columns x,y required, vx,vy optional).
-    #[arg(long, value_name = "FILE.csv")]
-    pub init: Option<PathBuf>,
     /// Write the final state to CSV (i,x,y,vx,vy,fx,fy,rho,p; exact round-trip).
     #[arg(long, value_name = "FILE.csv")]
     pub dump: Option<PathBuf>,
@@ -80,7 +66,7 @@ struct Report {
 
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
-    let (state, domain) = initial_state(args.preset, args.n, args.seed, args.init.as_deref())?;
+    let (state, domain) = args.scene.initial_state()?;
     let n = state.len();
     // Open the dump file before the run, so a bad path costs nothing.
     let mut dump = match &args.dump {
@@ -92,7 +78,12 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         cores,
         chunks: args.chunks,
     };
-    let mut sim = Simulation::new(args.preset.params(), domain, state, args.neighbors);
+    let mut sim = Simulation::new(
+        args.scene.preset.params(),
+        domain,
+        state,
+        args.scene.neighbors,
+    );
     sim.inject_panic_at(args.inject_panic_at);
     let outcome = run_timed(&mut sim, args.strategy, &config, args.steps);
 
@@ -115,8 +106,8 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
 
     let info = args.strategy.info();
     let report = Report {
-        preset: args.preset,
-        neighbors: args.neighbors,
+        preset: args.scene.preset,
+        neighbors: args.scene.neighbors,
         strategy: info.name.to_owned(),
         cores: if args.strategy == StrategyName::Seq {
             1
@@ -124,8 +115,8 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
             cores
         },
         chunks: info.uses_chunks.then_some(args.chunks),
-        seed: args.init.is_none().then_some(args.seed),
-        init: args.init.as_ref().map(|p| p.display().to_string()),
+        seed: args.scene.init.is_none().then_some(args.scene.seed),
+        init: args.scene.init.as_ref().map(|p| p.display().to_string()),
         n,
         steps: args.steps,
         wall_s: elapsed.wall_s,
@@ -134,34 +125,6 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         checksum: checksum_hex(&sim.state),
     };
     print_report(&report, args.json)
-}
-
-/// The initial state and its tank, from `init` (a CSV file) or the preset's dam break of `n`
-/// particles (default 1000) jittered with `seed`. Shared by every command that runs the solver.
-pub(super) fn initial_state(
-    preset: Preset,
-    n: Option<usize>,
-    seed: u64,
-    init: Option<&Path>,
-) -> anyhow::Result<(State, Domain)> {
-    let Some(path) = init else {
-        let n = n.unwrap_or(1000);
-        return Ok((
-            dam_break::initial_state(preset, n, seed),
-            dam_break::domain(preset, n),
-        ));
-    };
-    let rows = init_csv::read(path)?;
-    let count = rows.state.len();
-    if let Some(asked) = n.filter(|&asked| asked != count) {
-        anyhow::bail!(
-            "--n {asked} conflicts with init file '{}', which holds {count} particles",
-            path.display()
-        );
-    }
-    let domain = dam_break::domain(preset, count);
-    init_csv::check_walls(path, &rows, domain)?;
-    Ok((rows.state, domain))
 }
 
 fn create(path: &Path) -> anyhow::Result<BufWriter<File>> {

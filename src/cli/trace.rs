@@ -13,14 +13,15 @@ use sph_strategies::{Config, StrategyName};
 use crate::checksum::checksum_hex;
 use crate::run::run_timed;
 use crate::solver::Simulation;
-use crate::sph::neighbors::NeighborMode;
-use crate::sph::params::Preset;
 use crate::trace::stats::{self, Stats};
 use crate::trace::{TraceConfig, TracedRun, chrome, run_traced, timeline};
 
 /// Options of `trace`.
 #[derive(Debug, Clone, Args)]
 pub struct TraceArgs {
+    /// The scene: preset, N, neighbour search, seed, initial state.
+    #[command(flatten)]
+    pub scene: super::scene::SceneArgs,
     /// Parallel strategy to trace (see `bench-sph list`).
     #[arg(long, value_parser = super::strategy)]
     pub strategy: StrategyName,
@@ -30,24 +31,9 @@ pub struct TraceArgs {
     /// Chunks per pass, for strategies that use chunks.
     #[arg(long, default_value_t = 10, value_parser = super::positive)]
     pub chunks: usize,
-    /// Number of particles [default: 1000, or the row count of --init].
-    #[arg(long, value_parser = super::positive)]
-    pub n: Option<usize>,
     /// Number of steps to trace.
     #[arg(long, default_value_t = 3, value_parser = super::positive)]
     pub steps: usize,
-    /// Neighbour search.
-    #[arg(long, value_enum, default_value_t = NeighborMode::AllPairs)]
-    pub neighbors: NeighborMode,
-    /// Constants and integration order to reproduce.
-    #[arg(long, value_enum, default_value_t = Preset::Seed)]
-    pub preset: Preset,
-    /// Seed of the initial jitter.
-    #[arg(long, default_value_t = 2019)]
-    pub seed: u64,
-    /// Initial state from CSV (as for `simulate --init`).
-    #[arg(long, value_name = "FILE.csv")]
-    pub init: Option<PathBuf>,
     /// Output directory (created if missing): trace.json, timeline.png, stats.csv, meta.json.
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -135,8 +121,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
 }
 
 fn trace_and_write(args: &TraceArgs, out: &mut Outputs) -> anyhow::Result<()> {
-    let (state, domain) =
-        super::simulate::initial_state(args.preset, args.n, args.seed, args.init.as_deref())?;
+    let (state, domain) = args.scene.initial_state()?;
     let cores = args.cores.unwrap_or_else(super::hardware_threads);
     let strategy_config = Config {
         cores,
@@ -149,12 +134,19 @@ fn trace_and_write(args: &TraceArgs, out: &mut Outputs) -> anyhow::Result<()> {
         chunks: info.uses_chunks.then_some(args.chunks),
         n: state.len(),
         steps: args.steps,
-        preset: args.preset,
-        neighbors: args.neighbors,
-        seed: args.init.is_none().then_some(args.seed),
-        init: args.init.as_ref().map(|p| p.display().to_string()),
+        preset: args.scene.preset,
+        neighbors: args.scene.neighbors,
+        seed: args.scene.init.is_none().then_some(args.scene.seed),
+        init: args.scene.init.as_ref().map(|p| p.display().to_string()),
     };
-    let fresh = || Simulation::new(args.preset.params(), domain, state.clone(), args.neighbors);
+    let fresh = || {
+        Simulation::new(
+            args.scene.preset.params(),
+            domain,
+            state.clone(),
+            args.scene.neighbors,
+        )
+    };
     let traced = |sim: &mut Simulation| -> anyhow::Result<TracedRun> {
         Ok(run_traced(
             sim,
