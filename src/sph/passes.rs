@@ -14,8 +14,8 @@ use super::state::{Domain, Positions};
 /// neighbours j ≠ i.
 ///
 /// Contributions `(MASS·POLY6) · ((u·u)·u)`, `u = HSQ − r2`, are summed in index order from 0.
-/// The neighbours are written to `slots` in index order, as many as fit; the returned count
-/// is the true number.
+/// The neighbours are written to `slots` in index order, as many as fit before its last
+/// entry (which is scratch); the returned count is the true number.
 #[inline]
 pub fn density_pressure(
     i: usize,
@@ -26,15 +26,14 @@ pub fn density_pressure(
 ) -> (f64, f64, u32) {
     let mut rho = 0.0;
     let mut count = 0usize;
+    // No branch per neighbour: every hit is written at the next free slot (or the scratch
+    // slot once the list is full) and only j ≠ i advances the count.
+    let scratch = slots.len() - 1;
     nb.for_each_within(i, pos, prm.hsq, |j, r2| {
         let u = prm.hsq - r2;
         rho += prm.mass_poly6 * ((u * u) * u);
-        if j != i {
-            if let Some(slot) = slots.get_mut(count) {
-                *slot = j as u32;
-            }
-            count += 1;
-        }
+        slots[count.min(scratch)] = j as u32;
+        count += usize::from(j != i);
     });
     (rho, prm.gas_const * (rho - prm.rest_density), count as u32)
 }

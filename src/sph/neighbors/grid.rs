@@ -1,5 +1,6 @@
-//! A uniform cell list with cell size H, rebuilt every step by a stable counting sort of the
-//! particle indices by cell: O(N + cells), deterministic, no hashing of floats.
+//! A uniform cell list with cell size H (a hair over it), rebuilt every step by a stable
+//! counting sort of the particle indices by cell: O(N + cells), deterministic, no hashing of
+//! floats.
 //!
 //! Candidates of particle i are the particles in the 3×3 cells around it. Within one row of
 //! the grid the three cells are contiguous in the sorted order, so each row is one slice. The
@@ -47,7 +48,9 @@ impl Grid {
         );
         Grid {
             shape: Shape {
-                cell: h,
+                // A hair wider than H, so that multiplying by the rounded reciprocal can never
+                // put two particles closer than H two cells apart.
+                per_cell: 1.0 / (h * (1.0 + 1e-9)),
                 cols,
                 rows,
             },
@@ -69,8 +72,8 @@ impl Grid {
 /// Cell size and counts of a grid (small and `Copy`, so kernels can share it).
 #[derive(Debug, Clone, Copy)]
 struct Shape {
-    /// Cell edge, px (the kernel radius).
-    cell: f64,
+    /// Cells per px: the reciprocal of the cell edge (just over the kernel radius).
+    per_cell: f64,
     /// Cells along x.
     cols: usize,
     /// Cells along y.
@@ -83,10 +86,10 @@ impl Shape {
     /// that cell or the one next to it.
     #[inline]
     fn coords(&self, x: f64, y: f64) -> (usize, usize) {
-        // `as usize` saturates: negative and NaN give 0, huge values clamp below.
-        let cx = ((x / self.cell) as usize).min(self.cols - 1);
-        let cy = ((y / self.cell) as usize).min(self.rows - 1);
-        (cx, cy)
+        // `as i64` saturates (NaN gives 0) and is one instruction on x86-64, unlike `as usize`.
+        let cx = ((x * self.per_cell) as i64).clamp(0, self.cols as i64 - 1);
+        let cy = ((y * self.per_cell) as i64).clamp(0, self.rows as i64 - 1);
+        (cx as usize, cy as usize)
     }
 
     /// The row-major cell number of a position.
@@ -142,7 +145,7 @@ impl Neighbors for Grid {
         )
     }
 
-    #[inline]
+    #[inline(always)]
     fn for_each_within(
         &self,
         i: usize,
@@ -153,46 +156,55 @@ impl Neighbors for Grid {
         let (xi, yi) = (pos.x[i], pos.y[i]);
         let (cx, cy) = self.shape.coords(xi, yi);
         let (c0, c1) = (cx.saturating_sub(1), (cx + 1).min(self.shape.cols - 1));
-        // Hits are kept sorted by particle index as they arrive (insertion into a small stack
-        // buffer: a particle has about 5-30 hits, mostly nearly in order). A crowd beyond the
-        // buffer spills into a vector that is sorted once.
-        let mut index = [0u32; INLINE_HITS];
-        let mut dist2 = [0.0f64; INLINE_HITS];
+        // Hits are collected without branching (every candidate is written, the count only
+        // advances on a hit), then put in index order by a branch-free rank sort; a row that
+        // would overflow the stack buffer goes to a vector, sorted once. The squared distance
+        // is recomputed when a hit is visited (same formula, same bits) so that only indices
+        // are moved.
+        let mut hits = [0u32; INLINE_HITS];
         let mut len = 0;
-        let mut spilled: Vec<(u32, f64)> = Vec::new();
+        let mut spilled: Vec<u32> = Vec::new();
         for row in cy.saturating_sub(1)..=(cy + 1).min(self.shape.rows - 1) {
             let lo = self.start[row * self.shape.cols + c0] as usize;
             let hi = self.start[row * self.shape.cols + c1 + 1] as usize;
-            for k in lo..hi {
-                let r2 = distance_squared(xi, yi, self.sorted_x[k], self.sorted_y[k]);
-                if r2 < hsq {
-                    let j = self.order[k];
-                    if len == INLINE_HITS {
-                        spilled.push((j, r2));
-                        continue;
-                    }
-                    let mut slot = len;
-                    while slot > 0 && index[slot - 1] > j {
-                        index[slot] = index[slot - 1];
-                        dist2[slot] = dist2[slot - 1];
-                        slot -= 1;
-                    }
-                    index[slot] = j;
-                    dist2[slot] = r2;
-                    len += 1;
+            let (xs, ys, js) = (
+                &self.sorted_x[lo..hi],
+                &self.sorted_y[lo..hi],
+                &self.order[lo..hi],
+            );
+            if len + js.len() <= INLINE_HITS {
+                for ((&xj, &yj), &j) in xs.iter().zip(ys).zip(js) {
+                    hits[len] = j;
+                    len += usize::from(distance_squared(xi, yi, xj, yj) < hsq);
                 }
+            } else {
+                spilled.extend(xs.iter().zip(ys).zip(js).filter_map(|((&xj, &yj), &j)| {
+                    (distance_squared(xi, yi, xj, yj) < hsq).then_some(j)
+                }));
             }
         }
-        if spilled.is_empty() {
-            for (&j, &r2) in index[..len].iter().zip(&dist2[..len]) {
-                visit(j as usize, r2);
-            }
+        let mut ranked = [0u32; INLINE_HITS];
+        let hits = if spilled.is_empty() {
+            rank_sort(&hits[..len], &mut ranked[..len]);
+            &ranked[..len]
         } else {
-            spilled.extend(index.iter().copied().zip(dist2));
-            spilled.sort_unstable_by_key(|&(j, _)| j);
-            for (j, r2) in spilled {
-                visit(j as usize, r2);
-            }
+            spilled.extend_from_slice(&hits[..len]);
+            spilled.sort_unstable();
+            &spilled[..]
+        };
+        for &j in hits {
+            let j = j as usize;
+            visit(j, distance_squared(xi, yi, pos.x[j], pos.y[j]));
         }
+    }
+}
+
+/// Puts the distinct values of `src` in increasing order into `dst` by counting, for each, how
+/// many are smaller: quadratic but branch-free, which beats branching sorts on a few dozen.
+#[inline]
+fn rank_sort(src: &[u32], dst: &mut [u32]) {
+    for &j in src {
+        let rank: u32 = src.iter().map(|&w| u32::from(w < j)).sum();
+        dst[rank as usize] = j;
     }
 }

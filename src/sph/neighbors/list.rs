@@ -2,8 +2,9 @@
 //! pass, so a step scans for candidates once instead of twice.
 //!
 //! A particle has [`SLOTS`] slots. Its count is the true number of neighbours (j ≠ i with
-//! `r2 < HSQ`); when it exceeds the slots the list is incomplete and the force pass asks the
-//! search again for that particle. Either way the same j are visited in the same order.
+//! `r2 < HSQ`); the list holds at most `SLOTS - 1` of them (the last slot is scratch, so
+//! the density pass can write every hit without branching). When the count is higher the
+//! list is incomplete and the force pass asks the search again for that particle. Either way the same j are visited in the same order.
 
 use sph_strategies::Split;
 
@@ -16,7 +17,8 @@ pub const SLOTS: usize = 32;
 pub struct NeighborLists {
     /// Neighbours of particle i (excluding i), possibly more than [`SLOTS`].
     pub count: Vec<u32>,
-    /// Particle i's neighbours are `slots[i * SLOTS..][..min(count[i], SLOTS)]`, increasing.
+    /// Particle i's neighbours are `slots[i * SLOTS..][..count[i]]`, increasing, when
+    /// `count[i] < SLOTS`.
     pub slots: Vec<u32>,
 }
 
@@ -33,7 +35,7 @@ impl NeighborLists {
     #[inline]
     pub fn of(&self, i: usize) -> Option<&[u32]> {
         let count = self.count[i] as usize;
-        (count <= SLOTS).then(|| &self.slots[i * SLOTS..i * SLOTS + count])
+        (count < SLOTS).then(|| &self.slots[i * SLOTS..i * SLOTS + count])
     }
 
     /// Heap bytes held.
