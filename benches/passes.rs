@@ -1,16 +1,17 @@
 //! Criterion benches: each pass (density, forces) and a full step, for every strategy in the
 //! registry, at 1 core and at all hardware threads, on the paper's all-pairs N = 1000 and on
-//! the grid at N = 100 000. Chunked strategies use 10 chunks per core. Run with `cargo bench`
-//! or `cargo criterion` (install it with `cargo install cargo-criterion`).
+//! the grid at N = 100 000, each from the seed dam break after 100 steps. Chunked strategies
+//! use 10 chunks per core. Run with `cargo bench` or `cargo criterion` (install it with
+//! `cargo install cargo-criterion`).
 
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use bench_sph::scene::dam_break;
 use bench_sph::solver::{Pass, Simulation};
 use bench_sph::sph::neighbors::NeighborMode;
 use bench_sph::sph::params::Preset;
-use criterion::measurement::WallTime;
-use criterion::{BenchmarkGroup, BenchmarkId, Criterion, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use sph_strategies::seq::SeqExecutor;
 use sph_strategies::{Config, Executor, Session, StrategyName};
 
 /// What one benchmark measures.
@@ -35,35 +36,69 @@ impl Work {
     }
 }
 
-/// Runs one benchmark inside a strategy's session, so the pool exists only once.
-struct Bench<'g, 'c> {
-    group: &'g mut BenchmarkGroup<'c, WallTime>,
-    id: BenchmarkId,
-    sim: Simulation,
+/// Steps run before benchmarking, so that every benchmark starts from the same fluid in
+/// motion rather than from the dam at rest.
+const SETTLE_STEPS: usize = 100;
+
+/// Times `iters` repetitions of one benchmark's work inside a strategy's session (the
+/// strategy's threads are started before the session, outside the timing). Every repetition
+/// starts from `start`: a pass rewrites only its own outputs, and a step is timed from a
+/// fresh copy (made outside the timing), so every strategy measures the same work.
+struct TimedIters<'s> {
+    start: &'s Simulation,
+    sim: &'s mut Simulation,
     work: Work,
+    iters: u64,
 }
 
-impl Session for Bench<'_, '_> {
-    type Output = ();
+impl Session for TimedIters<'_> {
+    type Output = Duration;
 
-    fn run<E: Executor>(mut self, exec: &E) {
-        // Bring the neighbour lists and densities up to date before timing a single pass.
-        self.sim.rebuild_neighbors();
-        for pass in [Pass::Density, Pass::Forces] {
-            self.sim.run_pass(exec, pass).expect("pass runs");
+    fn run<E: Executor>(self, exec: &E) -> Duration {
+        let mut total = Duration::ZERO;
+        for _ in 0..self.iters {
+            let begin = match self.work {
+                Work::Pass(pass) => {
+                    let begin = Instant::now();
+                    self.sim.run_pass(exec, pass).expect("pass runs");
+                    begin
+                }
+                Work::Step => {
+                    self.sim.clone_from(self.start);
+                    let begin = Instant::now();
+                    self.sim.advance(exec, 1).expect("step runs");
+                    begin
+                }
+            };
+            total += begin.elapsed();
         }
-        let sim = &mut self.sim;
-        self.group.bench_function(self.id, |b| match self.work {
-            Work::Pass(pass) => b.iter(|| sim.run_pass(exec, pass).expect("pass runs")),
-            Work::Step => b.iter(|| sim.advance(exec, 1).expect("step runs")),
-        });
+        total
     }
+}
+
+/// The seed dam break of `n` particles after [`SETTLE_STEPS`] steps, with this step's
+/// neighbour lists, densities and forces in place (so a single pass can be timed).
+fn settled(mode: NeighborMode, n: usize) -> Simulation {
+    let mut sim = Simulation::new(
+        Preset::Seed.params(),
+        dam_break::domain(Preset::Seed, n),
+        dam_break::initial_state(Preset::Seed, n, 2019),
+        mode,
+    );
+    sim.advance(&SeqExecutor, SETTLE_STEPS)
+        .expect("settling runs");
+    sim.rebuild_neighbors();
+    for pass in [Pass::Density, Pass::Forces] {
+        sim.run_pass(&SeqExecutor, pass).expect("pass runs");
+    }
+    sim
 }
 
 fn bench_scene(c: &mut Criterion, label: &str, mode: NeighborMode, n: usize) {
     let all = std::thread::available_parallelism().map_or(1, |n| n.get());
     let mut cores_list = vec![1, all];
     cores_list.dedup();
+    let start = settled(mode, n);
     for work in Work::ALL {
         let mut group = c.benchmark_group(format!("{label}/{}", work.name()));
         group
@@ -75,28 +110,23 @@ fn bench_scene(c: &mut Criterion, label: &str, mode: NeighborMode, n: usize) {
                 if strategy == StrategyName::Seq && cores > 1 {
                     continue;
                 }
-                let sim = Simulation::new(
-                    Preset::Seed.params(),
-                    dam_break::domain(Preset::Seed, n),
-                    dam_break::initial_state(Preset::Seed, n, 2019),
-                    mode,
-                );
-                let id = BenchmarkId::new(strategy.as_str(), format!("{cores}-cores"));
-                let bench = Bench {
-                    group: &mut group,
-                    id,
-                    sim,
-                    work,
+                let mut sim = start.clone();
+                let config = Config {
+                    cores,
+                    chunks: 10 * cores,
                 };
-                sph_strategies::run(
-                    strategy,
-                    &Config {
-                        cores,
-                        chunks: 10 * cores,
-                    },
-                    bench,
-                )
-                .expect("strategy builds");
+                let id = BenchmarkId::new(strategy.as_str(), format!("{cores}-cores"));
+                group.bench_function(id, |b| {
+                    b.iter_custom(|iters| {
+                        let timed = TimedIters {
+                            start: &start,
+                            sim: &mut sim,
+                            work,
+                            iters,
+                        };
+                        sph_strategies::run(strategy, &config, timed).expect("strategy builds")
+                    })
+                });
             }
         }
         group.finish();

@@ -242,7 +242,7 @@ fn print_summary(
     writeln!(out, "trace: {}, {} steps", config.title(), config.steps)?;
     writeln!(
         out,
-        "step loop {:.3} ms traced; serial work on the caller {:.3} ms",
+        "step loop {:.3} ms traced; serial work between passes {:.3} ms",
         wall_s * 1e3,
         ms(stats.total.serial_ns)
     )?;

@@ -34,7 +34,7 @@ pub enum StepError {
 }
 
 /// A running simulation: constants, walls, particles and the neighbour search.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct Simulation {
     /// The preset's constants.
     pub params: Params,

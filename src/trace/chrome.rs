@@ -2,7 +2,7 @@
 //! (<https://ui.perfetto.dev>) and `chrome://tracing` open.
 //!
 //! One process; one track (`tid`) per worker, named `worker k (thread)`, and one more track,
-//! `caller (serial)`, for the grid rebuild and divergence check done between passes by the
+//! `serial (between passes)`, for the grid rebuild and divergence check done between passes by the
 //! thread that drives the steps. Each kernel call is one complete event (`"ph": "X"`) named
 //! after its pass, with category `pass` (or named `grid rebuild`, category `rebuild`, for the
 //! grid's rebuild kernels), `ts`/`dur` in microseconds from the start of the step loop, and
@@ -115,7 +115,7 @@ pub fn write<W: Write>(
     let tracks = workers
         .iter()
         .map(|w| (w.worker, worker_track_name(w)))
-        .chain([(caller_tid, "caller (serial)".to_owned())]);
+        .chain([(caller_tid, "serial (between passes)".to_owned())]);
     for (tid, name) in tracks {
         events.push(meta("thread_name", tid, Args::Name { name }));
         events.push(meta(
@@ -272,7 +272,7 @@ mod tests {
             [
                 (0, "worker 0 (rayon-chunks-0)"),
                 (1, "worker 1 (rayon-chunks-1)"),
-                (2, "caller (serial)")
+                (2, "serial (between passes)")
             ]
         );
         let step = events.iter().find(|e| e["ph"] == "i").unwrap();

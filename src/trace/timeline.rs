@@ -156,7 +156,7 @@ fn draw(
     let tracks = trace.workers + 1;
     let mut labels: Vec<String> = workers.iter().map(worker_track_name).collect();
     labels.resize(trace.workers, String::new());
-    labels.push("caller (serial)".to_owned());
+    labels.push("serial (between passes)".to_owned());
 
     let root = BitMapBackend::with_buffer(pixels, size).into_drawing_area();
     root.fill(&WHITE)?;

@@ -106,10 +106,11 @@ pub trait Executor {
 /// The body of a run: everything that happens while a strategy's threads exist.
 ///
 /// It is a trait rather than a closure because its `run` is generic over the executor, so that
-/// every pass is statically dispatched.
-pub trait Session {
+/// every pass is statically dispatched. It is `Send` because a strategy may run it on one of
+/// its own threads.
+pub trait Session: Send {
     /// What the run produces.
-    type Output;
+    type Output: Send;
 
     /// Runs the body with `exec`.
     fn run<E: Executor>(self, exec: &E) -> Self::Output;

@@ -6,12 +6,13 @@
 //! neighbouring chunks onto one thread, but calls the kernel exactly once per chunk, and idle
 //! threads steal the rest.
 //!
-//! **Cost.** No thread start-up (the pool of `cores` threads is built once, outside timing);
-//! per pass one `install`, a vector of chunks and about one `join` per chunk; nothing per
-//! element. Too few chunks leave threads idle; too many add scheduling overhead.
+//! **Cost.** No thread start-up (the pool of `cores` threads is built once, outside timing,
+//! and the whole session runs on one of its threads, see `rayon_pool::run_inside`); per pass
+//! a vector of chunks and about one `join` per chunk; nothing per element. Too few chunks
+//! leave threads idle; too many add scheduling overhead.
 //!
 //! **Panics.** Rayon finishes both halves of a `join` and then re-raises a kernel's panic on
-//! the calling thread, where it is caught and returned as [`KernelPanic`].
+//! the thread that started the pass, where it is caught and returned as [`KernelPanic`].
 
 use rayon::iter::{IntoParallelIterator, ParallelIterator};
 
@@ -44,8 +45,9 @@ impl Strategy for RayonChunks {
     }
 
     fn run<S: Session>(&self, session: S) -> S::Output {
-        session.run(&RayonChunksExecutor {
-            pool: &self.pool,
+        // The session runs on one of the pool's threads: see `rayon_pool::run_inside`.
+        crate::rayon_pool::run_inside(&self.pool, session, |pool| RayonChunksExecutor {
+            pool,
             chunks: self.chunks,
         })
     }

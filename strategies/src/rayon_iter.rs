@@ -6,12 +6,13 @@
 //! far to go (about a few pieces per thread, more where work is stolen), and the kernel is
 //! called once per leaf that rayon does not split further. `--chunks` is ignored.
 //!
-//! **Cost.** No thread start-up (the pool of `cores` threads is built once, outside timing);
-//! per pass one `install` into the pool, then one `join` and one split per halving. The number
-//! of kernel calls varies from run to run, between 1 and `len`.
+//! **Cost.** No thread start-up (the pool of `cores` threads is built once, outside timing,
+//! and the whole session runs on one of its threads, see `rayon_pool::run_inside`); per pass
+//! one `join` and one split per halving. The number of kernel calls varies from run to run,
+//! between 1 and `len`.
 //!
 //! **Panics.** Rayon finishes both halves of a `join` and then re-raises a kernel's panic on
-//! the calling thread, where it is caught and returned as [`KernelPanic`].
+//! the thread that started the pass, where it is caught and returned as [`KernelPanic`].
 
 use rayon::iter::ParallelIterator;
 
@@ -39,7 +40,8 @@ impl Strategy for RayonIter {
     }
 
     fn run<S: Session>(&self, session: S) -> S::Output {
-        session.run(&RayonIterExecutor { pool: &self.pool })
+        // The session runs on one of the pool's threads: see `rayon_pool::run_inside`.
+        crate::rayon_pool::run_inside(&self.pool, session, |pool| RayonIterExecutor { pool })
     }
 }
 

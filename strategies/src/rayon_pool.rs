@@ -1,6 +1,6 @@
 //! The thread pool that every rayon strategy owns.
 
-use crate::{BuildError, Config};
+use crate::{BuildError, Config, Executor, Session};
 
 /// A rayon pool with exactly `config.cores` threads, named `{name}-{index}`.
 pub(crate) fn build(config: &Config, name: &'static str) -> Result<rayon::ThreadPool, BuildError> {
@@ -9,4 +9,21 @@ pub(crate) fn build(config: &Config, name: &'static str) -> Result<rayon::Thread
         .thread_name(move |i| format!("{name}-{i}"))
         .build()
         .map_err(|e| BuildError::Pool(e.to_string()))
+}
+
+/// Runs `session` on one of `pool`'s threads, with the executor `make(pool)`.
+///
+/// The step loop's serial parts then run on a worker, which also takes part in every pass:
+/// the pool's `cores` threads do all the work (the caller only waits for the result), and a
+/// pass starts and ends without handing work to, and waking, a thread outside the pool.
+pub(crate) fn run_inside<'p, S, E>(
+    pool: &'p rayon::ThreadPool,
+    session: S,
+    make: impl FnOnce(&'p rayon::ThreadPool) -> E + Send,
+) -> S::Output
+where
+    S: Session,
+    E: Executor,
+{
+    pool.install(|| session.run(&make(pool)))
 }

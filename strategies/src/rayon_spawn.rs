@@ -4,13 +4,14 @@
 //! `pool.scope`, spawns one task per element; idle threads steal tasks from the spawning
 //! thread's deque. The scope ends when every task has run. `--chunks` is ignored.
 //!
-//! **Cost.** No thread start-up (the pool of `cores` threads is built once, outside timing),
-//! but per element: one boxed task (a heap allocation), one deque push and pop (or steal) and
+//! **Cost.** No thread start-up (the pool of `cores` threads is built once, outside timing,
+//! and the whole session runs on one of its threads, see `rayon_pool::run_inside`), but per
+//! element: one boxed task (a heap allocation), one deque push and pop (or steal) and
 //! one kernel call; plus a `len`-long vector of chunks per pass. This overhead is the point of
 //! the strategy.
 //!
 //! **Panics.** Rayon's scope waits for every task, then re-raises the first kernel panic on
-//! the calling thread, where it is caught and returned as [`KernelPanic`].
+//! the thread that started the pass, where it is caught and returned as [`KernelPanic`].
 
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Session, Split, Strategy, balanced_chunks,
@@ -38,7 +39,8 @@ impl Strategy for RayonSpawn {
     }
 
     fn run<S: Session>(&self, session: S) -> S::Output {
-        session.run(&RayonSpawnExecutor { pool: &self.pool })
+        // The session runs on one of the pool's threads: see `rayon_pool::run_inside`.
+        crate::rayon_pool::run_inside(&self.pool, session, |pool| RayonSpawnExecutor { pool })
     }
 }
 

@@ -80,7 +80,7 @@ pub fn build(mode: NeighborMode, domain: Domain, h: f64, n: usize) -> AnyNeighbo
 }
 
 /// One of the searches, chosen once per run.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub enum AnyNeighbors {
     /// See [`AllPairs`].
     AllPairs(AllPairs),
