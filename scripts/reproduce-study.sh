@@ -8,8 +8,8 @@
 # Writes (replacing earlier results of the same names):
 #   results/paper/            the paper's study: seed preset, all-pairs, N = 1000, 1000 steps,
 #                             every strategy, chunks 10..200 in steps of 10
-#   results/grid/             grid search at N = 1000, 10 000, 100 000, 20 steps
-#   results/all-pairs-small/  all-pairs at N = 1000, 3000, 20 steps (chart 6 beside the grid)
+#   results/grid/             grid search at N = 1000, 10 000, 100 000, 100 steps
+#   results/all-pairs-small/  all-pairs at N = 1000, 3000, 100 steps (chart 6 beside the grid)
 #   report/                   charts, REPORT.md and two traces (rayon-chunks, rayon-spawn)
 # Run it on a quiet machine: nothing else should compete for the cores while it measures.
 set -euo pipefail
@@ -22,9 +22,9 @@ BIN=target/release/bench-sph
 
 "$BIN" sweep --preset seed --neighbors all-pairs --n 1000 --steps 1000 \
     --cores "$CORES" --chunks 10..200:10 --out results/paper --force --no-plots
-"$BIN" sweep --preset seed --neighbors grid --n 1000,10000,100000 --steps 20 \
+"$BIN" sweep --preset seed --neighbors grid --n 1000,10000,100000 --steps 100 \
     --cores "$CORES" --chunks 10,50,200 --out results/grid --force --no-plots
-"$BIN" sweep --preset seed --neighbors all-pairs --n 1000,3000 --steps 20 \
+"$BIN" sweep --preset seed --neighbors all-pairs --n 1000,3000 --steps 100 \
     --strategies rayon-chunks --cores "$CORES" --chunks 50 \
     --out results/all-pairs-small --force --no-plots
 
