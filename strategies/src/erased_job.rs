@@ -18,7 +18,9 @@
 
 use std::mem;
 use std::ptr::NonNull;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
+use std::time::{Duration, Instant};
 
 use crate::{KernelPanic, panic};
 
@@ -71,13 +73,27 @@ struct State {
     shutdown: bool,
 }
 
+/// How long a thread spins, watching the hints, before it sleeps on a condition variable:
+/// passes follow each other within microseconds, and waking a sleeping thread costs tens of
+/// microseconds (more on a virtual machine).
+const SPIN: Duration = Duration::from_micros(200);
+
 /// A rendezvous between one dispatching thread and a fixed number of worker threads.
 ///
 /// Exactly `workers` threads must call [`serve`](Self::serve); [`run`](Self::run) then runs a
-/// job once on each of them, and [`shut_down`](Self::shut_down) makes `serve` return.
+/// job once on each of them and once on the dispatcher itself, and
+/// [`shut_down`](Self::shut_down) makes `serve` return.
+///
+/// Every decision is taken under the mutex. Two atomics mirror parts of the state as hints,
+/// so that a waiting thread can spin without taking the lock before it falls back to its
+/// condition variable; a stale hint only costs a lock, never a decision.
 pub(crate) struct JobBoard {
     workers: usize,
     state: Mutex<State>,
+    /// Hint: `State::epoch`, bumped again at shut-down.
+    epoch_hint: AtomicU64,
+    /// Hint: `State::finished` of the job in flight.
+    finished_hint: AtomicUsize,
     /// Wakes workers: a job was published, or the board shut down.
     to_workers: Condvar,
     /// Wakes dispatchers: the pass in flight finished.
@@ -85,11 +101,13 @@ pub(crate) struct JobBoard {
 }
 
 impl JobBoard {
-    /// A board for exactly `workers` serving threads (`workers >= 1`).
+    /// A board for exactly `workers` serving threads (0 is allowed: the dispatcher then runs
+    /// each job alone).
     pub(crate) fn new(workers: usize) -> Self {
-        assert!(workers >= 1, "a job board needs at least one worker");
         JobBoard {
             workers,
+            epoch_hint: AtomicU64::new(0),
+            finished_hint: AtomicUsize::new(0),
             state: Mutex::new(State {
                 job: None,
                 epoch: 0,
@@ -103,10 +121,11 @@ impl JobBoard {
         }
     }
 
-    /// Runs `job` once on every worker and returns when all of them have finished it.
+    /// Runs `job` once on every worker and once on the calling thread, and returns when all of
+    /// them have finished it.
     ///
-    /// A panic that escapes `job` on a worker is caught there and returned (the first one, if
-    /// several); the worker keeps serving. Calls from several threads are serialised.
+    /// A panic that escapes `job` (on a worker or here) is caught and returned (the first one,
+    /// if several); the workers keep serving. Calls from several threads are serialised.
     ///
     /// # Panics
     /// If the board has been shut down (its workers are gone, so the job could never run).
@@ -117,23 +136,37 @@ impl JobBoard {
             state = self.wait(&self.to_dispatcher, state);
         }
         assert!(!state.shutdown, "job board used after shut-down");
-
         state.job = Some(ErasedJob::new(job));
         state.epoch += 1;
         state.finished = 0;
         state.escaped = None;
+        self.finished_hint.store(0, Ordering::Relaxed);
+        self.epoch_hint.store(state.epoch, Ordering::Release);
+        drop(state);
         self.to_workers.notify_all();
-
+        // The dispatcher's own share: a plain call through the live borrow. Its panic is
+        // caught, so that nothing below can be skipped.
+        let own = panic::catch(job);
+        let mut state = self.lock();
+        if let Err(p) = own {
+            state.escaped.get_or_insert(p);
+        }
         // This loop is what makes `ErasedJob::call` sound: `job`'s borrow lasts at least until
         // this function returns, and it cannot return (nothing below can panic: lock poisoning
-        // is ignored) while `running > 0`. A worker increments `running` under the lock when it
-        // takes the job, and decrements it under the lock only after its call has returned or
-        // unwound; once `job` is cleared below (in the same critical section that saw
-        // `running == 0`), no worker can take it again. Waiting for `finished` as well is for
-        // correctness — every worker runs the job — not for soundness, which holds even if
-        // more or fewer threads serve the board than `workers`.
+        // is ignored) while `running > 0`, a condition only ever checked under the lock. A
+        // worker increments `running` under the lock when it takes the job, and decrements it
+        // under the lock only after its call has returned or unwound; once `job` is cleared
+        // below (in the same critical section that saw `running == 0`), no worker can take it
+        // again. Waiting for `finished` as well is for correctness — every worker runs the
+        // job — not for soundness, which holds even if more or fewer threads serve the board
+        // than `workers`.
         while state.finished < self.workers || state.running > 0 {
-            state = self.wait(&self.to_dispatcher, state);
+            drop(state);
+            spin_until(|| self.finished_hint.load(Ordering::Acquire) >= self.workers);
+            state = self.lock();
+            if state.finished < self.workers || state.running > 0 {
+                state = self.wait(&self.to_dispatcher, state);
+            }
         }
         state.job = None;
         let escaped = state.escaped.take();
@@ -164,7 +197,12 @@ impl JobBoard {
                     if state.shutdown {
                         return;
                     }
-                    state = self.wait(&self.to_workers, state);
+                    drop(state);
+                    spin_until(|| self.epoch_hint.load(Ordering::Acquire) != seen);
+                    state = self.lock();
+                    if state.epoch == seen && !state.shutdown {
+                        state = self.wait(&self.to_workers, state);
+                    }
                 }
             };
 
@@ -181,6 +219,7 @@ impl JobBoard {
             }
             state.running -= 1;
             state.finished += 1;
+            self.finished_hint.store(state.finished, Ordering::Release);
             if state.running == 0 && state.finished >= self.workers {
                 self.to_dispatcher.notify_all();
             }
@@ -190,7 +229,10 @@ impl JobBoard {
     /// Makes every [`serve`](Self::serve) return once it has finished any job in flight, and
     /// makes later [`run`](Self::run)s panic.
     pub(crate) fn shut_down(&self) {
-        self.lock().shutdown = true;
+        let mut state = self.lock();
+        state.shutdown = true;
+        self.epoch_hint.store(state.epoch + 1, Ordering::Release);
+        drop(state);
         self.to_workers.notify_all();
     }
 
@@ -203,6 +245,19 @@ impl JobBoard {
 
     fn wait<'g>(&self, cv: &Condvar, guard: MutexGuard<'g, State>) -> MutexGuard<'g, State> {
         cv.wait(guard).unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+/// Spins until `done()` or until [`SPIN`] has passed.
+fn spin_until(done: impl Fn() -> bool) {
+    let start = Instant::now();
+    while !done() {
+        for _ in 0..64 {
+            std::hint::spin_loop();
+        }
+        if start.elapsed() > SPIN {
+            return;
+        }
     }
 }
 
@@ -226,7 +281,8 @@ mod tests {
                         calls.fetch_add(1, Ordering::Relaxed);
                     })
                     .unwrap();
-                assert_eq!(calls.load(Ordering::Relaxed), 3, "pass {pass}");
+                // Once on each of the three workers and once on the dispatcher.
+                assert_eq!(calls.load(Ordering::Relaxed), 4, "pass {pass}");
             }
             board.shut_down();
         });
@@ -247,7 +303,7 @@ mod tests {
                     calls.fetch_add(1, Ordering::Relaxed);
                 })
                 .unwrap();
-            assert_eq!(calls.load(Ordering::Relaxed), 2);
+            assert_eq!(calls.load(Ordering::Relaxed), 3);
             board.shut_down();
         });
     }
@@ -278,7 +334,7 @@ mod tests {
             }
             board.shut_down();
         });
-        assert_eq!(calls.load(Ordering::Relaxed), 4 * 50 * 2);
+        assert_eq!(calls.load(Ordering::Relaxed), 4 * 50 * 3);
     }
 
     #[test]
