@@ -71,6 +71,16 @@ struct State {
     escaped: Option<KernelPanic>,
     /// Set once, when the workers must exit.
     shutdown: bool,
+    /// Workers asleep on `to_workers`, and dispatchers asleep on `to_dispatcher`: a
+    /// notification (a system call) is sent only when someone sleeps.
+    asleep: Sleepers,
+}
+
+/// Threads asleep on each condition variable.
+#[derive(Default)]
+struct Sleepers {
+    workers: usize,
+    dispatchers: usize,
 }
 
 /// How long a thread spins, watching the hints, before it sleeps on a condition variable:
@@ -115,6 +125,7 @@ impl JobBoard {
                 finished: 0,
                 escaped: None,
                 shutdown: false,
+                asleep: Sleepers::default(),
             }),
             to_workers: Condvar::new(),
             to_dispatcher: Condvar::new(),
@@ -133,7 +144,7 @@ impl JobBoard {
         let mut state = self.lock();
         // Another thread's pass is in flight: wait for it, so the counts are only ours.
         while state.job.is_some() {
-            state = self.wait(&self.to_dispatcher, state);
+            state = self.wait_as_dispatcher(state);
         }
         assert!(!state.shutdown, "job board used after shut-down");
         state.job = Some(ErasedJob::new(job));
@@ -142,8 +153,11 @@ impl JobBoard {
         state.escaped = None;
         self.finished_hint.store(0, Ordering::Relaxed);
         self.epoch_hint.store(state.epoch, Ordering::Release);
+        let wake_workers = state.asleep.workers > 0;
         drop(state);
-        self.to_workers.notify_all();
+        if wake_workers {
+            self.to_workers.notify_all();
+        }
         // The dispatcher's own share: a plain call through the live borrow. Its panic is
         // caught, so that nothing below can be skipped.
         let own = panic::catch(job);
@@ -165,14 +179,17 @@ impl JobBoard {
             spin_until(|| self.finished_hint.load(Ordering::Acquire) >= self.workers);
             state = self.lock();
             if state.finished < self.workers || state.running > 0 {
-                state = self.wait(&self.to_dispatcher, state);
+                state = self.wait_as_dispatcher(state);
             }
         }
         state.job = None;
         let escaped = state.escaped.take();
+        let wake_dispatchers = state.asleep.dispatchers > 0;
         drop(state);
         // Let a dispatcher that waited for this pass publish its own.
-        self.to_dispatcher.notify_all();
+        if wake_dispatchers {
+            self.to_dispatcher.notify_all();
+        }
         escaped.map_or(Ok(()), Err)
     }
 
@@ -201,7 +218,9 @@ impl JobBoard {
                     spin_until(|| self.epoch_hint.load(Ordering::Acquire) != seen);
                     state = self.lock();
                     if state.epoch == seen && !state.shutdown {
+                        state.asleep.workers += 1;
                         state = self.wait(&self.to_workers, state);
+                        state.asleep.workers -= 1;
                     }
                 }
             };
@@ -220,7 +239,8 @@ impl JobBoard {
             state.running -= 1;
             state.finished += 1;
             self.finished_hint.store(state.finished, Ordering::Release);
-            if state.running == 0 && state.finished >= self.workers {
+            if state.running == 0 && state.finished >= self.workers && state.asleep.dispatchers > 0
+            {
                 self.to_dispatcher.notify_all();
             }
         }
@@ -243,16 +263,28 @@ impl JobBoard {
         self.state.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
+    /// Sleeps on `to_dispatcher`, counted as a sleeping dispatcher.
+    fn wait_as_dispatcher<'g>(&self, mut state: MutexGuard<'g, State>) -> MutexGuard<'g, State> {
+        state.asleep.dispatchers += 1;
+        let mut state = self.wait(&self.to_dispatcher, state);
+        state.asleep.dispatchers -= 1;
+        state
+    }
+
     fn wait<'g>(&self, cv: &Condvar, guard: MutexGuard<'g, State>) -> MutexGuard<'g, State> {
         cv.wait(guard).unwrap_or_else(PoisonError::into_inner)
     }
 }
 
-/// Spins until `done()` or until [`SPIN`] has passed.
+/// Spins until `done()` or until [`SPIN`] has passed. `done` is checked after every pause
+/// (one `PAUSE` can take over a hundred cycles); the clock only every 64 of them.
 fn spin_until(done: impl Fn() -> bool) {
     let start = Instant::now();
-    while !done() {
+    loop {
         for _ in 0..64 {
+            if done() {
+                return;
+            }
             std::hint::spin_loop();
         }
         if start.elapsed() > SPIN {
