@@ -13,8 +13,23 @@ fn main() {
         rustc_version.as_deref().unwrap_or("unknown")
     );
     println!("cargo:rustc-env=BENCH_SPH_GIT_COMMIT={}", git_commit());
-    // No `rerun-if-changed` line on purpose: Cargo then reruns this script whenever a file of
-    // the package changes, which keeps the commit and its dirty flag current.
+    // Rerun when the commit or the tracked sources may have changed, including the
+    // `strategies` crate (a change there alone would otherwise leave a stale commit). A path
+    // that does not exist (no `.git`) makes Cargo rerun the script every build.
+    for path in [
+        ".git/HEAD",
+        ".git/index",
+        ".git/refs",
+        "Cargo.toml",
+        "build.rs",
+        "src",
+        "strategies",
+        "benches",
+        "tests",
+        "assets",
+    ] {
+        println!("cargo:rerun-if-changed={path}");
+    }
 }
 
 /// `git rev-parse HEAD`, plus `-dirty` when tracked files differ from it.
