@@ -159,8 +159,11 @@ impl JobBoard {
             self.to_workers.notify_all();
         }
         // The dispatcher's own share: a plain call through the live borrow. Its panic is
-        // caught, so that nothing below can be skipped.
+        // caught, and the guard turns any unwind that still escapes into an abort, so that
+        // the wait below can never be skipped.
+        let guard = AbortOnUnwind;
         let own = panic::catch(job);
+        mem::forget(guard);
         let mut state = self.lock();
         if let Err(p) = own {
             state.escaped.get_or_insert(p);
@@ -228,8 +231,11 @@ impl JobBoard {
             // SAFETY: this worker counted itself in `running` when it took `job` and has not
             // yet counted itself out, so the dispatcher is still inside `run`, where the borrow
             // behind `job` is alive (see the comment on the wait loop there). `catch` keeps an
-            // unwinding job from skipping the count-out below.
+            // unwinding job from skipping the count-out below, and the guard aborts should an
+            // unwind escape `catch` all the same.
+            let guard = AbortOnUnwind;
             let outcome = panic::catch(|| unsafe { job.call() });
+            mem::forget(guard);
 
             // From here on `job` is never called again; the next iteration overwrites it.
             let mut state = self.lock();
@@ -273,6 +279,17 @@ impl JobBoard {
 
     fn wait<'g>(&self, cv: &Condvar, guard: MutexGuard<'g, State>) -> MutexGuard<'g, State> {
         cv.wait(guard).unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+/// Aborts the process when dropped. Armed around the calls of a job and disarmed with
+/// `mem::forget` after them, so only an unwind that escaped `panic::catch` reaches it: going
+/// on would skip the bookkeeping that keeps an erased job from outliving its borrow.
+struct AbortOnUnwind;
+
+impl Drop for AbortOnUnwind {
+    fn drop(&mut self) {
+        std::process::abort();
     }
 }
 

@@ -21,6 +21,9 @@ impl KernelPanic {
         } else {
             "panic with a non-string payload".to_owned()
         };
+        // Leaked, not dropped: a payload whose `Drop` panics would otherwise unwind out of
+        // `catch` (rust-lang/rust#86027), past the code that relies on `catch` returning.
+        std::mem::forget(payload);
         KernelPanic { message }
     }
 }
