@@ -221,9 +221,7 @@ impl JobBoard {
                     spin_until(|| self.epoch_hint.load(Ordering::Acquire) != seen);
                     state = self.lock();
                     if state.epoch == seen && !state.shutdown {
-                        state.asleep.workers += 1;
-                        state = self.wait(&self.to_workers, state);
-                        state.asleep.workers -= 1;
+                        state = self.wait_as_worker(state);
                     }
                 }
             };
@@ -267,6 +265,14 @@ impl JobBoard {
     /// is ignored.
     fn lock(&self) -> MutexGuard<'_, State> {
         self.state.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+
+    /// Sleeps on `to_workers`, counted as a sleeping worker.
+    fn wait_as_worker<'g>(&self, mut state: MutexGuard<'g, State>) -> MutexGuard<'g, State> {
+        state.asleep.workers += 1;
+        let mut state = self.wait(&self.to_workers, state);
+        state.asleep.workers -= 1;
+        state
     }
 
     /// Sleeps on `to_dispatcher`, counted as a sleeping dispatcher.

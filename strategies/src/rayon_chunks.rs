@@ -46,10 +46,14 @@ impl Strategy for RayonChunks {
 
     fn run<S: Session>(&self, session: S) -> S::Output {
         // The session runs on one of the pool's threads: see `rayon_pool::run_inside`.
-        crate::rayon_pool::run_inside(&self.pool, session, |pool| RayonChunksExecutor {
-            pool,
-            chunks: self.chunks,
-        })
+        crate::rayon_pool::run_inside(
+            &self.pool,
+            session,
+            RayonChunksExecutor {
+                pool: &self.pool,
+                chunks: self.chunks,
+            },
+        )
     }
 }
 

@@ -41,7 +41,7 @@ impl Strategy for RayonIter {
 
     fn run<S: Session>(&self, session: S) -> S::Output {
         // The session runs on one of the pool's threads: see `rayon_pool::run_inside`.
-        crate::rayon_pool::run_inside(&self.pool, session, |pool| RayonIterExecutor { pool })
+        crate::rayon_pool::run_inside(&self.pool, session, RayonIterExecutor { pool: &self.pool })
     }
 }
 

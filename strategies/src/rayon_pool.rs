@@ -11,19 +11,15 @@ pub(crate) fn build(config: &Config, name: &'static str) -> Result<rayon::Thread
         .map_err(|e| BuildError::Pool(e.to_string()))
 }
 
-/// Runs `session` on one of `pool`'s threads, with the executor `make(pool)`.
+/// Runs `session` on one of `pool`'s threads, with `exec`.
 ///
 /// The step loop's serial parts then run on a worker, which also takes part in every pass:
 /// the pool's `cores` threads do all the work (the caller only waits for the result), and a
 /// pass starts and ends without handing work to, and waking, a thread outside the pool.
-pub(crate) fn run_inside<'p, S, E>(
-    pool: &'p rayon::ThreadPool,
-    session: S,
-    make: impl FnOnce(&'p rayon::ThreadPool) -> E + Send,
-) -> S::Output
+pub(crate) fn run_inside<S, E>(pool: &rayon::ThreadPool, session: S, exec: E) -> S::Output
 where
     S: Session,
-    E: Executor,
+    E: Executor + Sync,
 {
-    pool.install(|| session.run(&make(pool)))
+    pool.install(|| session.run(&exec))
 }
