@@ -5,6 +5,8 @@
 //! - [`solver`]: one step as three passes run by a strategy's executor;
 //! - [`scene`]: initial dam-break states; [`io`]: CSV in and out;
 //! - [`run`]: timed runs; [`clock`], [`checksum`]: what a run reports;
+//! - [`limits`]: the documented range of every numeric option;
+//! - [`output`]: files written whole or not at all, output directories, a closable stdout;
 //! - [`plot`]: the bundled font shared by charts and animations;
 //! - [`render`]: animations of the dam break (GIF or PNG frames); `viewer` (cargo feature
 //!   `viewer`): the same, live in a window;
@@ -17,6 +19,8 @@ pub mod checksum;
 pub mod cli;
 pub mod clock;
 pub mod io;
+pub mod limits;
+pub mod output;
 pub mod plot;
 pub mod render;
 pub mod report;

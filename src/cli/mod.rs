@@ -118,6 +118,44 @@ fn positive(s: &str) -> Result<usize, String> {
     }
 }
 
+/// A worker-thread count: 1 ..= [`crate::limits::MAX_CORES`].
+fn cores(s: &str) -> Result<usize, String> {
+    let v = positive(s)?;
+    crate::limits::check("cores", v, 1, crate::limits::MAX_CORES).map_err(|e| e.to_string())
+}
+
+/// A chunk count: 1 ..= [`crate::limits::MAX_CHUNKS`].
+fn chunks(s: &str) -> Result<usize, String> {
+    let v = positive(s)?;
+    crate::limits::check("chunks", v, 1, crate::limits::MAX_CHUNKS).map_err(|e| e.to_string())
+}
+
+/// A step count: 1 ..= [`crate::limits::MAX_STEPS`].
+fn steps(s: &str) -> Result<usize, String> {
+    let v = positive(s)?;
+    crate::limits::check("steps", v, 1, crate::limits::MAX_STEPS).map_err(|e| e.to_string())
+}
+
+/// A particle count: 1 ..= [`crate::limits::MAX_PARTICLES`].
+fn particles(s: &str) -> Result<usize, String> {
+    let v = positive(s)?;
+    crate::limits::check("particles", v, 1, crate::limits::MAX_PARTICLES).map_err(|e| e.to_string())
+}
+
+/// Timed trials per cell: 1 ..= [`crate::limits::MAX_TRIALS`].
+fn trials(s: &str) -> Result<usize, String> {
+    let v = positive(s)?;
+    crate::limits::check("trials", v, 1, crate::limits::MAX_TRIALS).map_err(|e| e.to_string())
+}
+
+/// Warm-up runs per cell: 0 ..= [`crate::limits::MAX_WARMUP`].
+fn warmup(s: &str) -> Result<usize, String> {
+    let v = s
+        .parse::<usize>()
+        .map_err(|_| format!("'{s}' is not a whole number of at least 0"))?;
+    crate::limits::check("warm-ups", v, 0, crate::limits::MAX_WARMUP).map_err(|e| e.to_string())
+}
+
 /// A strategy name from the registry.
 fn strategy(s: &str) -> Result<StrategyName, String> {
     s.parse::<StrategyName>().map_err(|e| e.to_string())
@@ -144,5 +182,15 @@ mod tests {
         assert!(positive("-3").is_err());
         assert!(positive("x").is_err());
         assert_eq!(positive("12"), Ok(12));
+    }
+
+    #[test]
+    fn counts_beyond_their_documented_maximum_are_rejected() {
+        assert_eq!(cores("1024"), Ok(1024));
+        assert!(cores("1025").unwrap_err().contains("between 1 and 1024"));
+        assert!(cores("18446744073709551615").is_err());
+        assert!(cores("99999999999999999999999").is_err());
+        assert!(particles("100000001").is_err());
+        assert!(chunks("0").is_err() && steps("1000000001").is_err());
     }
 }

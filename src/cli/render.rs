@@ -30,7 +30,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub scene: super::scene::SceneArgs,
     /// Number of steps to show (frames at steps 0, K, 2K, … up to this).
-    #[arg(long, default_value_t = 1000, value_parser = super::positive)]
+    #[arg(long, default_value_t = 1000, value_parser = super::steps)]
     pub steps: usize,
     /// One frame every K steps.
     #[arg(long, value_name = "K", default_value_t = 10, value_parser = super::positive)]
@@ -39,10 +39,10 @@ pub struct RenderArgs {
     #[arg(long, default_value = "seq", value_parser = super::strategy)]
     pub strategy: StrategyName,
     /// Worker threads [default: the machine's hardware threads].
-    #[arg(long, value_parser = super::positive)]
+    #[arg(long, value_parser = super::cores)]
     pub cores: Option<usize>,
     /// Chunks per pass, for strategies that use chunks.
-    #[arg(long, default_value_t = 10, value_parser = super::positive)]
+    #[arg(long, default_value_t = 10, value_parser = super::chunks)]
     pub chunks: usize,
     /// What the particles' colour shows (the range is fixed for the whole animation).
     #[arg(long, value_enum, default_value_t = ColorBy::Speed)]

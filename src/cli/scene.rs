@@ -18,7 +18,7 @@ pub struct SceneArgs {
     #[arg(long, value_enum, default_value_t = Preset::Seed)]
     pub preset: Preset,
     /// Number of particles [default: 1000, or the row count of --init].
-    #[arg(long, value_parser = super::positive)]
+    #[arg(long, value_parser = super::particles)]
     pub n: Option<usize>,
     /// Neighbour search.
     #[arg(long, value_enum, default_value_t = NeighborMode::AllPairs)]

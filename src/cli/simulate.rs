@@ -23,16 +23,16 @@ pub struct SimulateArgs {
     #[command(flatten)]
     pub scene: super::scene::SceneArgs,
     /// Number of steps.
-    #[arg(long, default_value_t = 1000, value_parser = super::positive)]
+    #[arg(long, default_value_t = 1000, value_parser = super::steps)]
     pub steps: usize,
     /// Parallel strategy (see `bench-sph list`).
     #[arg(long, default_value = "seq", value_parser = super::strategy)]
     pub strategy: StrategyName,
     /// Worker threads [default: the machine's hardware threads].
-    #[arg(long, value_parser = super::positive)]
+    #[arg(long, value_parser = super::cores)]
     pub cores: Option<usize>,
     /// Chunks per pass, for strategies that use chunks.
-    #[arg(long, default_value_t = 10, value_parser = super::positive)]
+    #[arg(long, default_value_t = 10, value_parser = super::chunks)]
     pub chunks: usize,
     /// Write the final state to CSV (i,x,y,vx,vy,fx,fy,rho,p; exact round-trip).
     #[arg(long, value_name = "FILE.csv")]

@@ -65,13 +65,13 @@ pub struct SweepArgs {
     )]
     pub n: String,
     /// Steps per run.
-    #[arg(long, default_value_t = 1000, value_parser = super::positive, conflicts_with = "resume")]
+    #[arg(long, default_value_t = 1000, value_parser = super::steps, conflicts_with = "resume")]
     pub steps: usize,
-    /// Timed runs per cell.
-    #[arg(long, default_value_t = 5, value_parser = super::positive, conflicts_with = "resume")]
+    /// Timed runs per cell (1 ..= 1000).
+    #[arg(long, default_value_t = 5, value_parser = super::trials, conflicts_with = "resume")]
     pub trials: usize,
-    /// Untimed runs before each cell's trials.
-    #[arg(long, default_value_t = 1, conflicts_with = "resume")]
+    /// Untimed runs before each cell's trials (0 ..= 1000).
+    #[arg(long, default_value_t = 1, value_parser = super::warmup, conflicts_with = "resume")]
     pub warmup: usize,
     /// Seed of the initial jitter.
     #[arg(long, default_value_t = 2019, conflicts_with = "resume")]

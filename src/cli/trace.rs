@@ -26,13 +26,13 @@ pub struct TraceArgs {
     #[arg(long, value_parser = super::strategy)]
     pub strategy: StrategyName,
     /// Worker threads [default: the machine's hardware threads].
-    #[arg(long, value_parser = super::positive)]
+    #[arg(long, value_parser = super::cores)]
     pub cores: Option<usize>,
     /// Chunks per pass, for strategies that use chunks.
-    #[arg(long, default_value_t = 10, value_parser = super::positive)]
+    #[arg(long, default_value_t = 10, value_parser = super::chunks)]
     pub chunks: usize,
     /// Number of steps to trace.
-    #[arg(long, default_value_t = 3, value_parser = super::positive)]
+    #[arg(long, default_value_t = 3, value_parser = super::steps)]
     pub steps: usize,
     /// Output directory (created if missing): trace.json, timeline.png, stats.csv, meta.json.
     #[arg(long, value_name = "DIR")]

@@ -28,10 +28,10 @@ pub struct ViewArgs {
     #[arg(long, default_value = "seq", value_parser = super::strategy)]
     pub strategy: StrategyName,
     /// Worker threads [default: the machine's hardware threads].
-    #[arg(long, value_parser = super::positive)]
+    #[arg(long, value_parser = super::cores)]
     pub cores: Option<usize>,
     /// Chunks per pass, for strategies that use chunks.
-    #[arg(long, default_value_t = 10, value_parser = super::positive)]
+    #[arg(long, default_value_t = 10, value_parser = super::chunks)]
     pub chunks: usize,
     /// Seed of the initial jitter.
     #[arg(long, default_value_t = 2019)]

@@ -46,6 +46,15 @@ impl Axis {
         }
     }
 
+    /// The largest value allowed (see [`crate::limits`]).
+    pub fn max(self) -> usize {
+        match self {
+            Axis::Cores => crate::limits::MAX_CORES,
+            Axis::Chunks => crate::limits::MAX_CHUNKS,
+            Axis::Particles => crate::limits::MAX_PARTICLES,
+        }
+    }
+
     /// What the values count, for messages.
     fn noun(self) -> &'static str {
         match self {
@@ -112,6 +121,16 @@ pub enum RangeError {
         /// B.
         end: usize,
     },
+    /// A value above the axis's maximum.
+    #[error("'{item}' goes above {max}, the most {axis} allowed")]
+    TooLarge {
+        /// The item as written.
+        item: String,
+        /// The option's values.
+        axis: Axis,
+        /// The maximum.
+        max: usize,
+    },
     /// More values than [`MAX_VALUES`].
     #[error("the list gives more than {MAX_VALUES} values")]
     TooMany,
@@ -165,10 +184,18 @@ fn expand_item(item: &str, axis: Axis, out: &mut Vec<usize>) -> Result<(), Range
         s.parse().map_err(|_| garbage())
     };
 
+    let too_large = || RangeError::TooLarge {
+        item: item.to_owned(),
+        axis,
+        max: axis.max(),
+    };
     let Some((start, rest)) = item.split_once("..") else {
         let v = number(item)?;
         if v == 0 {
             return Err(zero());
+        }
+        if v > axis.max() {
+            return Err(too_large());
         }
         return push_checked(out, std::iter::once(v));
     };
@@ -191,6 +218,9 @@ fn expand_item(item: &str, axis: Axis, out: &mut Vec<usize>) -> Result<(), Range
     }
     if start == 0 {
         return Err(zero());
+    }
+    if end > axis.max() {
+        return Err(too_large());
     }
     let step = match step.or(axis.default_step()) {
         Some(step) => step,
@@ -367,8 +397,23 @@ mod tests {
 
     #[test]
     fn huge_lists_are_refused_before_they_are_built() {
-        assert_eq!(cores("1..1000000000000"), Err(RangeError::TooMany));
-        assert!(cores("1..10000").is_ok());
+        let chunks_of = |s| parse(s, Axis::Chunks);
+        assert_eq!(chunks_of("1..1000000:1"), Err(RangeError::TooMany));
+        assert!(chunks_of("1..10000:1").is_ok());
+    }
+
+    #[test]
+    fn values_above_the_documented_maximum_are_refused() {
+        assert_eq!(cores("1024").unwrap(), [1024]);
+        for bad in ["1025", "1..2000", "18446744073709551615", "1,5000"] {
+            assert!(
+                matches!(cores(bad), Err(RangeError::TooLarge { max: 1024, .. })),
+                "{bad}"
+            );
+        }
+        let err = cores("1..2000").unwrap_err().to_string();
+        assert_eq!(err, "'1..2000' goes above 1024, the most cores allowed");
+        assert!(parse("200000000", Axis::Particles).is_err());
     }
 
     #[test]

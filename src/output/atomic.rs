@@ -1,0 +1,147 @@
+//! Files written whole or not at all: a temporary file `.NAME.PID.tmp` beside the
+//! destination, synced and renamed over it by [`AtomicFile::commit`]. An `AtomicFile` dropped
+//! without a commit (an error, a panic, an early return) removes its temporary file, and the
+//! destination keeps its earlier contents.
+
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+
+/// The suffix of every temporary file (see [`is_temporary`]).
+pub const TMP_SUFFIX: &str = ".tmp";
+
+/// Whether a file name is one of [`AtomicFile`]'s temporary names (`.NAME.PID.tmp`): debris
+/// of a killed process, never a result.
+pub fn is_temporary(name: &str) -> bool {
+    name.starts_with('.') && name.ends_with(TMP_SUFFIX)
+}
+
+/// A file being written under a temporary name; see the module docs.
+#[derive(Debug)]
+pub struct AtomicFile {
+    dest: PathBuf,
+    tmp: PathBuf,
+    out: Option<BufWriter<File>>,
+}
+
+impl AtomicFile {
+    /// Starts writing `dest` (its directory must exist). Errors name `dest`.
+    pub fn create(dest: &Path) -> anyhow::Result<AtomicFile> {
+        let name = dest
+            .file_name()
+            .with_context(|| format!("cannot write '{}': not a file name", dest.display()))?;
+        let tmp = dest.with_file_name(format!(
+            ".{}.{}{TMP_SUFFIX}",
+            name.to_string_lossy(),
+            std::process::id()
+        ));
+        let file =
+            File::create(&tmp).with_context(|| format!("cannot write '{}'", dest.display()))?;
+        Ok(AtomicFile {
+            dest: dest.to_path_buf(),
+            tmp,
+            out: Some(BufWriter::new(file)),
+        })
+    }
+
+    /// The destination.
+    pub fn path(&self) -> &Path {
+        &self.dest
+    }
+
+    /// Flushes, syncs and renames the file over its destination.
+    pub fn commit(mut self) -> anyhow::Result<()> {
+        let out = self.out.take().expect("an AtomicFile is committed once");
+        let context = || format!("cannot write '{}'", self.dest.display());
+        let file = out
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .with_context(context)?;
+        file.sync_all().with_context(context)?;
+        drop(file);
+        std::fs::rename(&self.tmp, &self.dest).with_context(context)?;
+        Ok(())
+    }
+}
+
+impl Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.out.as_mut().expect("not yet committed").write(buf)
+    }
+
+    fn flush(&mut self) -> io::Result<()> {
+        self.out.as_mut().expect("not yet committed").flush()
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        if self.out.take().is_some() {
+            // Not committed: the destination keeps what it had.
+            let _ = std::fs::remove_file(&self.tmp);
+        }
+    }
+}
+
+/// Writes `bytes` to `dest` atomically.
+pub fn write(dest: &Path, bytes: &[u8]) -> anyhow::Result<()> {
+    let mut file = AtomicFile::create(dest)?;
+    file.write_all(bytes)
+        .with_context(|| format!("cannot write '{}'", dest.display()))?;
+    file.commit()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn a_committed_file_replaces_the_destination_and_leaves_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let dest = dir.path().join("out.csv");
+        std::fs::write(&dest, "old").unwrap();
+        write(&dest, b"new").unwrap();
+        assert_eq!(std::fs::read_to_string(&dest).unwrap(), "new");
+        assert_eq!(names(dir.path()), ["out.csv"]);
+    }
+
+    #[test]
+    fn a_file_dropped_before_its_commit_leaves_the_destination_as_it_was() {
+        let dir = tempfile::tempdir().unwrap();
+        let dest = dir.path().join("out.csv");
+        std::fs::write(&dest, "old").unwrap();
+        let mut f = AtomicFile::create(&dest).unwrap();
+        f.write_all(b"half a fi").unwrap();
+        assert_eq!(
+            names(dir.path()).len(),
+            2,
+            "the temporary file exists while writing"
+        );
+        assert!(names(dir.path()).iter().any(|n| is_temporary(n)));
+        drop(f);
+        assert_eq!(std::fs::read_to_string(&dest).unwrap(), "old");
+        assert_eq!(names(dir.path()), ["out.csv"]);
+    }
+
+    #[test]
+    fn a_missing_directory_is_an_error_naming_the_destination() {
+        let dir = tempfile::tempdir().unwrap();
+        let dest = dir.path().join("no/such/out.csv");
+        let err = format!("{:#}", write(&dest, b"x").unwrap_err());
+        assert!(
+            err.contains("cannot write") && err.contains("out.csv"),
+            "{err}"
+        );
+    }
+}
