@@ -59,10 +59,10 @@ impl Executor for StdStatic {
                 .collect();
             let mut result = Ok(());
             for thread in threads {
-                if let Err(payload) = thread.join() {
-                    if result.is_ok() {
-                        result = Err(KernelPanic::from_payload(payload));
-                    }
+                if let Err(payload) = thread.join()
+                    && result.is_ok()
+                {
+                    result = Err(KernelPanic::from_payload(payload));
                 }
             }
             result
