@@ -16,6 +16,11 @@ fn fnv1a(mut hash: u64, bytes: &[u8]) -> u64 {
     hash
 }
 
+/// FNV-1a (64-bit) of `bytes`: a stable fingerprint (the same on every machine and build).
+pub fn fingerprint(bytes: &[u8]) -> u64 {
+    fnv1a(FNV_OFFSET, bytes)
+}
+
 /// The state's checksum.
 pub fn checksum(state: &State) -> u64 {
     (0..state.len()).fold(FNV_OFFSET, |h, i| {

@@ -1,8 +1,11 @@
-//! Wall-clock and process CPU time (user + system, all threads) over a region.
+//! Wall-clock and process CPU time (user + system, all threads) over a region, and the
+//! foreign CPU time of the rest of the machine over the same region ([`crate::contention`]).
 
 use std::time::{Duration, Instant};
 
 use nix::sys::resource::{UsageWho, getrusage};
+
+use crate::contention::{CpuTicks, Foreign, foreign_between, ticks_per_second};
 
 /// User + system CPU time consumed by this process so far, in seconds.
 pub fn process_cpu_seconds() -> f64 {
@@ -25,6 +28,8 @@ pub struct Elapsed {
     pub wall_s: f64,
     /// Process CPU seconds (user + system) over the same window.
     pub cpu_s: f64,
+    /// What other work used of the machine over the same window (`None` where unknown).
+    pub foreign: Option<Foreign>,
 }
 
 /// Measures a region from [`Stopwatch::start`] to [`Stopwatch::stop`].
@@ -32,24 +37,34 @@ pub struct Elapsed {
 pub struct Stopwatch {
     wall: Instant,
     cpu: f64,
+    ticks: Option<CpuTicks>,
 }
 
 impl Stopwatch {
     /// Starts measuring now.
     pub fn start() -> Self {
+        // The machine's counters are read first and last, so their window encloses ours.
+        let ticks = CpuTicks::now();
         let cpu = process_cpu_seconds();
         Stopwatch {
             wall: Instant::now(),
             cpu,
+            ticks,
         }
     }
 
     /// The time since `start`.
     pub fn stop(&self) -> Elapsed {
         let wall_s = self.wall.elapsed().as_secs_f64();
+        let cpu_s = process_cpu_seconds() - self.cpu;
+        let foreign = match (self.ticks, CpuTicks::now()) {
+            (Some(a), Some(b)) => Some(foreign_between(a, b, cpu_s, ticks_per_second())),
+            _ => None,
+        };
         Elapsed {
             wall_s,
-            cpu_s: process_cpu_seconds() - self.cpu,
+            cpu_s,
+            foreign,
         }
     }
 }

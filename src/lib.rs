@@ -4,7 +4,8 @@
 //! - [`sph`]: the pure physics (constants, state, neighbour search, per-particle passes);
 //! - [`solver`]: one step as three passes run by a strategy's executor;
 //! - [`scene`]: initial dam-break states; [`io`]: CSV in and out;
-//! - [`run`]: timed runs; [`clock`], [`checksum`]: what a run reports;
+//! - [`run`]: timed runs; [`clock`], [`checksum`]: what a run reports; [`contention`]: what
+//!   the rest of the machine did meanwhile;
 //! - [`limits`]: the documented range of every numeric option;
 //! - [`output`]: files written whole or not at all, output directories, a closable stdout;
 //! - [`plot`]: the bundled font shared by charts and animations;
@@ -18,6 +19,7 @@
 pub mod checksum;
 pub mod cli;
 pub mod clock;
+pub mod contention;
 pub mod io;
 pub mod limits;
 pub mod output;

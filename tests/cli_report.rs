@@ -134,18 +134,20 @@ fn the_report_carries_the_fixture_best_cells_speedups_and_the_paper_beside_them(
         "| hardware threads | 2 |",
         "--fake-timings",
         "## seed preset, all-pairs, N = 60, 3 steps",
-        "Reference: `seq` at 1 core, 2.000 ± 0.040 s over 3 trials.",
-        // rayon-chunks, all-pairs N = 60: best cells beside the paper's Table 1.
-        "| 2 | 2 | 1.089 ± 0.022 | 1.84× | 0.92 | 45 | 14.904 | 2.00× |",
-        "| 3 ⚠ oversubscribed | 5 | 1.310 ± 0.026 | 1.53× | 0.51 | 90 | 10.39 | 2.87× |",
-        "| 6 | — | — | — | — | 150 | 5.816 | 5.13× |",
+        "Reference: `seq` at 1 core, 2.00 ± 0.04 s over 3 trials.",
+        // rayon-chunks, all-pairs N = 60: best cells beside the paper's Table 1 (at most
+        // three significant digits, the paper's numbers too).
+        "| 2 | 2 | 1.09 | 1.84× | 0.919 | 45 | 14.9 | 2.00× |",
+        "| 3 ⚠ oversubscribed | 5 | 1.31 | 1.53× | 0.509 | 90 | 10.4 | 2.87× |",
+        "| 6 | — | — | — | — | 150 | 5.82 | 5.13× |",
         // rayon-iter has no chunks and so no paper columns.
-        "| 2 | — | 1.145 ± 0.023 | 1.75× | 0.87 |",
+        "| 2 | — | 1.14 | 1.75× | 0.874 |",
         // The grid groups are not comparable with the paper: plain tables.
-        "| 2 | 2 | 0.5443 ± 0.0109 | 1.84× | 0.92 |",
-        "At 2 cores, **rayon-chunks** with 2 chunks is fastest: 1.089 s, 1.84× over seq, \
-         4.9 % less time than the runner-up crossbeam-pool (1.145 s).",
-        "e = 0.089",
+        "| 2 | 2 | 0.544 | 1.84× | 0.919 |",
+        // The fixture predates confidence intervals: no winner is named.
+        "At 2 cores, the lowest mean is rayon-chunks with 2 chunks (1.09 s), but these cells \
+         have no confidence intervals",
+        "e = 0.0886",
         "Speedups compare; absolute times do not",
         "None: every cell reproduced its group's `seq` checksum.",
     ] {

@@ -11,10 +11,11 @@ use std::time::{Duration, Instant};
 type Row = HashMap<String, String>;
 
 const TRIAL_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
-    trial,wall_s,cpu_s,checksum,status,reason";
+    trial,wall_s,cpu_s,checksum,status,reason,foreign_cpu_s,steal_s,load1";
 const SUMMARY_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
     trials,mean_s,stddev_s,min_s,median_s,max_s,cpu_mean_s,speedup,efficiency,outliers,\
-    oversubscribed,checksum,status,reason";
+    oversubscribed,checksum,status,reason,mean_ci_low_s,mean_ci_high_s,speedup_ci_low,\
+    speedup_ci_high,foreign_cpu_mean_s,contended";
 
 /// A tiny sweep: 1 seq cell + 3 strategies × 2 cores + 2 strategies × 2 cores × 2 chunks = 15.
 const TINY: &[&str] = &[
@@ -519,7 +520,15 @@ fn an_existing_results_directory_is_refused_without_resume_or_force() {
     let d = dir.to_str().unwrap();
     let mut args = TINY.to_vec();
     args.extend(["--out", d]);
-    fails_with(&args, &["Error:", "already exists", "--resume", "--force"]);
+    fails_with(
+        &args,
+        &[
+            "Error:",
+            "already holds a sweep's results",
+            "--resume",
+            "--force",
+        ],
+    );
     assert_one_row_per_trial(&dir, 2, TINY_CELLS);
 
     // --force replaces the results; other files stay.
@@ -579,7 +588,10 @@ fn an_unwritable_out_directory_is_an_error_before_anything_runs() {
 fn resume_needs_a_sweep_directory_and_takes_no_new_parameters() {
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path().to_str().unwrap();
-    fails_with(&["sweep", "--resume", d], &["Error:", "no meta.json"]);
+    fails_with(
+        &["sweep", "--resume", d],
+        &["Error:", "no sweep's meta.json"],
+    );
     fails_with(&["sweep", "--resume", d, "--cores", "2"], &["--cores"]);
 }
 

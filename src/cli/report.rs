@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use anyhow::Context;
 use clap::Args;
 
 /// Options of `report`.
@@ -18,15 +19,20 @@ pub struct ReportArgs {
     /// the results directories or the output directory are found without it.
     #[arg(long, value_name = "DIR")]
     pub trace: Vec<PathBuf>,
+    /// Write into an --out directory that holds files bench-sph report did not write (they
+    /// stay untouched; only the report's own files are replaced).
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// Runs `report`.
 pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     let out = args.out.clone().unwrap_or_else(|| args.dirs[0].clone());
-    let written = crate::report::generate(&args.dirs, &out, &args.trace)?;
-    println!("Report in {}:", out.display());
+    let written = crate::report::generate(&args.dirs, &out, &args.trace, args.force)?;
+    let mut text = format!("Report in {}:", out.display());
     for p in &written {
-        println!("  {}", p.display());
+        text.push_str(&format!("\n  {}", p.display()));
     }
+    crate::output::console::line(&text).context("cannot print to standard output")?;
     Ok(())
 }

@@ -99,6 +99,10 @@ pub struct SweepArgs {
     /// turn) instead of the measured ones. The runs still happen and are checked.
     #[arg(long, value_name = "LIST", hide = true, conflicts_with = "resume")]
     pub fake_timings: Option<String>,
+    /// Test only: record these shares (0 ..= 1, comma-separated, taken in turn) of the
+    /// machine's capacity as taken by other work, instead of the measured foreign CPU.
+    #[arg(long, value_name = "LIST", hide = true, conflicts_with = "resume")]
+    pub fake_contention: Option<String>,
     /// Test only: stop as if Ctrl-C was pressed once this many cells are written.
     #[arg(long, value_name = "K", hide = true)]
     pub stop_after_cells: Option<usize>,
@@ -144,6 +148,7 @@ impl SweepArgs {
             warmup: self.warmup,
             seed: self.seed,
             fake_timings: self.fake_timings.clone(),
+            fake_contention: self.fake_contention.clone(),
         })
     }
 

@@ -1,13 +1,28 @@
-//! Reading a results directory: `meta.json` and `summary.csv` into the sweep's own types
-//! ([`Meta`], [`SummaryRow`]), with errors that name the file and the line.
+//! Reading results directories: `meta.json`, `summary.csv` and `trials.csv` into the sweep's
+//! own types ([`Meta`], [`SummaryRow`], [`TrialRow`]), with errors that name the file and the
+//! line, and every cell checked before it can become a number in the report.
+//!
+//! - Files of this version and of the first release (before the contention and interval
+//!   columns) are read; the missing columns are empty.
+//! - A cell whose numbers are impossible (not finite and positive, statistics that are not
+//!   those of its trial rows, counts beyond the documented limits) is dropped, and the report
+//!   lists it with the reason ([`Sweep::dropped`]).
+//! - The same directory twice, or the same cell in two directories, is refused: counting a
+//!   cell twice would weigh it double in every finding.
 
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
+use crate::sweep::export::{
+    LEGACY_SUMMARY_COLUMNS, LEGACY_TRIAL_COLUMNS, SUMMARY_COLUMNS, TRIAL_COLUMNS,
+};
 use crate::sweep::meta::Meta;
-use crate::sweep::rows::SummaryRow;
-use crate::sweep::{META_FILE, SUMMARY_FILE};
+use crate::sweep::plan::CellKey;
+use crate::sweep::rows::{SummaryRow, TrialRow};
+use crate::sweep::validate;
+use crate::sweep::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
 
 /// One sweep's results.
 #[derive(Debug, Clone)]
@@ -16,53 +31,145 @@ pub struct Sweep {
     pub dir: PathBuf,
     /// Its `meta.json`.
     pub meta: Meta,
-    /// Its `summary.csv`, one row per cell, in file order (the sweep's plan order).
+    /// Its `summary.csv` cells that passed the checks, in file order (the plan's order).
     pub rows: Vec<SummaryRow>,
+    /// Cells left out, each with why.
+    pub dropped: Vec<String>,
 }
 
-/// Reads `dir/meta.json` and `dir/summary.csv`.
+/// Reads every directory of `dirs`, refusing repeats (see the module docs).
+pub fn load_all(dirs: &[PathBuf]) -> anyhow::Result<Vec<Sweep>> {
+    let mut seen: HashMap<PathBuf, &Path> = HashMap::new();
+    for d in dirs {
+        let canonical = d
+            .canonicalize()
+            .with_context(|| format!("results directory '{}' does not exist", d.display()))?;
+        if let Some(first) = seen.insert(canonical, d) {
+            bail!(
+                "results directory '{}' is given twice (also as '{}'): each cell would count \
+                 twice",
+                d.display(),
+                first.display()
+            );
+        }
+    }
+    let sweeps = dirs
+        .iter()
+        .map(|d| load(d))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let mut owner: HashMap<CellKey, &Path> = HashMap::new();
+    for s in &sweeps {
+        for r in &s.rows {
+            if let Some(first) = owner.insert(r.key(), &s.dir) {
+                bail!(
+                    "the cell {} is in both '{}' and '{}': report them separately, or remove \
+                     it from one (a cell must count once)",
+                    r.key().label(),
+                    first.display(),
+                    s.dir.display()
+                );
+            }
+        }
+    }
+    Ok(sweeps)
+}
+
+/// Reads `dir/meta.json`, `dir/summary.csv` and (where present) `dir/trials.csv`.
 pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
     if !dir.is_dir() {
         bail!("results directory '{}' does not exist", dir.display());
     }
     let meta = Meta::read(&dir.join(META_FILE))?;
-    let rows = read_summary(&dir.join(SUMMARY_FILE))?;
-    if rows.is_empty() {
+    let summary = read_summary(&dir.join(SUMMARY_FILE))?;
+    if summary.is_empty() {
         bail!(
             "'{}' has no cells: nothing to report",
             dir.join(SUMMARY_FILE).display()
+        );
+    }
+    let trials_path = dir.join(TRIALS_FILE);
+    let trials = if trials_path.is_file() {
+        Some(read_trials(&trials_path)?)
+    } else {
+        None
+    };
+    let mut by_cell: HashMap<CellKey, Vec<TrialRow>> = HashMap::new();
+    for t in trials.iter().flatten() {
+        by_cell.entry(t.key()).or_default().push(t.clone());
+    }
+    let mut seen = HashSet::new();
+    let mut rows = Vec::new();
+    let mut dropped = Vec::new();
+    for row in summary {
+        let checked = if !seen.insert(row.key()) {
+            Err("a second summary row of the same cell".to_owned())
+        } else if trials.is_some() {
+            let mut of_cell = by_cell.remove(&row.key()).unwrap_or_default();
+            of_cell.sort_by_key(|t| t.trial);
+            validate::cell(&row, &of_cell)
+        } else {
+            validate::summary_alone(&row)
+        };
+        match checked {
+            Ok(()) => rows.push(row),
+            Err(why) => dropped.push(format!("{}: {why}", row.key().label())),
+        }
+    }
+    if rows.is_empty() {
+        bail!(
+            "'{}' has no usable cells ({} dropped; the first: {})",
+            dir.display(),
+            dropped.len(),
+            dropped.first().map_or("", String::as_str)
         );
     }
     Ok(Sweep {
         dir: dir.to_path_buf(),
         meta,
         rows,
+        dropped,
     })
 }
 
-/// Reads a `summary.csv`.
+/// Reads a `summary.csv` (this version's columns or the first release's).
 pub fn read_summary(path: &Path) -> anyhow::Result<Vec<SummaryRow>> {
+    read_csv(path, &SUMMARY_COLUMNS, LEGACY_SUMMARY_COLUMNS, "summary")
+}
+
+/// Reads a `trials.csv` (this version's columns or the first release's).
+pub fn read_trials(path: &Path) -> anyhow::Result<Vec<TrialRow>> {
+    read_csv(path, &TRIAL_COLUMNS, LEGACY_TRIAL_COLUMNS, "trial")
+}
+
+/// The rows of a results CSV whose header is `columns` or its first `legacy` columns.
+fn read_csv<R: serde::de::DeserializeOwned>(
+    path: &Path,
+    columns: &[&str],
+    legacy: usize,
+    what: &str,
+) -> anyhow::Result<Vec<R>> {
     let mut reader = csv::Reader::from_path(path)
         .with_context(|| format!("cannot read '{}'", path.display()))?;
     let header = reader
         .headers()
         .with_context(|| format!("cannot read '{}'", path.display()))?
         .clone();
-    let expected = crate::sweep::export::SUMMARY_COLUMNS;
-    if header.iter().ne(expected.iter().copied()) {
+    let found: Vec<&str> = header.iter().collect();
+    if found != columns && found != columns[..legacy] {
         bail!(
-            "'{}' is not a bench-sph summary.csv: its header is not {}",
+            "'{}' is not a bench-sph {}: its header is not {}",
             path.display(),
-            expected.join(",")
+            path.file_name().unwrap_or_default().to_string_lossy(),
+            columns.join(",")
         );
     }
     reader
-        .deserialize::<SummaryRow>()
+        .deserialize::<R>()
         .enumerate()
         .map(|(i, row)| {
             row.with_context(|| {
                 format!(
-                    "'{}' line {}: not a bench-sph summary row",
+                    "'{}' line {}: not a bench-sph {what} row",
                     path.display(),
                     i + 2
                 )
@@ -79,12 +186,27 @@ mod tests {
     fn a_garbled_summary_names_the_file_and_line() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("summary.csv");
-        let header = crate::sweep::export::SUMMARY_COLUMNS.join(",");
+        let header = SUMMARY_COLUMNS.join(",");
         std::fs::write(&path, format!("{header}\nseq,all-pairs,seed,x\n")).unwrap();
         let err = format!("{:#}", read_summary(&path).unwrap_err());
         assert!(err.contains("line 2"), "{err}");
         std::fs::write(&path, "a,b\n1,2\n").unwrap();
         let err = format!("{:#}", read_summary(&path).unwrap_err());
         assert!(err.contains("not a bench-sph summary.csv"), "{err}");
+    }
+
+    #[test]
+    fn a_first_release_summary_reads_with_empty_new_columns() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("summary.csv");
+        let header = SUMMARY_COLUMNS[..LEGACY_SUMMARY_COLUMNS].join(",");
+        std::fs::write(
+            &path,
+            format!("{header}\nseq,all-pairs,seed,60,3,1,,,2,1.5,0.5,1.0,1.5,2.0,1.5,1.0,1.0,0,false,00000000000000aa,ok,\n"),
+        )
+        .unwrap();
+        let rows = read_summary(&path).unwrap();
+        assert_eq!(rows.len(), 1);
+        assert_eq!((rows[0].mean_ci_low_s, rows[0].contended), (None, None));
     }
 }

@@ -23,15 +23,17 @@
 //! lists them with their reason.
 
 pub mod charts;
+pub mod findings;
 pub mod load;
 pub mod markdown;
+pub mod numbers;
 pub mod paper;
 pub mod series;
 pub mod traces;
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{Context, bail};
+use anyhow::bail;
 
 use markdown::{ChartRef, Skipped};
 use series::{GroupKey, Metric};
@@ -39,24 +41,69 @@ use series::{GroupKey, Metric};
 /// The report's file name.
 pub const REPORT_FILE: &str = "REPORT.md";
 
+/// Whether a file name is one `bench-sph report` writes: `REPORT.md`, a chart
+/// (`<preset>-….png`) or a copied timeline (`…-timeline.png`). A sweep that draws its report
+/// owns these too.
+pub fn is_own_file(name: &str) -> bool {
+    use crate::sph::params::Preset;
+    name == REPORT_FILE
+        || (name.ends_with(".png")
+            && (name.ends_with("-timeline.png")
+                || Preset::ALL
+                    .iter()
+                    .any(|p| name.starts_with(&format!("{}-", p.as_str())))))
+}
+
+/// Whether an entry of a report's directory may stay beside the report: a sweep's own files
+/// (the report is often drawn into the sweep's directory) and any directory (traces; the
+/// report never writes into subdirectories).
+fn tolerated(path: &Path) -> bool {
+    use crate::sweep::{META_FILE, SUMMARY_FILE, TRIALS_FILE, lock::LOCK_FILE};
+    path.is_dir()
+        || path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .is_some_and(|n| [TRIALS_FILE, SUMMARY_FILE, META_FILE, LOCK_FILE].contains(&n))
+}
+
 /// Reads the sweeps in `results_dirs`, draws every chart that applies into `out_dir`
-/// (created if missing), embeds the traces found under the results directories and `out_dir`
-/// or named in `trace_dirs`, and writes `out_dir/REPORT.md`. Returns the files written, the
-/// report last.
+/// (claimed first: see [`crate::output::claim`]; `force` writes beside foreign files),
+/// embeds the traces found under the results directories and `out_dir` or named in
+/// `trace_dirs`, writes `out_dir/REPORT.md`, and removes the charts of an earlier report that
+/// this one did not draw again. Cells dropped as impossible are listed on standard error and
+/// in the report. Returns the files written, the report last.
 pub fn generate(
     results_dirs: &[PathBuf],
     out_dir: &Path,
     trace_dirs: &[PathBuf],
+    force: bool,
 ) -> anyhow::Result<Vec<PathBuf>> {
     if results_dirs.is_empty() {
         bail!("no results directory given");
     }
-    let sweeps = results_dirs
-        .iter()
-        .map(|d| load::load(d))
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    std::fs::create_dir_all(out_dir)
-        .with_context(|| format!("cannot create report directory '{}'", out_dir.display()))?;
+    let sweeps = load::load_all(results_dirs)?;
+    for s in &sweeps {
+        for why in &s.dropped {
+            crate::output::console::warn(&format!(
+                "warning: '{}': cell left out of the report: {why}",
+                s.dir.display()
+            ));
+        }
+    }
+    let owns = |p: &Path| {
+        p.is_file()
+            && p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(is_own_file)
+    };
+    let owner = crate::output::claim::Owner {
+        command: "bench-sph report",
+        option: "--out",
+        owns: &owns,
+        tolerates: &tolerated,
+    };
+    let claimed = crate::output::claim::claim(out_dir, &owner, force)?;
+    claimed.check_writable(REPORT_FILE)?;
     let rows: Vec<_> = sweeps.iter().flat_map(|s| s.rows.clone()).collect();
 
     let mut written = Vec::new();
@@ -68,7 +115,7 @@ pub fn generate(
             file: file.clone(),
             caption,
         });
-        out_dir.join(file)
+        claimed.check_writable(&file)
     };
 
     for g in series::groups(&rows) {
@@ -118,7 +165,7 @@ pub fn generate(
                     format!("{}-{n}-{what}-vs-chunks-{s}.png", g.slug()),
                     Some(&g),
                     caption,
-                );
+                )?;
                 charts::chunks::draw(
                     &path,
                     &title,
@@ -154,15 +201,16 @@ pub fn generate(
                     };
                     let caption = format!(
                         "Chart 3: {s}, best runtime (above) and best speedup (below) against cores, \
-                         bars from the fastest to the slowest trial{} (the paper's Figures 9 and 10); \
+                         bars: 95 % confidence intervals{} (the paper's Figures 9 and 10); \
                          {subtitle}.",
                         if comparable {
-                            "; grey triangles: the paper's published speedups on its own machine"
+                            "; grey triangles: the paper's published speedups on its own machine, \
+                             at the core counts measured here"
                         } else {
                             ""
                         }
                     );
-                    let path = chart(format!("{}-3-best-{s}.png", g.slug()), Some(&g), caption);
+                    let path = chart(format!("{}-3-best-{s}.png", g.slug()), Some(&g), caption)?;
                     charts::best::draw(
                         &path,
                         &format!("Best runtime and speedup against cores: {s}"),
@@ -176,10 +224,10 @@ pub fn generate(
                     format!("{}-4-speedup.png", g.slug()),
                     Some(&g),
                     format!(
-                        "Chart 4: every strategy's best speedup against cores, error bars from the \
-                         trial spread of the best cell; {subtitle}."
+                        "Chart 4: every strategy's best speedup against cores, error bars the 95 % \
+                         bootstrap interval of the best cell's speedup; {subtitle}."
                     ),
-                );
+                )?;
                 charts::speedup::draw(
                     &path,
                     "Speedup against cores, every strategy",
@@ -193,9 +241,10 @@ pub fn generate(
                     Some(&g),
                     format!(
                         "Chart 5: parallel efficiency S/p (above) and the Karp–Flatt serial fraction \
-                         e = (1/S − 1/p)/(1 − 1/p) (below) against cores; {subtitle}."
+                         e = (1/S − 1/p)/(1 − 1/p) (below, only where S > 1 and p > 1) against \
+                         cores; {subtitle}."
                     ),
-                );
+                )?;
                 charts::efficiency::draw(
                     &path,
                     "Efficiency and Karp–Flatt serial fraction against cores",
@@ -205,12 +254,15 @@ pub fn generate(
                 )?;
                 written.push(path);
             }
-            Some(_) => skipped.push(skip(format!(
-                "Charts 3–5 (against cores) are not drawn: only {} was measured.",
-                cores
-                    .first()
-                    .map_or_else(|| "no core count".to_owned(), |&c| series::cores_label(c))
-            ))),
+            Some(_) => skipped.push(skip(match cores.first() {
+                Some(&c) => format!(
+                    "Charts 3–5 (against cores) are not drawn: only {} was measured.",
+                    series::cores_label(c)
+                ),
+                None => "Charts 3–5 (against cores) are not drawn: no parallel strategy has a \
+                         usable cell."
+                    .to_owned(),
+            })),
             None => skipped.push(skip(
                 "Charts 3–5 (against cores) are not drawn: there is no usable seq reference."
                     .to_owned(),
@@ -226,9 +278,11 @@ pub fn generate(
                     None,
                     format!(
                         "Chart 6: all-pairs against grid, seconds per step against N ({preset} \
-                         preset), for seq and for the fastest parallel cell; bars: trial spread."
+                         preset), for seq and for the fastest parallel cell, one line per step \
+                         count (runs of different lengths are never joined); bars: 95 % \
+                         confidence intervals."
                     ),
-                );
+                )?;
                 charts::neighbors::draw(
                     &path,
                     "All-pairs against grid: time per step against N",
@@ -267,8 +321,8 @@ pub fn generate(
         traces: &traces,
     });
     let report = out_dir.join(REPORT_FILE);
-    std::fs::write(&report, text)
-        .with_context(|| format!("cannot write '{}'", report.display()))?;
+    crate::output::atomic::write(&report, text.as_bytes())?;
     written.push(report);
+    claimed.remove_stale(&written)?;
     Ok(written)
 }

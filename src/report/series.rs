@@ -6,6 +6,8 @@
 
 use std::collections::BTreeSet;
 
+use crate::sweep::bootstrap::Interval;
+
 use crate::sweep::rows::{Status, SummaryRow};
 
 /// One (preset, neighbours, N, steps): cells that share an initial state and a `seq` reference.
@@ -116,8 +118,8 @@ pub fn seq_mean(rows: &[SummaryRow], group: &GroupKey) -> Option<f64> {
         .and_then(|r| r.mean_s)
 }
 
-/// A point with its spread: `y` the value, `lo..hi` the trial spread (equal to `y` when
-/// unknown).
+/// A point with its uncertainty: `y` the value, `lo..hi` its 95 % confidence interval
+/// (equal to `y` when unknown).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Point {
     /// Abscissa (chunks, cores or N).
@@ -130,6 +132,22 @@ pub struct Point {
     pub hi: f64,
     /// Whether the cell used more threads than the machine has.
     pub oversubscribed: bool,
+    /// Whether other work used the machine while the cell was measured.
+    pub contended: bool,
+}
+
+impl Point {
+    /// A point without uncertainty or flags (a reference value).
+    pub fn exact(x: f64, y: f64) -> Point {
+        Point {
+            x,
+            y,
+            lo: y,
+            hi: y,
+            oversubscribed: false,
+            contended: false,
+        }
+    }
 }
 
 /// A labelled line of points, sorted by x.
@@ -181,7 +199,11 @@ pub fn chunk_lines(
                 let (y, lo, hi) = match metric {
                     Metric::Wall => {
                         let y = r.mean_s?;
-                        (y, r.min_s.unwrap_or(y), r.max_s.unwrap_or(y))
+                        (
+                            y,
+                            r.mean_ci_low_s.unwrap_or(y),
+                            r.mean_ci_high_s.unwrap_or(y),
+                        )
                     }
                     Metric::Cpu => {
                         let y = r.cpu_mean_s?;
@@ -194,6 +216,7 @@ pub fn chunk_lines(
                     lo,
                     hi,
                     oversubscribed: r.oversubscribed,
+                    contended: r.contended == Some(true),
                 })
             })
             .collect();
@@ -235,14 +258,15 @@ pub struct Best {
     pub efficiency: Option<f64>,
     /// More threads than the machine has.
     pub oversubscribed: bool,
+    /// 95 % interval of the mean seconds (`None` for one trial or an older sweep).
+    pub mean_ci: Option<Interval>,
+    /// 95 % interval of the speedup.
+    pub speedup_ci: Option<Interval>,
+    /// Other work used the machine while it was measured.
+    pub contended: bool,
 }
 
 impl Best {
-    /// Speedup spread from the trials: `seq / max_s ..= seq / min_s`.
-    pub fn speedup_spread(&self, seq_mean_s: f64) -> (f64, f64) {
-        (seq_mean_s / self.max_s, seq_mean_s / self.min_s)
-    }
-
     /// The Karp–Flatt serial fraction at this cell (see [`karp_flatt`]).
     pub fn serial_fraction(&self) -> Option<f64> {
         karp_flatt(self.speedup?, self.cores)
@@ -258,13 +282,18 @@ pub fn best_per_cores(rows: &[SummaryRow], group: &GroupKey, strategy: &str) -> 
     }
     set.into_iter()
         .filter_map(|c| {
+            // The fastest trustworthy cell; a contended one only when all of them are.
             let r = ok
                 .iter()
                 .filter(|r| r.strategy == strategy && r.cores == c)
                 .min_by(|a, b| {
-                    a.mean_s
-                        .unwrap_or(f64::INFINITY)
-                        .total_cmp(&b.mean_s.unwrap_or(f64::INFINITY))
+                    (a.contended == Some(true))
+                        .cmp(&(b.contended == Some(true)))
+                        .then(
+                            a.mean_s
+                                .unwrap_or(f64::INFINITY)
+                                .total_cmp(&b.mean_s.unwrap_or(f64::INFINITY)),
+                        )
                 })?;
             let mean_s = r.mean_s?;
             Some(Best {
@@ -277,9 +306,20 @@ pub fn best_per_cores(rows: &[SummaryRow], group: &GroupKey, strategy: &str) -> 
                 speedup: r.speedup,
                 efficiency: r.efficiency,
                 oversubscribed: r.oversubscribed,
+                mean_ci: interval(r.mean_ci_low_s, r.mean_ci_high_s),
+                speedup_ci: interval(r.speedup_ci_low, r.speedup_ci_high),
+                contended: r.contended == Some(true),
             })
         })
         .collect()
+}
+
+/// An interval from its two ends, if both are known.
+pub fn interval(low: Option<f64>, high: Option<f64>) -> Option<Interval> {
+    Some(Interval {
+        low: low?,
+        high: high?,
+    })
 }
 
 /// The Karp–Flatt experimentally determined serial fraction
@@ -293,7 +333,7 @@ pub fn karp_flatt(speedup: f64, p: usize) -> Option<f64> {
 }
 
 /// Best lines per strategy for `group` (every strategy but `seq`): speedup against cores,
-/// spread from the fastest and slowest trial of the best cell.
+/// with the best cell's 95 % interval of the speedup.
 pub fn speedup_lines(rows: &[SummaryRow], group: &GroupKey) -> Vec<Line> {
     let Some(seq) = seq_mean(rows, group) else {
         return Vec::new();
@@ -305,13 +345,14 @@ pub fn speedup_lines(rows: &[SummaryRow], group: &GroupKey) -> Vec<Line> {
             let points: Vec<Point> = best_per_cores(rows, group, &s)
                 .iter()
                 .map(|b| {
-                    let (lo, hi) = b.speedup_spread(seq);
+                    let y = seq / b.mean_s;
                     Point {
                         x: b.cores as f64,
-                        y: seq / b.mean_s,
-                        lo,
-                        hi,
+                        y,
+                        lo: b.speedup_ci.map_or(y, |i| i.low),
+                        hi: b.speedup_ci.map_or(y, |i| i.high),
                         oversubscribed: b.oversubscribed,
+                        contended: b.contended,
                     }
                 })
                 .collect();
@@ -320,7 +361,7 @@ pub fn speedup_lines(rows: &[SummaryRow], group: &GroupKey) -> Vec<Line> {
         .collect()
 }
 
-/// Best runtime against cores for one strategy (spread: fastest to slowest trial).
+/// Best runtime against cores for one strategy (bars: 95 % interval of the mean).
 pub fn runtime_line(best: &[Best], label: &str) -> Line {
     Line {
         label: label.to_owned(),
@@ -329,16 +370,17 @@ pub fn runtime_line(best: &[Best], label: &str) -> Line {
             .map(|b| Point {
                 x: b.cores as f64,
                 y: b.mean_s,
-                lo: b.min_s,
-                hi: b.max_s,
+                lo: b.mean_ci.map_or(b.mean_s, |i| i.low),
+                hi: b.mean_ci.map_or(b.mean_s, |i| i.high),
                 oversubscribed: b.oversubscribed,
+                contended: b.contended,
             })
             .collect(),
     }
 }
 
 /// Per strategy, efficiency against cores (all core counts) and the Karp–Flatt fraction
-/// against cores (core counts of at least 2).
+/// against cores (only where it means something: at least 2 cores and a speedup above 1).
 pub fn efficiency_lines(rows: &[SummaryRow], group: &GroupKey) -> (Vec<Line>, Vec<Line>) {
     let mut eff = Vec::new();
     let mut kf = Vec::new();
@@ -349,6 +391,7 @@ pub fn efficiency_lines(rows: &[SummaryRow], group: &GroupKey) -> (Vec<Line>, Ve
             lo: y,
             hi: y,
             oversubscribed: p.oversubscribed,
+            contended: p.contended,
         };
         eff.push(Line {
             label: line.label.clone(),
@@ -357,6 +400,7 @@ pub fn efficiency_lines(rows: &[SummaryRow], group: &GroupKey) -> (Vec<Line>, Ve
         let k: Vec<Point> = line
             .points
             .iter()
+            .filter(|p| p.y > 1.0)
             .filter_map(|p| Some(point(p, karp_flatt(p.y, p.x as usize)?)))
             .collect();
         if !k.is_empty() {
@@ -381,10 +425,17 @@ pub fn neighbor_lines(rows: &[SummaryRow], preset: &str) -> Option<Vec<Line>> {
         return None;
     }
     let mut lines = Vec::new();
-    for mode in modes {
+    let steps: BTreeSet<usize> = gs.iter().map(|g| g.steps).collect();
+    for (mode, run_steps) in modes
+        .iter()
+        .flat_map(|m| steps.iter().map(move |s| (*m, *s)))
+    {
         let mut seq_points = Vec::new();
         let mut best_points = Vec::new();
-        for g in gs.iter().filter(|g| g.neighbors == mode) {
+        for g in gs
+            .iter()
+            .filter(|g| g.neighbors == mode && g.steps == run_steps)
+        {
             let ok = ok_rows(rows, g);
             let per_step = |r: &SummaryRow| -> Option<Point> {
                 let s = g.steps as f64;
@@ -392,9 +443,10 @@ pub fn neighbor_lines(rows: &[SummaryRow], preset: &str) -> Option<Vec<Line>> {
                 Some(Point {
                     x: g.n as f64,
                     y,
-                    lo: r.min_s.map_or(y, |v| v / s),
-                    hi: r.max_s.map_or(y, |v| v / s),
+                    lo: r.mean_ci_low_s.map_or(y, |v| v / s),
+                    hi: r.mean_ci_high_s.map_or(y, |v| v / s),
                     oversubscribed: r.oversubscribed,
+                    contended: r.contended == Some(true),
                 })
             };
             if let Some(p) = ok
@@ -413,9 +465,14 @@ pub fn neighbor_lines(rows: &[SummaryRow], preset: &str) -> Option<Vec<Line>> {
                 best_points.push(p);
             }
         }
+        let each = if steps.len() > 1 {
+            format!(", {run_steps} steps")
+        } else {
+            String::new()
+        };
         for (label, mut points) in [
-            (format!("{mode}, seq (1 core)"), seq_points),
-            (format!("{mode}, fastest parallel cell"), best_points),
+            (format!("{mode}, seq (1 core){each}"), seq_points),
+            (format!("{mode}, fastest parallel cell{each}"), best_points),
         ] {
             points.sort_by(|a, b| a.x.total_cmp(&b.x));
             if !points.is_empty() {
@@ -510,6 +567,12 @@ pub(crate) mod tests {
             checksum: "00000000000000aa".to_owned(),
             status: Status::Ok,
             reason: String::new(),
+            mean_ci_low_s: Some(mean * 0.98),
+            mean_ci_high_s: Some(mean * 1.02),
+            speedup_ci_low: Some(4.0 / mean * 0.95),
+            speedup_ci_high: Some(4.0 / mean * 1.05),
+            foreign_cpu_mean_s: Some(0.0),
+            contended: Some(false),
         }
     }
 

@@ -98,7 +98,37 @@ pub fn cell_line(position: usize, total: usize, cell: &Cell, row: &SummaryRow) -
     if row.oversubscribed {
         line.push_str("  (oversubscribed)");
     }
+    if row.contended == Some(true) {
+        line.push_str("  (CONTENDED: other work used the machine)");
+    }
     line
+}
+
+/// The warning before the plan when other work already keeps the machine busy.
+pub fn busy_warning(busy_threads: f64, hardware_threads: usize) -> String {
+    format!(
+        "warning: {busy_threads:.1} of {hardware_threads} cores busy with other work: timings          will not be trustworthy (cells that see it are marked contended=true in summary.csv)"
+    )
+}
+
+/// The warning after a sweep naming its contended cells, if any.
+pub fn contended_cells(rows: &[SummaryRow]) -> Option<String> {
+    let names: Vec<String> = rows
+        .iter()
+        .filter(|r| r.contended == Some(true))
+        .map(|r| r.key().label())
+        .collect();
+    if names.is_empty() {
+        return None;
+    }
+    let mut text = format!(
+        "warning: {} saw other work on the machine (contended=true in summary.csv); their          times are not trustworthy and the report leaves them out of its findings:",
+        plural(names.len(), "cell", "cells")
+    );
+    for name in names {
+        let _ = write!(text, "\n  {name}");
+    }
+    Some(text)
 }
 
 /// The fastest finished cell of each strategy in each group, as a table, groups in plan
@@ -181,6 +211,7 @@ mod tests {
             warmup: 1,
             seed: 1,
             fake_timings: None,
+            fake_contention: None,
         })
     }
 
@@ -191,11 +222,19 @@ mod tests {
                 elapsed: Elapsed {
                     wall_s: w,
                     cpu_s: w,
+                    foreign: None,
                 },
+                load1: None,
                 checksum: "0000000000000001".to_owned(),
             })
             .collect();
-        summary_row(cell, &m, failure, Some(4.0), 2)
+        let seq = [4.0, 4.0];
+        summary_row(
+            cell,
+            &m,
+            failure,
+            &crate::sweep::rows::test_context(Some(&seq), 2),
+        )
     }
 
     #[test]

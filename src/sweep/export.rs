@@ -10,7 +10,7 @@ use std::io::Write;
 use super::rows::{SummaryRow, TrialRow};
 
 /// The columns of `trials.csv`, in order.
-pub const TRIAL_COLUMNS: [&str; 14] = [
+pub const TRIAL_COLUMNS: [&str; 17] = [
     "strategy",
     "neighbors",
     "preset",
@@ -25,10 +25,13 @@ pub const TRIAL_COLUMNS: [&str; 14] = [
     "checksum",
     "status",
     "reason",
+    "foreign_cpu_s",
+    "steal_s",
+    "load1",
 ];
 
 /// The columns of `summary.csv`, in order.
-pub const SUMMARY_COLUMNS: [&str; 22] = [
+pub const SUMMARY_COLUMNS: [&str; 28] = [
     "strategy",
     "neighbors",
     "preset",
@@ -51,7 +54,19 @@ pub const SUMMARY_COLUMNS: [&str; 22] = [
     "checksum",
     "status",
     "reason",
+    "mean_ci_low_s",
+    "mean_ci_high_s",
+    "speedup_ci_low",
+    "speedup_ci_high",
+    "foreign_cpu_mean_s",
+    "contended",
 ];
+
+/// How many leading columns of each file bench-sph 0.1.0 wrote before the contention and
+/// confidence-interval columns were appended: a file with exactly those is an older sweep.
+pub const LEGACY_TRIAL_COLUMNS: usize = 14;
+/// See [`LEGACY_TRIAL_COLUMNS`].
+pub const LEGACY_SUMMARY_COLUMNS: usize = 22;
 
 /// Writes cells to the two CSV streams.
 #[derive(Debug)]
@@ -108,10 +123,11 @@ pub fn to_csv<R: serde::Serialize>(columns: &[&str], rows: &[R]) -> csv::Result<
 mod tests {
     use super::*;
     use crate::clock::Elapsed;
+    use crate::contention::Foreign;
     use crate::sph::neighbors::NeighborMode;
     use crate::sph::params::Preset;
     use crate::sweep::plan::{Cell, Group};
-    use crate::sweep::rows::{Measured, summary_row, trial_rows};
+    use crate::sweep::rows::{Measured, summary_row, test_context, trial_rows};
     use sph_strategies::StrategyName;
 
     fn cell() -> Cell {
@@ -132,7 +148,15 @@ mod tests {
         [(0.5, 1.0), (0.25, 0.5)]
             .iter()
             .map(|&(wall_s, cpu_s)| Measured {
-                elapsed: Elapsed { wall_s, cpu_s },
+                elapsed: Elapsed {
+                    wall_s,
+                    cpu_s,
+                    foreign: Some(Foreign {
+                        cpu_s: 0.01,
+                        steal_s: Some(0.0),
+                    }),
+                },
+                load1: Some(0.5),
                 checksum: "0123456789abcdef".to_owned(),
             })
             .collect()
@@ -150,7 +174,7 @@ mod tests {
     fn the_column_lists_match_the_row_structs() {
         let m = measured();
         let trials = trial_rows(&cell(), &m, None);
-        let summary = summary_row(&cell(), &m, None, Some(1.0), 2);
+        let summary = summary_row(&cell(), &m, None, &test_context(Some(&[1.0]), 2));
         assert_eq!(derived_header(&trials[0]), TRIAL_COLUMNS.join(","));
         assert_eq!(derived_header(&summary), SUMMARY_COLUMNS.join(","));
     }
@@ -162,7 +186,7 @@ mod tests {
         let mut e = Exporter::new(&mut t, &mut s, true).unwrap();
         e.write_cell(
             &trial_rows(&cell(), &m, None),
-            &summary_row(&cell(), &m, None, Some(0.75), 2),
+            &summary_row(&cell(), &m, None, &test_context(Some(&[0.75, 0.75]), 2)),
         )
         .unwrap();
         drop(e);
@@ -170,18 +194,20 @@ mod tests {
             String::from_utf8(t).unwrap(),
             format!(
                 "{}\n\
-                 rayon-chunks,grid,seed,60,3,2,5,12,1,0.5,1.0,0123456789abcdef,ok,\n\
-                 rayon-chunks,grid,seed,60,3,2,5,12,2,0.25,0.5,0123456789abcdef,ok,\n",
+                 rayon-chunks,grid,seed,60,3,2,5,12,1,0.5,1.0,0123456789abcdef,ok,,0.01,0.0,0.5\n\
+                 rayon-chunks,grid,seed,60,3,2,5,12,2,0.25,0.5,0123456789abcdef,ok,,0.01,0.0,0.5\n",
                 TRIAL_COLUMNS.join(",")
             )
         );
-        // mean 0.375, stddev √0.03125, median 0.375, speedup 2, efficiency 1.
+        // mean 0.375, stddev √0.03125, median 0.375, speedup 2, efficiency 1; resampled
+        // means of two trials are 0.25, 0.375 or 0.5 (a quarter of them each at the ends),
+        // so the interval spans 0.25..0.5 and the speedup's 0.75/0.5..0.75/0.25.
         assert_eq!(
             String::from_utf8(s).unwrap(),
             format!(
                 "{}\n\
                  rayon-chunks,grid,seed,60,3,2,5,12,2,0.375,{},0.25,0.375,0.5,0.75,2.0,1.0,0,\
-                 false,0123456789abcdef,ok,\n",
+                 false,0123456789abcdef,ok,,0.25,0.5,1.5,3.0,0.01,false\n",
                 SUMMARY_COLUMNS.join(","),
                 0.03125f64.sqrt()
             )

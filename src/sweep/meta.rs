@@ -106,6 +106,35 @@ pub struct Session {
     pub git_commit: String,
     /// The machine.
     pub machine: Machine,
+    /// Hardware threads' worth of CPU other work was using just before the session started
+    /// (`null` where unknown; see [`crate::contention`]).
+    #[serde(default)]
+    pub busy_threads_at_start: Option<f64>,
+}
+
+/// How the summary's intervals and `contended` flags were computed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Statistics {
+    /// Bootstrap resamples per interval.
+    pub bootstrap_resamples: usize,
+    /// The intervals' confidence level.
+    pub confidence: f64,
+    /// The seed of the bootstrap's random streams (the sweep's `seed`).
+    pub bootstrap_seed: u64,
+    /// Share of the machine's capacity other work may take before a trial is contended.
+    pub contended_share: f64,
+}
+
+impl Statistics {
+    /// This version's settings for a sweep with `seed`.
+    pub fn current(seed: u64) -> Statistics {
+        Statistics {
+            bootstrap_resamples: super::bootstrap::RESAMPLES,
+            confidence: super::bootstrap::CONFIDENCE,
+            bootstrap_seed: seed,
+            contended_share: crate::contention::CONTENDED_SHARE,
+        }
+    }
 }
 
 impl Session {
@@ -120,6 +149,7 @@ impl Session {
             version: VERSION.to_owned(),
             git_commit: GIT_COMMIT.to_owned(),
             machine,
+            busy_threads_at_start: None,
         }
     }
 }
@@ -133,6 +163,10 @@ pub struct Meta {
     pub version: String,
     /// bench-sph git commit of the first session, or `unknown`.
     pub git_commit: String,
+    /// Whether that build had uncommitted changes to tracked files (then the commit does not
+    /// describe the code exactly).
+    #[serde(default)]
+    pub git_dirty: bool,
     /// `rustc --version` of the first session's build.
     pub rustc: String,
     /// The first session's machine.
@@ -149,6 +183,10 @@ pub struct Meta {
     pub planned_cells: usize,
     /// Every parameter (read back by `--resume`).
     pub params: SweepParams,
+    /// How the intervals and contention flags were computed (`null` in sweeps written
+    /// before they existed).
+    #[serde(default)]
+    pub statistics: Option<Statistics>,
     /// Every session, first to last.
     pub sessions: Vec<Session>,
 }
@@ -160,6 +198,7 @@ impl Meta {
             tool: "bench-sph sweep".to_owned(),
             version: session.version.clone(),
             git_commit: session.git_commit.clone(),
+            git_dirty: session.git_commit.ends_with("-dirty"),
             rustc: RUSTC.to_owned(),
             machine: session.machine.clone(),
             command_line: session.command_line.clone(),
@@ -167,6 +206,7 @@ impl Meta {
             finished_utc: None,
             status: SweepStatus::Running,
             planned_cells,
+            statistics: Some(Statistics::current(params.seed)),
             params,
             sessions: vec![session],
         }
@@ -195,11 +235,17 @@ impl Meta {
     /// Writes `path` whole (through a temporary file renamed over it, so a crash never leaves
     /// half a file).
     pub fn write(&self, path: &Path) -> anyhow::Result<()> {
-        let tmp = path.with_extension("json.tmp");
         let mut text = serde_json::to_string_pretty(self)?;
         text.push('\n');
-        std::fs::write(&tmp, text).with_context(|| format!("cannot write '{}'", tmp.display()))?;
-        std::fs::rename(&tmp, path).with_context(|| format!("cannot write '{}'", path.display()))
+        crate::output::atomic::write(path, text.as_bytes())
+    }
+
+    /// Whether `path` is a sweep's `meta.json` (by its `tool` field).
+    pub fn is_sweep_meta(path: &Path) -> bool {
+        std::fs::read_to_string(path)
+            .ok()
+            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+            .is_some_and(|v| v["tool"] == "bench-sph sweep")
     }
 }
 

@@ -15,8 +15,11 @@
 //!   oversubscribed, the common checksum, status and reason;
 //! - `meta.json`: machine, build, times, command lines and every parameter.
 
+pub mod bootstrap;
 pub mod console;
+pub mod dir;
 pub mod export;
+pub mod lock;
 pub mod meta;
 pub mod params;
 pub mod plan;
@@ -26,22 +29,27 @@ pub mod rows;
 pub mod runner;
 pub mod stats;
 pub mod timing;
+pub mod validate;
 
 use std::collections::{HashMap, HashSet};
 use std::fs::{File, OpenOptions};
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
+use std::time::Duration;
 
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use lock::DirLock;
 use meta::{Machine, Meta, Session, SweepStatus};
 use params::SweepParams;
 use plan::{CellKey, Group, Plan};
 use range::{Axis, compact};
-use rows::{Status, SummaryRow};
+use rows::{Status, SummaryRow, TrialRow};
 use runner::{Reference, Runner};
 use timing::Timing;
+
+use crate::contention::Threshold;
 
 /// The per-trial file.
 pub const TRIALS_FILE: &str = "trials.csv";
@@ -88,9 +96,16 @@ struct Opened {
     meta: Meta,
     /// Summary rows of cells finished by earlier sessions.
     finished: Vec<SummaryRow>,
+    /// Their trial rows.
+    finished_trials: Vec<TrialRow>,
     /// Whether the CSV files are new (and need their header lines).
     fresh: bool,
+    /// The directory's lock, held until the sweep ends.
+    _lock: DirLock,
 }
+
+/// How long the busy-machine check before the plan watches the machine.
+const BUSY_CHECK: Duration = Duration::from_millis(300);
 
 /// Runs a sweep: plan, measure, write, summarise. Errors (after writing all that is done)
 /// when it was interrupted or a cell failed.
@@ -98,66 +113,50 @@ pub fn run(request: Request) -> anyhow::Result<()> {
     let machine = Machine::detect();
     let hardware_threads = machine.hardware_threads;
     let session = Session::start(request.command_line.clone(), machine);
+    let opened = match &request.target {
+        Target::New { params, out, force } => start_new(params, out.as_deref(), *force, session)?,
+        Target::Resume { dir } => reopen(dir, session)?,
+    };
     let Opened {
         dir,
         mut meta,
         finished,
+        finished_trials,
         fresh,
-    } = match &request.target {
-        Target::New { params, out, force } => start_new(params, out.as_deref(), *force, session)?,
-        Target::Resume { dir } => reopen(dir, session)?,
-    };
+        _lock,
+    } = opened;
     let params = meta.params.clone();
-    let timing = Timing::new(params.fake_timings.as_deref())?;
+    let timing = Timing::new(
+        params.fake_timings.as_deref(),
+        params.fake_contention.as_deref(),
+    )?;
     let plan = Plan::new(&params);
-    let exporter = export::Exporter::new(
-        append(&dir.join(TRIALS_FILE))?,
-        append(&dir.join(SUMMARY_FILE))?,
-        fresh,
-    )
-    .context("cannot write the results")?;
+    let threshold = Threshold {
+        hardware_threads,
+        hz: crate::contention::ticks_per_second(),
+    };
 
     let done: HashSet<CellKey> = finished.iter().map(SummaryRow::key).collect();
     let todo: Vec<usize> = (0..plan.cells.len())
         .filter(|&i| !done.contains(&plan.cells[i].key()))
         .collect();
-    let mut references: HashMap<Group, Reference> = finished
-        .iter()
-        .filter(|r| r.strategy == sph_strategies::StrategyName::Seq.as_str())
-        .filter_map(|r| {
-            let cell = plan.cells.iter().find(|c| c.key() == r.key())?;
-            Some((cell.group, Reference::from_row(r)))
-        })
-        .collect();
+    let mut references = finished_references(&plan, &finished, &finished_trials);
 
-    // Calibrate the groups that still have cells, then say what will happen.
-    let seq_run_s: HashMap<Group, f64> = plan
-        .groups
-        .iter()
-        .filter(|g| todo.iter().any(|&i| plan.cells[i].group == **g))
-        .map(|&g| (g, runner::calibrate(g, params.seed)))
-        .collect();
-    let runs_per_cell = params.warmup + params.trials;
-    let run_s: Vec<f64> = plan
-        .cells
-        .iter()
-        .map(|c| {
-            let seq = seq_run_s.get(&c.group).copied().unwrap_or(0.0);
-            plan::estimate_run_s(c, seq, hardware_threads)
-        })
-        .collect();
-    let estimate: f64 = todo.iter().map(|&i| run_s[i] * runs_per_cell as f64).sum();
-    print_plan(
-        &dir,
-        &params,
-        &plan,
-        &todo,
-        estimate,
-        &seq_run_s,
-        hardware_threads,
-    );
+    // Say what will happen before anything slow: the plan, the machine's load, then the
+    // estimate (from short, bounded seq runs).
+    print_plan(&dir, &params, &plan, &todo, hardware_threads);
+    let busy = busy_before(&timing, &threshold);
+    if let Some(session) = meta.sessions.last_mut() {
+        session.busy_threads_at_start = busy.map(|b| b.threads);
+    }
+    meta.write(&dir.join(META_FILE))?;
+    if let Some(b) = busy.filter(|b| b.contended) {
+        console_warn(&console::busy_warning(b.threads, hardware_threads));
+    }
+    let run_s = estimate(&plan, &todo, &params, hardware_threads)?;
 
     runner::install_ctrlc_handler();
+    let runs_per_cell = params.warmup + params.trials;
     let run_ms: Vec<u64> = run_s
         .iter()
         .map(|s| {
@@ -168,13 +167,21 @@ pub fn run(request: Request) -> anyhow::Result<()> {
             }
         })
         .collect();
+    let exporter = export::Exporter::new(
+        append(&dir.join(TRIALS_FILE))?,
+        append(&dir.join(SUMMARY_FILE))?,
+        fresh,
+    )
+    .context("cannot write the results")?;
     let progress = progress_bar(todo.iter().map(|&i| run_ms[i] * runs_per_cell as u64).sum());
     let mut runner = Runner {
         plan: &plan,
         warmup: params.warmup,
         trials: params.trials,
         seed: params.seed,
+        resamples: bootstrap::RESAMPLES,
         hardware_threads,
+        threshold,
         timing,
         stop_after_cells: request.stop_after_cells,
         exporter,
@@ -194,13 +201,30 @@ pub fn run(request: Request) -> anyhow::Result<()> {
     };
     meta.finish(status, outcome.rows.len());
     meta.write(&dir.join(META_FILE))?;
+    finish(&dir, &plan, &all_rows, status, request.no_plots)
+}
 
-    println!();
-    print!("{}", console::best_cells(&plan, &all_rows));
-    if status == SweepStatus::Complete {
-        println!("{}", render_charts(&dir, request.no_plots)?);
+/// The end of a sweep: what it found, where it is, and the error that says why it is not
+/// complete (if it is not).
+fn finish(
+    dir: &Path,
+    plan: &Plan,
+    all_rows: &[SummaryRow],
+    status: SweepStatus,
+    no_plots: bool,
+) -> anyhow::Result<()> {
+    // Standard output may be gone (`| head`): the sweep's files are complete by now, so
+    // printing failures are ignored and the sweep ends with its status.
+    let mut text = format!("\n{}", console::best_cells(plan, all_rows));
+    if let Some(contended) = console::contended_cells(all_rows) {
+        console_warn(&contended);
     }
-    print_paths(&dir, &all_rows);
+    if status == SweepStatus::Complete {
+        text.push_str(&render_charts(dir, no_plots)?);
+        text.push('\n');
+    }
+    text.push_str(&paths_text(dir, all_rows));
+    let _ = crate::output::console::line(text.trim_end());
 
     if status == SweepStatus::Interrupted {
         bail!(
@@ -230,6 +254,109 @@ pub fn run(request: Request) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The references of groups whose `seq` cell an earlier session finished.
+fn finished_references(
+    plan: &Plan,
+    finished: &[SummaryRow],
+    trials: &[TrialRow],
+) -> HashMap<Group, Reference> {
+    finished
+        .iter()
+        .filter(|r| r.strategy == sph_strategies::StrategyName::Seq.as_str())
+        .filter_map(|r| {
+            let cell = plan.cells.iter().find(|c| c.key() == r.key())?;
+            let walls = trials
+                .iter()
+                .filter(|t| t.key() == r.key())
+                .map(|t| t.wall_s)
+                .collect();
+            Some((cell.group, Reference::from_row(r, walls)))
+        })
+        .collect()
+}
+
+/// What the check before the plan saw.
+#[derive(Debug, Clone, Copy)]
+struct Busy {
+    /// Hardware threads' worth of CPU that other work used.
+    threads: f64,
+    /// Whether that is beyond the contention threshold.
+    contended: bool,
+}
+
+/// Watches the machine for [`BUSY_CHECK`] (or takes `--fake-contention`'s first share).
+fn busy_before(timing: &Timing, threshold: &Threshold) -> Option<Busy> {
+    let (foreign_s, wall_s) = match timing.fake_busy_threads(threshold.hardware_threads) {
+        Some(threads) => (threads * BUSY_CHECK.as_secs_f64(), BUSY_CHECK.as_secs_f64()),
+        None => crate::contention::sample_now(BUSY_CHECK)?,
+    };
+    Some(Busy {
+        threads: foreign_s / wall_s,
+        contended: threshold.exceeded(foreign_s, wall_s),
+    })
+}
+
+/// Estimated seconds of one run of each cell, from a bounded `seq` run per group that still
+/// has cells to run; printed as the plan's last line.
+fn estimate(
+    plan: &Plan,
+    todo: &[usize],
+    params: &SweepParams,
+    hardware_threads: usize,
+) -> anyhow::Result<Vec<f64>> {
+    let groups: Vec<Group> = plan
+        .groups
+        .iter()
+        .copied()
+        .filter(|g| todo.iter().any(|&i| plan.cells[i].group == *g))
+        .collect();
+    if !groups.is_empty() {
+        let _ = crate::output::console::line("  estimating the time (a short seq run per group)…");
+    }
+    let seq_run_s: HashMap<Group, f64> = groups
+        .iter()
+        .map(|&g| (g, runner::calibrate(g, params.seed)))
+        .collect();
+    let run_s: Vec<f64> = plan
+        .cells
+        .iter()
+        .map(|c| {
+            let seq = seq_run_s.get(&c.group).copied().unwrap_or(0.0);
+            plan::estimate_run_s(c, seq, hardware_threads)
+        })
+        .collect();
+    let total: f64 = todo
+        .iter()
+        .map(|&i| run_s[i] * (params.warmup + params.trials) as f64)
+        .sum();
+    let mut text = String::new();
+    for g in &groups {
+        text.push_str(&format!(
+            "  seq ≈ {} per run: {}\n",
+            console::duration(seq_run_s[g]),
+            g.label()
+        ));
+    }
+    text.push_str(&format!(
+        "  estimated time: about {} (assuming ideal speedup up to {} hardware threads; the \
+         progress bar's ETA corrects it)\n",
+        console::duration(total),
+        hardware_threads
+    ));
+    print(&text);
+    Ok(run_s)
+}
+
+/// Prints `text`. A closed standard output is not an error here: the runner sees it
+/// ([`runner::interrupted`]) and ends the sweep as after Ctrl-C, with `meta.json` saying so.
+fn print(text: &str) {
+    let _ = crate::output::console::line(text.trim_end_matches('\n'));
+}
+
+fn console_warn(text: &str) {
+    crate::output::console::warn(text);
+}
+
 /// The one place where a finished sweep's charts are made: `bench-sph report` on the sweep's
 /// directory, writing into it. A drawing failure is an error, but the CSVs and meta.json are
 /// already complete by then.
@@ -237,14 +364,15 @@ fn render_charts(dir: &Path, no_plots: bool) -> anyhow::Result<String> {
     if no_plots {
         return Ok("Charts: skipped (--no-plots).".to_owned());
     }
-    let written = crate::report::generate(&[dir.to_path_buf()], dir, &[]).with_context(|| {
-        format!(
-            "the charts and REPORT.md could not be made (the results in '{}' are complete; \
+    let written =
+        crate::report::generate(&[dir.to_path_buf()], dir, &[], false).with_context(|| {
+            format!(
+                "the charts and REPORT.md could not be made (the results in '{}' are complete; \
              retry with `bench-sph report {}`)",
-            dir.display(),
-            dir.display()
-        )
-    })?;
+                dir.display(),
+                dir.display()
+            )
+        })?;
     let mut text = format!("Charts and report ({} files):", written.len());
     for p in &written {
         text.push_str(&format!("\n  {}", p.display()));
@@ -252,7 +380,7 @@ fn render_charts(dir: &Path, no_plots: bool) -> anyhow::Result<String> {
     Ok(text)
 }
 
-/// Creates (or, with `force`, reclaims) the directory of a new sweep and writes its
+/// Creates (or, with `force`, reclaims) the directory of a new sweep, locks it and writes its
 /// `meta.json`: any problem with the path shows here, before anything runs.
 fn start_new(
     params: &SweepParams,
@@ -260,39 +388,12 @@ fn start_new(
     force: bool,
     session: Session,
 ) -> anyhow::Result<Opened> {
-    Timing::new(params.fake_timings.as_deref())?;
-    let dir = out.map_or_else(
-        || Path::new("results").join(meta::timestamp_dir_name()),
-        Path::to_path_buf,
-    );
-    if dir.exists() {
-        if !dir.is_dir() {
-            bail!("--out '{}' exists and is not a directory", dir.display());
-        }
-        let non_empty = std::fs::read_dir(&dir)
-            .with_context(|| format!("cannot read results directory '{}'", dir.display()))?
-            .next()
-            .is_some();
-        if non_empty && !force {
-            bail!(
-                "results directory '{}' already exists and is not empty; continue that sweep \
-                 with `--resume {}`, or replace its results with `--force`",
-                dir.display(),
-                dir.display()
-            );
-        }
-        // --force replaces the files a sweep writes, and only those.
-        for name in [TRIALS_FILE, SUMMARY_FILE, META_FILE] {
-            let path = dir.join(name);
-            if path.exists() {
-                std::fs::remove_file(&path)
-                    .with_context(|| format!("cannot replace '{}'", path.display()))?;
-            }
-        }
-    } else {
-        std::fs::create_dir_all(&dir)
-            .with_context(|| format!("cannot create results directory '{}'", dir.display()))?;
-    }
+    params.validate()?;
+    let dir = match out {
+        Some(dir) => dir.to_path_buf(),
+        None => dir::new_default()?,
+    };
+    let lock = dir::open_new(&dir, force)?;
     let plan = Plan::new(params);
     let meta = Meta::new(params.clone(), plan.cells.len(), session);
     meta.write(&dir.join(META_FILE))?;
@@ -300,45 +401,67 @@ fn start_new(
         dir,
         meta,
         finished: Vec::new(),
+        finished_trials: Vec::new(),
         fresh: true,
+        _lock: lock,
     })
 }
 
-/// Reads an earlier sweep's parameters and finished cells, repairs its CSV files, and
-/// records this session in its `meta.json`.
+/// Reads an earlier sweep's parameters (checked as the command line checks them) and
+/// finished cells (each re-checked), repairs its CSV files, and records this session in its
+/// `meta.json`.
 fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
+    let lock = dir::open_existing(dir)?;
     let meta_path = dir.join(META_FILE);
-    if !meta_path.is_file() {
-        bail!(
-            "cannot resume '{}': it has no {META_FILE}, so it is not a sweep's results directory",
-            dir.display()
-        );
-    }
     let mut meta = Meta::read(&meta_path)?;
-    let repaired = resume::load_and_repair(dir)?;
+    meta.params.validate().with_context(|| {
+        format!(
+            "cannot resume '{}': its {META_FILE} has parameters the command line would refuse",
+            dir.display()
+        )
+    })?;
+    let plan = Plan::new(&meta.params);
+    let planned: HashSet<CellKey> = plan.cells.iter().map(|c| c.key()).collect();
+    let trials = meta.params.trials;
+    let check = |row: &SummaryRow| -> Result<(), String> {
+        if !planned.contains(&row.key()) {
+            return Err("not a cell of this sweep's plan".to_owned());
+        }
+        if row.trials != trials {
+            return Err(format!(
+                "{} trials, but the sweep asks for {trials}",
+                row.trials
+            ));
+        }
+        Ok(())
+    };
+    let repaired = resume::load_and_repair(dir, &check)?;
     let (was, now) = (&meta.machine, &session.machine);
     if was.cpu_model != now.cpu_model || was.hardware_threads != now.hardware_threads {
-        eprintln!(
+        console_warn(&format!(
             "warning: this sweep started on '{}' ({} hardware threads) and continues on '{}' \
              ({}): times from the two machines are not comparable",
             was.cpu_model, was.hardware_threads, now.cpu_model, now.hardware_threads
-        );
+        ));
     }
     if meta.git_commit != session.git_commit {
-        eprintln!(
+        console_warn(&format!(
             "warning: this sweep started with bench-sph {} and continues with {}",
             meta.git_commit, session.git_commit
-        );
+        ));
     }
-    println!(
+    for why in &repaired.rejected {
+        console_warn(&format!("warning: dropped, will run again: {why}"));
+    }
+    print(&format!(
         "Resuming '{}': {} finished cells kept{}",
         dir.display(),
         repaired.finished.len(),
         match repaired.dropped_trial_rows + repaired.dropped_summary_rows {
             0 => String::new(),
-            k => format!(" ({k} rows of an unfinished cell dropped)"),
+            k => format!(" ({k} rows of unfinished or rejected cells dropped)"),
         }
-    );
+    ));
     meta.sessions.push(session);
     meta.status = SweepStatus::Running;
     meta.finished_utc = None;
@@ -347,7 +470,9 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
         dir: dir.to_path_buf(),
         meta,
         finished: repaired.finished,
+        finished_trials: repaired.finished_trials,
         fresh: false,
+        _lock: lock,
     })
 }
 
@@ -361,38 +486,31 @@ fn append(path: &Path) -> anyhow::Result<BufWriter<File>> {
     Ok(BufWriter::new(file))
 }
 
-/// The plan: groups, strategies, lists, cells, runs and the estimated duration; warnings on
-/// standard error.
+/// The plan: groups, strategies, lists, cells and runs; warnings on standard error.
 fn print_plan(
     dir: &Path,
     params: &SweepParams,
     plan: &Plan,
     todo: &[usize],
-    estimate_s: f64,
-    seq_run_s: &HashMap<Group, f64>,
     hardware_threads: usize,
 ) {
-    println!("bench-sph sweep → {}", dir.display());
+    let mut text = format!("bench-sph sweep → {}\n", dir.display());
     for group in &plan.groups {
-        let seq = seq_run_s
-            .get(group)
-            .map(|&s| format!(" (seq ≈ {} per run)", console::duration(s)))
-            .unwrap_or_default();
-        println!("  group: {}{seq}", group.label());
+        text.push_str(&format!("  group: {}\n", group.label()));
     }
     let names: Vec<&str> = params.strategies.iter().map(|s| s.as_str()).collect();
-    println!(
-        "  strategies: {} (seq at 1 core is measured in every group: it is the reference)",
+    text.push_str(&format!(
+        "  strategies: {} (seq at 1 core is measured in every group: it is the reference)\n",
         names.join(", ")
-    );
-    println!(
-        "  cores {}; chunks {} (for {})",
+    ));
+    text.push_str(&format!(
+        "  cores {}; chunks {} (for {})\n",
         compact(&params.cores, Axis::Cores),
         compact(&params.chunks, Axis::Chunks),
         chunked_strategies(params)
-    );
-    println!(
-        "  {} × ({} + {}) = {}",
+    ));
+    text.push_str(&format!(
+        "  {} × ({} + {}) = {}\n",
         console::plural(plan.cells.len(), "cell", "cells"),
         console::plural(params.warmup, "warm-up", "warm-ups"),
         console::plural(params.trials, "trial", "trials"),
@@ -401,29 +519,24 @@ fn print_plan(
             "run",
             "runs"
         ),
-    );
+    ));
     if todo.len() < plan.cells.len() {
-        println!(
-            "  {} already finished, {} to run",
+        text.push_str(&format!(
+            "  {} already finished, {} to run\n",
             plan.cells.len() - todo.len(),
             todo.len()
-        );
+        ));
     }
-    println!(
-        "  estimated time: about {} (from a short seq run per group, assuming ideal speedup up \
-         to {} hardware threads; the progress bar's ETA corrects it)",
-        console::duration(estimate_s),
-        hardware_threads
-    );
+    print(&text);
     if let Some(warning) = console::oversubscription_warning(plan, hardware_threads) {
-        eprintln!("{warning}");
+        console_warn(&warning);
     }
-    if params.fake_timings.is_some() {
-        eprintln!(
-            "warning: --fake-timings is set (test only): the times written are not measurements"
+    if params.fake_timings.is_some() || params.fake_contention.is_some() {
+        console_warn(
+            "warning: --fake-timings/--fake-contention is set (test only): the numbers written \
+             are not measurements",
         );
     }
-    println!();
 }
 
 fn chunked_strategies(params: &SweepParams) -> String {
@@ -454,17 +567,17 @@ fn progress_bar(total_ms: u64) -> ProgressBar {
 }
 
 /// Where everything is.
-fn print_paths(dir: &Path, rows: &[SummaryRow]) {
+fn paths_text(dir: &Path, rows: &[SummaryRow]) -> String {
     let trial_rows: usize = rows.iter().map(|r| r.trials).sum();
     let failed = rows.iter().filter(|r| r.status == Status::Failed).count();
-    println!("Results in {}:", dir.display());
-    println!(
-        "  {:<40} {}",
+    let mut text = format!("Results in {}:\n", dir.display());
+    text.push_str(&format!(
+        "  {:<40} {}\n",
         dir.join(TRIALS_FILE).display().to_string(),
         console::plural(trial_rows, "trial row", "trial rows")
-    );
-    println!(
-        "  {:<40} {}{}",
+    ));
+    text.push_str(&format!(
+        "  {:<40} {}{}\n",
         dir.join(SUMMARY_FILE).display().to_string(),
         console::plural(rows.len(), "cell", "cells"),
         if failed > 0 {
@@ -472,9 +585,10 @@ fn print_paths(dir: &Path, rows: &[SummaryRow]) {
         } else {
             String::new()
         }
-    );
-    println!(
-        "  {:<40} machine, build, command lines, parameters",
+    ));
+    text.push_str(&format!(
+        "  {:<40} machine, build, command lines, parameters\n",
         dir.join(META_FILE).display().to_string()
-    );
+    ));
+    text
 }

@@ -36,6 +36,44 @@ pub struct SweepParams {
     /// Test only: trial times replacing the measured ones (see [`super::timing`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fake_timings: Option<String>,
+    /// Test only: foreign-CPU shares replacing the measured ones (see [`super::timing`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fake_contention: Option<String>,
+}
+
+impl SweepParams {
+    /// Checks the parameters as the command line does: every list non-empty, sorted, free of
+    /// repeats and inside its documented range ([`crate::limits`]), and the fake lists (if
+    /// any) readable. `--resume` runs it on a `meta.json` that may have been edited.
+    pub fn validate(&self) -> anyhow::Result<()> {
+        use crate::limits::{self, check};
+        fn list(what: &'static str, values: &[usize], max: usize) -> anyhow::Result<()> {
+            if values.is_empty() {
+                anyhow::bail!("{what}: the list is empty");
+            }
+            if values.windows(2).any(|w| w[0] >= w[1]) {
+                anyhow::bail!("{what}: the list {values:?} is not sorted without repeats");
+            }
+            for &v in values {
+                check(what, v, 1, max)?;
+            }
+            Ok(())
+        }
+        if self.strategies.is_empty() || self.presets.is_empty() || self.neighbors.is_empty() {
+            anyhow::bail!("strategies, presets and neighbors must each name at least one");
+        }
+        list("cores", &self.cores, limits::MAX_CORES)?;
+        list("chunks", &self.chunks, limits::MAX_CHUNKS)?;
+        list("n", &self.n, limits::MAX_PARTICLES)?;
+        check("steps", self.steps, 1, limits::MAX_STEPS)?;
+        check("trials", self.trials, 1, limits::MAX_TRIALS)?;
+        check("warmup", self.warmup, 0, limits::MAX_WARMUP)?;
+        super::timing::Timing::new(
+            self.fake_timings.as_deref(),
+            self.fake_contention.as_deref(),
+        )?;
+        Ok(())
+    }
 }
 
 /// A type written by name in `meta.json` (the same name as on the command line and in CSVs).
@@ -122,6 +160,7 @@ mod tests {
             warmup: 0,
             seed: 7,
             fake_timings: None,
+            fake_contention: None,
         }
     }
 
@@ -134,6 +173,36 @@ mod tests {
         assert!(json.contains(r#""rayon-chunks""#), "{json}");
         assert!(!json.contains("fake_timings"), "{json}");
         assert_eq!(serde_json::from_str::<SweepParams>(&json).unwrap(), p);
+    }
+
+    #[test]
+    fn validation_refuses_what_the_command_line_refuses() {
+        assert!(example().validate().is_ok());
+        let mut p = example();
+        p.cores = vec![0];
+        assert!(
+            p.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("cores must be between 1")
+        );
+        let mut p = example();
+        p.trials = 0;
+        assert!(p.validate().unwrap_err().to_string().contains("trials"));
+        let mut p = example();
+        p.chunks = vec![5, 2];
+        assert!(p.validate().unwrap_err().to_string().contains("not sorted"));
+        let mut p = example();
+        p.n = vec![];
+        assert!(p.validate().unwrap_err().to_string().contains("empty"));
+        let mut p = example();
+        p.fake_contention = Some("2".into());
+        assert!(
+            p.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("--fake-contention")
+        );
     }
 
     #[test]

@@ -68,6 +68,21 @@ pub struct CellKey {
     pub chunks: Option<usize>,
 }
 
+impl CellKey {
+    /// E.g. `rayon-chunks, 2 cores, 10 chunks (preset seed, all-pairs, N = 1000, 300 steps)`.
+    pub fn label(&self) -> String {
+        let cores = if self.cores == 1 { "core" } else { "cores" };
+        let chunks = self
+            .chunks
+            .map(|k| format!(", {k} chunks"))
+            .unwrap_or_default();
+        format!(
+            "{}, {} {cores}{chunks} (preset {}, {}, N = {}, {} steps)",
+            self.strategy, self.cores, self.preset, self.neighbors, self.n, self.steps
+        )
+    }
+}
+
 impl Cell {
     /// Whether this is its group's `seq` reference cell.
     pub fn is_reference(&self) -> bool {
@@ -199,6 +214,7 @@ mod tests {
             warmup: 1,
             seed: 1,
             fake_timings: None,
+            fake_contention: None,
         }
     }
 

@@ -6,6 +6,11 @@
 //! written just before a kill, a line cut off mid-write — is dropped, both files are written
 //! back without it, and the cell runs again. Failed cells are finished too: their failure is a
 //! result (delete their rows by hand to retry them).
+//!
+//! A finished cell is believed only if it passes [`super::validate::cell`] (finite positive
+//! times, statistics that are those of its trials) and the caller's own check (`--resume`:
+//! the cell is in the plan and has the sweep's number of trials); otherwise it is dropped,
+//! listed in [`Repaired::rejected`], and runs again.
 
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -34,6 +39,10 @@ pub struct UnexpectedColumns {
 pub struct Repaired {
     /// The summary rows of the finished cells, in file order.
     pub finished: Vec<SummaryRow>,
+    /// The trial rows of the finished cells.
+    pub finished_trials: Vec<TrialRow>,
+    /// Finished-looking cells that were dropped: the cell and why.
+    pub rejected: Vec<String>,
     /// `trials.csv` as it should be: header plus the finished cells' trial rows.
     pub trials_csv: Vec<u8>,
     /// `summary.csv` as it should be: header plus the finished cells' rows.
@@ -46,8 +55,13 @@ pub struct Repaired {
     pub dropped_summary_rows: usize,
 }
 
-/// Repairs the contents of `trials.csv` and `summary.csv` (either may be empty: no file).
-pub fn repair(trials: &[u8], summary: &[u8]) -> Result<Repaired, UnexpectedColumns> {
+/// Repairs the contents of `trials.csv` and `summary.csv` (either may be empty: no file);
+/// `check` is the caller's own test of a finished cell (see the module docs).
+pub fn repair(
+    trials: &[u8],
+    summary: &[u8],
+    check: &dyn Fn(&SummaryRow) -> Result<(), String>,
+) -> Result<Repaired, UnexpectedColumns> {
     let (summary_rows, mut dropped_summary_rows) =
         read_rows::<SummaryRow>(summary, "summary.csv", &SUMMARY_COLUMNS)?;
     let (trial_rows, mut dropped_trial_rows) =
@@ -76,12 +90,21 @@ pub fn repair(trials: &[u8], summary: &[u8]) -> Result<Repaired, UnexpectedColum
     // Finished = a summary row and trials numbered exactly 1..=trials.
     let mut finished = Vec::new();
     let mut kept = Vec::new();
+    let mut rejected = Vec::new();
     for row in candidates {
         let mut trials = by_cell.remove(&row.key()).unwrap_or_default();
         trials.sort_by_key(|t| t.trial);
         let complete =
             trials.len() == row.trials && trials.iter().enumerate().all(|(i, t)| t.trial == i + 1);
-        if complete {
+        let believed = if complete {
+            super::validate::cell(&row, &trials).and_then(|()| check(&row))
+        } else {
+            Ok(())
+        };
+        if let Err(why) = &believed {
+            rejected.push(format!("{}: {why}", row.key().label()));
+        }
+        if complete && believed.is_ok() {
             kept.extend(trials);
             finished.push(row);
         } else {
@@ -97,6 +120,8 @@ pub fn repair(trials: &[u8], summary: &[u8]) -> Result<Repaired, UnexpectedColum
         summary_csv: csv_bytes(to_csv(&SUMMARY_COLUMNS, &finished)),
         kept_trial_rows: kept.len(),
         finished,
+        finished_trials: kept,
+        rejected,
         dropped_trial_rows,
         dropped_summary_rows,
     })
@@ -147,9 +172,13 @@ fn read_rows<R: serde::de::DeserializeOwned>(
     Ok((rows, dropped))
 }
 
-/// Reads `dir`'s CSV files (a missing one counts as empty), repairs them, and writes the
-/// repaired contents back (each through a temporary file renamed over the original).
-pub fn load_and_repair(dir: &Path) -> anyhow::Result<Repaired> {
+/// Reads `dir`'s CSV files (a missing one counts as empty), repairs them with `check`, and
+/// writes the repaired contents back (each through a temporary file renamed over the
+/// original).
+pub fn load_and_repair(
+    dir: &Path,
+    check: &dyn Fn(&SummaryRow) -> Result<(), String>,
+) -> anyhow::Result<Repaired> {
     let read = |name: &str| -> anyhow::Result<Vec<u8>> {
         let path = dir.join(name);
         match std::fs::read(&path) {
@@ -158,17 +187,13 @@ pub fn load_and_repair(dir: &Path) -> anyhow::Result<Repaired> {
             Err(e) => Err(e).with_context(|| format!("cannot read '{}'", path.display())),
         }
     };
-    let repaired = repair(&read("trials.csv")?, &read("summary.csv")?)
+    let repaired = repair(&read("trials.csv")?, &read("summary.csv")?, check)
         .with_context(|| format!("cannot resume '{}'", dir.display()))?;
     for (name, bytes) in [
         ("trials.csv", &repaired.trials_csv),
         ("summary.csv", &repaired.summary_csv),
     ] {
-        let path = dir.join(name);
-        let tmp = dir.join(format!("{name}.tmp"));
-        std::fs::write(&tmp, bytes).with_context(|| format!("cannot write '{}'", tmp.display()))?;
-        std::fs::rename(&tmp, &path)
-            .with_context(|| format!("cannot write '{}'", path.display()))?;
+        crate::output::atomic::write(&dir.join(name), bytes)?;
     }
     Ok(repaired)
 }
@@ -181,7 +206,7 @@ mod tests {
     use crate::sph::params::Preset;
     use crate::sweep::export::Exporter;
     use crate::sweep::plan::{Cell, Group};
-    use crate::sweep::rows::{Measured, summary_row, trial_rows};
+    use crate::sweep::rows::{Measured, summary_row, test_context, trial_rows};
     use sph_strategies::StrategyName;
 
     fn cell(cores: usize) -> Cell {
@@ -204,7 +229,9 @@ mod tests {
                 elapsed: Elapsed {
                     wall_s: i as f64,
                     cpu_s: i as f64,
+                    foreign: None,
                 },
+                load1: None,
                 checksum: "00000000000000ff".to_owned(),
             })
             .collect()
@@ -218,7 +245,7 @@ mod tests {
             let m = measured(3);
             e.write_cell(
                 &trial_rows(&cell(cores), &m, None),
-                &summary_row(&cell(cores), &m, None, Some(1.0), 2),
+                &summary_row(&cell(cores), &m, None, &test_context(Some(&[1.0]), 2)),
             )
             .unwrap();
         }
@@ -229,7 +256,7 @@ mod tests {
     #[test]
     fn intact_files_come_back_unchanged() {
         let (t, s) = two_cells();
-        let r = repair(&t, &s).unwrap();
+        let r = repair(&t, &s, &|_| Ok(())).unwrap();
         assert_eq!(r.finished.len(), 2);
         assert_eq!(
             (
@@ -249,11 +276,11 @@ mod tests {
         let mut e = Exporter::new(&mut t, Vec::new(), false).unwrap();
         e.write_cell(
             &trial_rows(&cell(3), &measured(2), None),
-            &summary_row(&cell(3), &measured(2), None, None, 2),
+            &summary_row(&cell(3), &measured(2), None, &test_context(None, 2)),
         )
         .unwrap();
         drop(e);
-        let r = repair(&t, &s).unwrap();
+        let r = repair(&t, &s, &|_| Ok(())).unwrap();
         assert_eq!(r.finished.len(), 2);
         assert_eq!(r.dropped_trial_rows, 2);
         assert_eq!(r.trials_csv, two_cells().0);
@@ -267,7 +294,7 @@ mod tests {
         s.extend_from_slice(
             b"rayon-iter,all-pairs,seed,60,3,4,,,3,1.0,1.0,1.0,1.0,1.0,1.0,1.0,1.0,0,fa",
         );
-        let r = repair(&t_cut, &s).unwrap();
+        let r = repair(&t_cut, &s, &|_| Ok(())).unwrap();
         assert_eq!(r.finished.len(), 2);
         assert_eq!((r.dropped_trial_rows, r.dropped_summary_rows), (1, 1));
         assert_eq!(r.trials_csv, t);
@@ -281,7 +308,7 @@ mod tests {
         let mut lines: Vec<&str> = text.lines().collect();
         lines.pop();
         let t = format!("{}\n", lines.join("\n"));
-        let r = repair(t.as_bytes(), &s).unwrap();
+        let r = repair(t.as_bytes(), &s, &|_| Ok(())).unwrap();
         assert_eq!(r.finished.len(), 1);
         assert_eq!(r.finished[0].cores, 1);
         assert_eq!(
@@ -302,7 +329,7 @@ mod tests {
         let t2 = format!("{text}{last}\n");
         let stext = String::from_utf8(s.clone()).unwrap();
         let s2 = format!("{stext}{}\n", stext.lines().last().unwrap());
-        let r = repair(t2.as_bytes(), s2.as_bytes()).unwrap();
+        let r = repair(t2.as_bytes(), s2.as_bytes(), &|_| Ok(())).unwrap();
         assert_eq!(r.finished.len(), 2);
         assert_eq!(r.trials_csv, t);
         assert_eq!(r.summary_csv, s);
@@ -310,14 +337,14 @@ mod tests {
 
     #[test]
     fn missing_files_mean_nothing_is_finished() {
-        let r = repair(b"", b"").unwrap();
+        let r = repair(b"", b"", &|_| Ok(())).unwrap();
         assert!(r.finished.is_empty());
         assert!(r.trials_csv.starts_with(b"strategy,"));
     }
 
     #[test]
     fn a_foreign_header_is_an_error() {
-        let err = repair(b"a,b\n1,2\n", b"").unwrap_err();
+        let err = repair(b"a,b\n1,2\n", b"", &|_| Ok(())).unwrap_err();
         assert_eq!(err.file, "trials.csv");
         assert!(err.to_string().contains("'a,b'"), "{err}");
     }

@@ -2,14 +2,23 @@
 //!
 //! Field names are the column names. Times are seconds; an empty field means "not defined"
 //! (chunks of a strategy without chunks, the stddev of one trial, any statistic of a failed
-//! cell). `status` is `ok` or `failed`; a failed cell's `reason` says why, and its summary
-//! carries no statistic, speedup or efficiency: a bug must never become a number.
+//! cell, anything unmeasurable on this OS). `status` is `ok` or `failed`; a failed cell's
+//! `reason` says why, and its summary carries no statistic, speedup or efficiency: a bug must
+//! never become a number.
+//!
+//! Columns added after the first release are appended at the end of each row (older readers
+//! keep working): per trial `foreign_cpu_s, steal_s, load1` ([`crate::contention`]); per cell
+//! the 95 % bootstrap intervals `mean_ci_low_s, mean_ci_high_s, speedup_ci_low,
+//! speedup_ci_high` ([`super::bootstrap`]), `foreign_cpu_mean_s` and `contended` (some trial
+//! saw more foreign CPU than [`Threshold::allowed_s`]).
 
 use serde::{Deserialize, Serialize};
 
+use super::bootstrap::{self, Interval};
 use super::plan::{Cell, CellKey};
 use super::stats::{Stats, mean};
 use crate::clock::Elapsed;
+use crate::contention::Threshold;
 
 /// Whether a cell's numbers can be used.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -24,8 +33,10 @@ pub enum Status {
 /// One timed run: its times and the checksum of its final state.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Measured {
-    /// Wall and CPU seconds of the step loop.
+    /// Wall, CPU and foreign CPU seconds of the step loop.
     pub elapsed: Elapsed,
+    /// The 1-minute load average when the run started (`None` where unknown).
+    pub load1: Option<f64>,
     /// [`crate::checksum::checksum_hex`] of the final state.
     pub checksum: String,
 }
@@ -61,6 +72,15 @@ pub struct TrialRow {
     pub status: Status,
     /// Why the cell failed (empty when ok).
     pub reason: String,
+    /// Busy CPU seconds of the machine not spent by this process over the same window.
+    #[serde(default)]
+    pub foreign_cpu_s: Option<f64>,
+    /// Of those, seconds stolen by the hypervisor.
+    #[serde(default)]
+    pub steal_s: Option<f64>,
+    /// The 1-minute load average when the trial started.
+    #[serde(default)]
+    pub load1: Option<f64>,
 }
 
 /// One row of `summary.csv`: one cell.
@@ -110,6 +130,24 @@ pub struct SummaryRow {
     pub status: Status,
     /// Why the cell failed (empty when ok).
     pub reason: String,
+    /// Lower end of the 95 % bootstrap interval of the mean wall seconds.
+    #[serde(default)]
+    pub mean_ci_low_s: Option<f64>,
+    /// Upper end of that interval.
+    #[serde(default)]
+    pub mean_ci_high_s: Option<f64>,
+    /// Lower end of the 95 % bootstrap interval of the speedup.
+    #[serde(default)]
+    pub speedup_ci_low: Option<f64>,
+    /// Upper end of that interval.
+    #[serde(default)]
+    pub speedup_ci_high: Option<f64>,
+    /// Mean foreign CPU seconds per trial.
+    #[serde(default)]
+    pub foreign_cpu_mean_s: Option<f64>,
+    /// Whether some trial saw more foreign CPU than the threshold (empty where unknown).
+    #[serde(default)]
+    pub contended: Option<bool>,
 }
 
 impl TrialRow {
@@ -163,24 +201,60 @@ pub fn trial_rows(cell: &Cell, measured: &[Measured], failure: Option<&str>) -> 
             checksum: m.checksum.clone(),
             status: status_of(failure),
             reason: failure.unwrap_or_default().to_owned(),
+            foreign_cpu_s: m.elapsed.foreign.map(|f| f.cpu_s),
+            steal_s: m.elapsed.foreign.and_then(|f| f.steal_s),
+            load1: m.load1,
         })
         .collect()
 }
 
-/// The summary row of a cell. `seq_mean_s` is the group's reference mean (for the reference
-/// cell itself, its own mean); without it, or for a failed cell, there is no speedup.
+/// What a summary row is computed against.
+#[derive(Debug, Clone, Copy)]
+pub struct CellContext<'a> {
+    /// The wall seconds of the group's `seq` trials (for the reference cell, its own); without
+    /// them there is no speedup.
+    pub seq_walls: Option<&'a [f64]>,
+    /// The machine's hardware threads (for `oversubscribed`).
+    pub hardware_threads: usize,
+    /// When foreign CPU makes a trial contended.
+    pub threshold: Threshold,
+    /// The sweep's seed (the bootstrap's streams derive from it).
+    pub seed: u64,
+    /// Bootstrap resamples per interval.
+    pub resamples: usize,
+}
+
+/// The summary row of a cell, against `ctx`; a failed cell has no statistics, speedup or
+/// intervals.
 pub fn summary_row(
     cell: &Cell,
     measured: &[Measured],
     failure: Option<&str>,
-    seq_mean_s: Option<f64>,
-    hardware_threads: usize,
+    ctx: &CellContext<'_>,
 ) -> SummaryRow {
     let key = cell.key();
     let walls: Vec<f64> = measured.iter().map(|m| m.elapsed.wall_s).collect();
     let cpus: Vec<f64> = measured.iter().map(|m| m.elapsed.cpu_s).collect();
     let stats = Stats::of(&walls).filter(|_| failure.is_none());
-    let speedup = stats.and_then(|s| seq_mean_s.map(|seq| seq / s.mean));
+    let seq_walls = ctx.seq_walls.filter(|w| !w.is_empty());
+    let speedup = stats.and_then(|s| seq_walls.map(|seq| mean(seq) / s.mean));
+    let label = cell.label();
+    let mean_ci = stats.and_then(|_| {
+        bootstrap::mean_interval(
+            &walls,
+            ctx.resamples,
+            &mut bootstrap::rng_for(ctx.seed, &label, 0),
+        )
+    });
+    let speedup_ci = stats.and_then(|_| {
+        let mut rng = bootstrap::rng_for(ctx.seed, &label, 1);
+        bootstrap::ratio_interval(seq_walls?, &walls, ctx.resamples, &mut rng)
+    });
+    let foreign: Option<Vec<f64>> = measured
+        .iter()
+        .map(|m| m.elapsed.foreign.map(|f| f.cpu_s))
+        .collect();
+    let foreign = foreign.filter(|f| !f.is_empty());
     SummaryRow {
         strategy: key.strategy,
         neighbors: key.neighbors,
@@ -200,13 +274,38 @@ pub fn summary_row(
         speedup,
         efficiency: speedup.map(|s| s / cell.cores as f64),
         outliers: stats.map(|s| s.outliers),
-        oversubscribed: cell.oversubscribed(hardware_threads),
+        oversubscribed: cell.oversubscribed(ctx.hardware_threads),
         checksum: match (failure, measured.first()) {
             (None, Some(m)) => m.checksum.clone(),
             _ => String::new(),
         },
         status: status_of(failure),
         reason: failure.unwrap_or_default().to_owned(),
+        mean_ci_low_s: mean_ci.map(|i: Interval| i.low),
+        mean_ci_high_s: mean_ci.map(|i| i.high),
+        speedup_ci_low: speedup_ci.map(|i| i.low),
+        speedup_ci_high: speedup_ci.map(|i| i.high),
+        foreign_cpu_mean_s: foreign.as_deref().map(mean),
+        contended: foreign.map(|f| {
+            f.iter()
+                .zip(&walls)
+                .any(|(&foreign, &wall)| ctx.threshold.exceeded(foreign, wall))
+        }),
+    }
+}
+
+/// A context for tests: no foreign-CPU slack beyond the rule, seed 1, 1000 resamples.
+#[cfg(test)]
+pub(crate) fn test_context(seq_walls: Option<&[f64]>, hardware_threads: usize) -> CellContext<'_> {
+    CellContext {
+        seq_walls,
+        hardware_threads,
+        threshold: Threshold {
+            hardware_threads,
+            hz: 100.0,
+        },
+        seed: 1,
+        resamples: 1000,
     }
 }
 
@@ -221,6 +320,7 @@ fn status_of(failure: Option<&str>) -> Status {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contention::Foreign;
     use crate::sph::neighbors::NeighborMode;
     use crate::sph::params::Preset;
     use crate::sweep::plan::Group;
@@ -247,7 +347,12 @@ mod tests {
                 elapsed: Elapsed {
                     wall_s: w,
                     cpu_s: 2.0 * w,
+                    foreign: Some(Foreign {
+                        cpu_s: 0.01 * w,
+                        steal_s: Some(0.0),
+                    }),
                 },
+                load1: Some(0.25),
                 checksum: "00000000000000aa".to_owned(),
             })
             .collect()
@@ -256,7 +361,12 @@ mod tests {
     #[test]
     fn a_summary_carries_the_statistics_speedup_and_efficiency() {
         let c = cell(StrategyName::RayonChunks, 2, Some(7));
-        let row = summary_row(&c, &measured(&[1.0, 2.0, 3.0]), None, Some(4.0), 1);
+        let row = summary_row(
+            &c,
+            &measured(&[1.0, 2.0, 3.0]),
+            None,
+            &test_context(Some(&[4.0, 4.0]), 1),
+        );
         assert_eq!(row.trials, 3);
         assert_eq!(row.mean_s, Some(2.0));
         assert_eq!(row.stddev_s, Some(1.0));
@@ -272,19 +382,70 @@ mod tests {
         assert!(row.oversubscribed);
         assert_eq!((row.status, row.reason.as_str()), (Status::Ok, ""));
         assert_eq!(row.checksum, "00000000000000aa");
+        let (lo, hi) = (row.mean_ci_low_s.unwrap(), row.mean_ci_high_s.unwrap());
+        assert!(
+            (1.0..2.0).contains(&lo) && hi > 2.0 && hi <= 3.0,
+            "{lo} {hi}"
+        );
+        let (lo, hi) = (row.speedup_ci_low.unwrap(), row.speedup_ci_high.unwrap());
+        assert!(
+            (4.0 / 3.0..2.0).contains(&lo) && hi > 2.0 && hi <= 4.0,
+            "{lo} {hi}"
+        );
+        assert_eq!(row.foreign_cpu_mean_s, Some(0.02));
+        assert_eq!(row.contended, Some(false));
+    }
+
+    #[test]
+    fn a_trial_with_too_much_foreign_cpu_makes_the_cell_contended() {
+        let c = cell(StrategyName::RayonChunks, 2, Some(7));
+        let mut m = measured(&[1.0, 1.0, 1.0]);
+        // 2 threads: allowed 5 % × 2 × 1 s + 2 ticks × 2 = 0.14 s.
+        m[1].elapsed.foreign = Some(Foreign {
+            cpu_s: 0.15,
+            steal_s: None,
+        });
+        let row = summary_row(&c, &m, None, &test_context(None, 2));
+        assert_eq!(row.contended, Some(true));
+        m[1].elapsed.foreign = Some(Foreign {
+            cpu_s: 0.14,
+            steal_s: None,
+        });
+        assert_eq!(
+            summary_row(&c, &m, None, &test_context(None, 2)).contended,
+            Some(false)
+        );
+    }
+
+    #[test]
+    fn without_foreign_readings_contention_is_unknown_not_invented() {
+        let c = cell(StrategyName::Seq, 1, None);
+        let mut m = measured(&[1.0, 1.0]);
+        m[0].elapsed.foreign = None;
+        let row = summary_row(&c, &m, None, &test_context(None, 2));
+        assert_eq!((row.contended, row.foreign_cpu_mean_s), (None, None));
+        let trials = trial_rows(&c, &m, None);
+        assert_eq!((trials[0].foreign_cpu_s, trials[0].steal_s), (None, None));
+        assert_eq!(trials[1].steal_s, Some(0.0));
     }
 
     #[test]
     fn a_failed_cell_has_a_reason_and_no_numbers() {
         let c = cell(StrategyName::RayonIter, 2, None);
         let m = measured(&[1.0, 2.0]);
-        let row = summary_row(&c, &m, Some("checksum differs"), Some(4.0), 2);
+        let row = summary_row(
+            &c,
+            &m,
+            Some("checksum differs"),
+            &test_context(Some(&[4.0]), 2),
+        );
         assert_eq!(row.status, Status::Failed);
         assert_eq!(row.reason, "checksum differs");
         assert_eq!(row.trials, 2);
         assert!(row.mean_s.is_none() && row.median_s.is_none() && row.cpu_mean_s.is_none());
         assert!(row.speedup.is_none() && row.efficiency.is_none() && row.outliers.is_none());
         assert!(row.checksum.is_empty() && !row.oversubscribed);
+        assert!(row.mean_ci_low_s.is_none() && row.speedup_ci_high.is_none());
         let trials = trial_rows(&c, &m, Some("checksum differs"));
         assert!(trials.iter().all(|t| t.status == Status::Failed));
         assert_eq!(trials[1].trial, 2);

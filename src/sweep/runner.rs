@@ -23,9 +23,10 @@ use sph_strategies::StrategyName;
 use super::console;
 use super::export::Exporter;
 use super::plan::{Cell, Group, Plan};
-use super::rows::{Measured, Status, SummaryRow, summary_row, trial_rows};
-use super::timing::Timing;
+use super::rows::{CellContext, Measured, Status, SummaryRow, summary_row, trial_rows};
+use super::timing::{Timing, Trial};
 use crate::checksum::checksum_hex;
+use crate::contention::Threshold;
 use crate::run::run_timed;
 use crate::scene::dam_break;
 use crate::solver::Simulation;
@@ -34,9 +35,10 @@ use crate::sph::state::{Domain, State};
 /// Set by Ctrl-C; checked before every run and every cell.
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 
-/// Whether Ctrl-C has been pressed.
+/// Whether the sweep must stop: Ctrl-C was pressed, or standard output was closed (the
+/// reader of `bench-sph sweep | head` went away), which ends the sweep the same way.
 pub fn interrupted() -> bool {
-    INTERRUPTED.load(Ordering::SeqCst)
+    INTERRUPTED.load(Ordering::SeqCst) || crate::output::console::closed()
 }
 
 /// Makes Ctrl-C stop the sweep between runs (a second Ctrl-C exits at once). Harmless to
@@ -144,25 +146,26 @@ pub fn measure_cell(
 /// What a group's other cells are measured against.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Reference {
-    /// The `seq` cell succeeded: its checksum and mean wall seconds.
+    /// The `seq` cell succeeded: its checksum and trial wall seconds.
     Ok {
         /// The checksum every run must reproduce.
         checksum: String,
-        /// The denominator of speedup, s.
-        mean_s: f64,
+        /// The wall seconds of its trials (their mean is the denominator of speedup).
+        walls: Vec<f64>,
     },
     /// The `seq` cell failed for this reason.
     Failed(String),
 }
 
 impl Reference {
-    /// The reference a finished `seq` summary row gives.
-    pub fn from_row(row: &SummaryRow) -> Reference {
+    /// The reference a finished `seq` cell gives: its summary row and its trial wall seconds.
+    pub fn from_row(row: &SummaryRow, walls: Vec<f64>) -> Reference {
         match (row.status, row.mean_s) {
-            (Status::Ok, Some(mean_s)) => Reference::Ok {
+            (Status::Ok, Some(_)) if !walls.is_empty() => Reference::Ok {
                 checksum: row.checksum.clone(),
-                mean_s,
+                walls,
             },
+            (Status::Ok, _) => Reference::Failed("its trials are missing".to_owned()),
             _ => Reference::Failed(row.reason.clone()),
         }
     }
@@ -198,10 +201,12 @@ impl GroupInput {
             self.state.clone(),
             g.neighbors,
         );
+        let load1 = crate::contention::load1();
         let elapsed = run_timed(&mut sim, cell.strategy, &cell.config(), steps)
             .map_err(|e| one_line(&format!("{:#}", anyhow::Error::new(e))))?;
         Ok(Measured {
             elapsed,
+            load1,
             checksum: checksum_hex(&sim.state),
         })
     }
@@ -212,13 +217,30 @@ fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
-/// Seconds one `seq` run of `group` takes, from a short timed run: one step, then doubling
-/// the steps until a run takes 50 ms or covers all steps. NaN when the run fails (the sweep
-/// will then report the failure properly).
+/// The most particles the estimate simulates, per neighbour search: it must take well under
+/// a second whatever N the sweep asks for.
+const CALIBRATION_N_ALL_PAIRS: usize = 4000;
+/// See [`CALIBRATION_N_ALL_PAIRS`].
+const CALIBRATION_N_GRID: usize = 200_000;
+
+/// Seconds one `seq` run of `group` takes, estimated from a short timed run of at most
+/// [`CALIBRATION_N_ALL_PAIRS`] (all-pairs) or [`CALIBRATION_N_GRID`] (grid) particles,
+/// scaled by (N / sample)² or N / sample: one step, then doubling the steps until a run
+/// takes 50 ms or covers all steps. NaN when the run fails (the sweep will then report the
+/// failure properly).
 pub fn calibrate(group: Group, seed: u64) -> f64 {
-    let input = GroupInput::new(group, seed);
+    let (cap, exponent) = match group.neighbors {
+        crate::sph::neighbors::NeighborMode::AllPairs => (CALIBRATION_N_ALL_PAIRS, 2),
+        crate::sph::neighbors::NeighborMode::Grid => (CALIBRATION_N_GRID, 1),
+    };
+    let sample = Group {
+        n: group.n.min(cap),
+        ..group
+    };
+    let scale = (group.n as f64 / sample.n as f64).powi(exponent);
+    let input = GroupInput::new(sample, seed);
     let seq = Cell {
-        group,
+        group: sample,
         strategy: StrategyName::Seq,
         cores: 1,
         chunks: None,
@@ -229,7 +251,7 @@ pub fn calibrate(group: Group, seed: u64) -> f64 {
             return f64::NAN;
         };
         if m.elapsed.wall_s >= 0.05 || steps >= group.steps {
-            return m.elapsed.wall_s / steps as f64 * group.steps as f64;
+            return m.elapsed.wall_s / steps as f64 * group.steps as f64 * scale;
         }
         steps = (steps * 2).min(group.steps);
     }
@@ -243,11 +265,15 @@ pub struct Runner<'a, T: Write, S: Write> {
     pub warmup: usize,
     /// Trials per cell.
     pub trials: usize,
-    /// Seed of the initial states.
+    /// Seed of the initial states and of the bootstrap.
     pub seed: u64,
-    /// The machine's hardware threads (for `oversubscribed`).
+    /// Bootstrap resamples per interval.
+    pub resamples: usize,
+    /// The machine's hardware threads (for `oversubscribed` and contention).
     pub hardware_threads: usize,
-    /// Where trial times come from.
+    /// When foreign CPU makes a trial contended.
+    pub threshold: Threshold,
+    /// Where trial numbers come from.
     pub timing: Timing,
     /// Test only: behave as if Ctrl-C was pressed after this many cells.
     pub stop_after_cells: Option<usize>,
@@ -287,12 +313,12 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
                 break;
             }
             let cell = self.plan.cells[index];
-            let (measured, failure, seq_mean) = if cell.is_reference() {
+            let (measured, failure, seq_walls) = if cell.is_reference() {
                 (None, None, None)
             } else {
                 match references.get(&cell.group) {
-                    Some(Reference::Ok { checksum, mean_s }) => {
-                        (Some(checksum.clone()), None, Some(*mean_s))
+                    Some(Reference::Ok { checksum, walls }) => {
+                        (Some(checksum.clone()), None, Some(walls.clone()))
                     }
                     Some(Reference::Failed(why)) => (
                         None,
@@ -325,24 +351,25 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
                 }
             };
 
-            let seq_mean = if cell.is_reference() {
-                (failure.is_none()).then(|| super::stats::mean(&walls(&measured)))
+            let seq_walls = if cell.is_reference() {
+                failure.is_none().then(|| walls(&measured))
             } else {
-                seq_mean
+                seq_walls
             };
-            let summary = summary_row(
-                &cell,
-                &measured,
-                failure.as_deref(),
-                seq_mean,
-                self.hardware_threads,
-            );
+            let ctx = CellContext {
+                seq_walls: seq_walls.as_deref(),
+                hardware_threads: self.hardware_threads,
+                threshold: self.threshold,
+                seed: self.seed,
+                resamples: self.resamples,
+            };
+            let summary = summary_row(&cell, &measured, failure.as_deref(), &ctx);
             let trials = trial_rows(&cell, &measured, failure.as_deref());
             self.exporter
                 .write_cell(&trials, &summary)
                 .context("cannot write the results")?;
             if cell.is_reference() {
-                references.insert(cell.group, Reference::from_row(&summary));
+                references.insert(cell.group, Reference::from_row(&summary, walls(&measured)));
             }
             let mut text = String::new();
             if self.plan.groups.len() > 1 && shown_group != Some(cell.group) {
@@ -355,7 +382,11 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
                 &cell,
                 &summary,
             ));
-            self.progress.suspend(|| println!("{text}"));
+            // A closed standard output ends the sweep like Ctrl-C (checked before the next
+            // cell); this cell is written already.
+            self.progress.suspend(|| {
+                let _ = crate::output::console::line(&text);
+            });
             outcome.rows.push(summary);
         }
         Ok(outcome)
@@ -375,7 +406,14 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
             self.progress.inc(run_ms);
             let mut m = result?;
             if let RunKind::Trial(k) = kind {
-                m.elapsed = self.timing.trial_time(m.elapsed, index, self.trials, k - 1);
+                let measured = Trial {
+                    elapsed: m.elapsed,
+                    load1: m.load1,
+                };
+                let t =
+                    self.timing
+                        .trial(measured, index, self.trials, k - 1, self.hardware_threads);
+                (m.elapsed, m.load1) = (t.elapsed, t.load1);
             }
             Ok(m)
         })
@@ -397,7 +435,9 @@ mod tests {
             elapsed: Elapsed {
                 wall_s: 1.0,
                 cpu_s: 1.0,
+                foreign: None,
             },
+            load1: None,
             checksum: checksum.to_owned(),
         })
     }

@@ -33,7 +33,7 @@ pub fn draw(path: &Path, title: &str, subtitle: &str, chart: &BestChart<'_>) -> 
     let c = strategy_color(chart.strategy);
     let mut legend = vec![
         LegendEntry::new(
-            format!("{} (best chunks;\nbars: trial spread)", chart.strategy),
+            format!("{} (best chunks;\nbars: 95 % CI)", chart.strategy),
             Mark::Line(c),
         ),
         LegendEntry::new(
@@ -61,23 +61,25 @@ fn plot(area: &Area<'_>, chart: &BestChart<'_>, c: RGBColor) -> DrawResult {
     let (labels, descs) = axis_styles();
     let grey = RGBColor(90, 90, 90);
 
-    let mut lines = vec![chart.speedup.clone()];
-    if chart.paper {
-        lines.push(Line {
+    // The axis spans the measured cores only; the paper's speedups are drawn where they
+    // inform, at those core counts.
+    let (x0, x1) = cores_range(std::slice::from_ref(&chart.speedup));
+    let measured = |cores: usize| chart.speedup.points.iter().any(|p| p.x == cores as f64);
+    let paper_points: Vec<(f64, f64)> = paper::TABLE
+        .iter()
+        .filter(|r| chart.paper && measured(r.cores))
+        .map(|r| (r.cores as f64, r.speedup))
+        .collect();
+    let lines = vec![
+        chart.speedup.clone(),
+        Line {
             label: String::new(),
-            points: paper::TABLE
+            points: paper_points
                 .iter()
-                .map(|r| crate::report::series::Point {
-                    x: r.cores as f64,
-                    y: r.speedup,
-                    lo: r.speedup,
-                    hi: r.speedup,
-                    oversubscribed: false,
-                })
+                .map(|&(x, y)| crate::report::series::Point::exact(x, y))
                 .collect(),
-        });
-    }
-    let (x0, x1) = cores_range(&lines);
+        },
+    ];
     let (x0, x1) = (x0.min(0.6), x1);
 
     // Runtime.
@@ -122,17 +124,14 @@ fn plot(area: &Area<'_>, chart: &BestChart<'_>, c: RGBColor) -> DrawResult {
         .axis_desc_style(descs)
         .draw()?;
     draw_dashed(&mut ch, vec![(1.0, 1.0), (x1 - 0.4, x1 - 0.4)], grey)?;
-    if chart.paper {
-        let pts: Vec<(f64, f64)> = paper::TABLE
-            .iter()
-            .map(|r| (r.cores as f64, r.speedup))
-            .collect();
+    if !paper_points.is_empty() {
         ch.draw_series(LineSeries::new(
-            pts.clone(),
+            paper_points.clone(),
             RGBColor(170, 170, 170).stroke_width(1),
         ))?;
         ch.draw_series(
-            pts.into_iter()
+            paper_points
+                .into_iter()
                 .map(|p| TriangleMarker::new(p, 7, RGBColor(110, 110, 110).filled())),
         )?;
     }

@@ -31,6 +31,10 @@ pub fn draw(
             "lowest point of a line",
             Mark::Cross(BLACK),
         ));
+        legend.push(LegendEntry::new(
+            "bars: 95 % confidence\ninterval of the mean",
+            Mark::Line(BLACK),
+        ));
     }
     legend.extend(oversubscribed_entry(lines));
     super::render(path, title, subtitle, &legend, |area| {
@@ -63,16 +67,15 @@ fn plot(area: &Area<'_>, y_desc: &str, lines: &[Line], mark_min: bool) -> DrawRe
         .draw()?;
     for (i, line) in lines.iter().enumerate() {
         let c = color(i);
-        draw_line(&mut chart, line, c, false)?;
-        if mark_min {
-            if let Some(m) = line.min_index() {
-                let p = line.points[m];
-                chart.draw_series(std::iter::once(Cross::new(
-                    (p.x, p.y),
-                    9,
-                    c.stroke_width(3),
-                )))?;
-            }
+        // Chart 1 (runtime) shows each point's 95 % interval of the mean.
+        draw_line(&mut chart, line, c, mark_min)?;
+        if mark_min && let Some(m) = line.min_index() {
+            let p = line.points[m];
+            chart.draw_series(std::iter::once(Cross::new(
+                (p.x, p.y),
+                9,
+                c.stroke_width(3),
+            )))?;
         }
     }
     Ok(())

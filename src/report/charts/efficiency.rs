@@ -1,5 +1,6 @@
 //! Chart 5: parallel efficiency `S / p` (above) and the Karp–Flatt serial fraction
-//! `e = (1/S − 1/p) / (1 − 1/p)` (below, from 2 cores) against cores, one line per strategy.
+//! `e = (1/S − 1/p) / (1 − 1/p)` (below, from 2 cores and only where S > 1) against cores, one
+//! line per strategy; the serial-fraction axis is clipped to [−0.5, 1] and says when it clips.
 
 use std::path::Path;
 
@@ -59,6 +60,14 @@ fn plot(area: &Area<'_>, efficiency: &[Line], serial: &[Line]) -> DrawResult {
         draw_line(&mut ch, line, strategy_color(&line.label), false)?;
     }
 
+    // The axis is clipped to [SERIAL_MIN, 1] so one pathological strategy cannot stretch
+    // it; a clipped point is drawn on the edge and the panel says so.
+    let clipped: Vec<Line> = serial.iter().map(clip).collect();
+    let any_clipped = clipped
+        .iter()
+        .zip(serial)
+        .any(|(c, l)| c.points.iter().zip(&l.points).any(|(a, b)| a.y != b.y));
+    let serial = &clipped[..];
     let ys = serial.iter().flat_map(|l| l.points.iter().map(|p| p.y));
     let lo = ys.clone().fold(0f64, f64::min);
     let hi = ys.fold(0.1f64, f64::max);
@@ -81,5 +90,27 @@ fn plot(area: &Area<'_>, efficiency: &[Line], serial: &[Line]) -> DrawResult {
     for line in serial {
         draw_line(&mut ch, line, strategy_color(&line.label), false)?;
     }
+    if any_clipped {
+        let style = TextStyle::from((crate::plot::font::FAMILY, 14).into_font())
+            .color(&RGBColor(180, 0, 0));
+        ch.draw_series(std::iter::once(Text::new(
+            format!("values beyond [{SERIAL_MIN}, 1] clipped to the edge"),
+            (x0 + 0.1, hi + pad * 0.5),
+            style,
+        )))?;
+    }
     Ok(())
+}
+
+/// The lowest serial fraction the panel shows (a superlinear speedup gives e < 0).
+const SERIAL_MIN: f64 = -0.5;
+
+/// `line` with every value clipped to `[SERIAL_MIN, 1]`.
+fn clip(line: &Line) -> Line {
+    let mut out = line.clone();
+    for p in &mut out.points {
+        p.y = p.y.clamp(SERIAL_MIN, 1.0);
+        (p.lo, p.hi) = (p.y, p.y);
+    }
+    out
 }

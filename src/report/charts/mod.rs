@@ -76,6 +76,8 @@ pub enum Mark {
     Dashed(RGBColor),
     /// A hollow dot (oversubscribed).
     Hollow(RGBColor),
+    /// A red ring (contended: other work used the machine).
+    Ring,
     /// A large cross (a line's minimum).
     Cross(RGBColor),
     /// A triangle (a reference series).
@@ -101,14 +103,26 @@ impl LegendEntry {
     }
 }
 
-/// The standard "hollow = oversubscribed" entry, when any line has such a point.
-pub fn oversubscribed_entry(lines: &[Line]) -> Option<LegendEntry> {
-    lines.iter().any(Line::any_oversubscribed).then(|| {
-        LegendEntry::new(
+/// The colour of the ring around a contended point.
+pub const CONTENDED: RGBColor = RGBColor(220, 0, 0);
+
+/// The standard "hollow = oversubscribed" and "ring = contended" entries, when any line has
+/// such a point.
+pub fn oversubscribed_entry(lines: &[Line]) -> Vec<LegendEntry> {
+    let mut out = Vec::new();
+    if lines.iter().any(Line::any_oversubscribed) {
+        out.push(LegendEntry::new(
             "oversubscribed: more threads\nthan hardware threads",
             Mark::Hollow(BLACK),
-        )
-    })
+        ));
+    }
+    if lines.iter().any(|l| l.points.iter().any(|p| p.contended)) {
+        out.push(LegendEntry::new(
+            "contended: other work used\nthe machine (untrustworthy)",
+            Mark::Ring,
+        ));
+    }
+    out
 }
 
 /// Draws a chart into `path`: `draw` gets the plot area (below the title, left of the legend).
@@ -124,9 +138,8 @@ pub fn render(
     compose(&mut pixels, title, subtitle, legend, draw)
         .map_err(|e| anyhow::anyhow!("{e}"))
         .with_context(|| format!("cannot draw '{}'", path.display()))?;
-    let file = std::fs::File::create(path)
-        .with_context(|| format!("cannot write '{}'", path.display()))?;
-    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), WIDTH, HEIGHT);
+    let mut file = crate::output::atomic::AtomicFile::create(path)?;
+    let mut encoder = png::Encoder::new(&mut file, WIDTH, HEIGHT);
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
     let mut writer = encoder
@@ -138,7 +151,7 @@ pub fn render(
     writer
         .finish()
         .with_context(|| format!("cannot write '{}'", path.display()))?;
-    Ok(())
+    file.commit()
 }
 
 fn compose(
@@ -194,6 +207,7 @@ fn draw_legend(area: &Area<'_>, entries: &[LegendEntry]) -> DrawResult {
                 }
             }
             Mark::Hollow(c) => area.draw(&Circle::new((cx, y), 5, c.stroke_width(2)))?,
+            Mark::Ring => area.draw(&Circle::new((cx, y), 9, CONTENDED.stroke_width(2)))?,
             Mark::Cross(c) => area.draw(&Cross::new((cx, y), 7, c.stroke_width(3)))?,
             Mark::Triangle(c) => area.draw(&TriangleMarker::new((cx, y), 7, c.filled()))?,
         }
@@ -375,16 +389,21 @@ where
     Ok(())
 }
 
-/// A point's marker: a filled dot, or a hollow ring (white inside) when oversubscribed.
+/// A point's marker: a filled dot, or a hollow ring (white inside) when oversubscribed; a
+/// red ring around it when contended.
 pub fn dots(p: &Point, c: RGBColor) -> Vec<Circle<(f64, f64), i32>> {
-    if p.oversubscribed {
+    let mut out = if p.oversubscribed {
         vec![
             Circle::new((p.x, p.y), 6, WHITE.filled()),
             Circle::new((p.x, p.y), 6, c.stroke_width(2)),
         ]
     } else {
         vec![Circle::new((p.x, p.y), 4, c.filled())]
+    };
+    if p.contended {
+        out.push(Circle::new((p.x, p.y), 9, CONTENDED.stroke_width(2)));
     }
+    out
 }
 
 /// Axis text styles shared by every chart: (tick labels, axis descriptions).

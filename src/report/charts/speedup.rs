@@ -1,4 +1,4 @@
-//! Chart 4: every strategy's best speedup against cores, error bars from the trial spread of
+//! Chart 4: every strategy's best speedup against cores, error bars the 95 % bootstrap interval of
 //! the best cell (`T_seq / slowest` to `T_seq / fastest`), with the ideal `S = p`.
 
 use std::path::Path;
@@ -22,7 +22,7 @@ pub fn draw(path: &Path, title: &str, subtitle: &str, lines: &[Line]) -> anyhow:
         Mark::Dashed(RGBColor(90, 90, 90)),
     ));
     legend.push(LegendEntry::new(
-        "bars: fastest to slowest\ntrial of the best cell",
+        "bars: 95 % confidence\ninterval of the speedup",
         Mark::Line(BLACK),
     ));
     legend.extend(oversubscribed_entry(lines));

@@ -1,0 +1,87 @@
+//! How REPORT.md writes numbers: never more than three significant digits (a mean of five
+//! noisy trials does not know its fourth digit), intervals as `[low–high]`.
+
+use crate::sweep::bootstrap::Interval;
+
+/// `v` to three significant digits, without exponent: `0.412`, `2.20`, `39.7`, `1230`.
+pub fn sig(v: f64) -> String {
+    if !v.is_finite() {
+        return v.to_string();
+    }
+    if v == 0.0 {
+        return "0".to_owned();
+    }
+    let magnitude = v.abs().log10().floor() as i32;
+    if magnitude >= 2 {
+        // Whole numbers: round away the digits beyond the third.
+        let unit = 10f64.powi(magnitude - 2);
+        return format!("{:.0}", (v / unit).round() * unit);
+    }
+    let places = (2 - magnitude) as usize;
+    let text = format!("{v:.places$}");
+    // Rounding can add a digit (9.996 → "10.00"): write it again at the new magnitude.
+    let rounded: f64 = text.parse().unwrap_or(v);
+    if rounded.abs().log10().floor() as i32 > magnitude {
+        return sig(rounded);
+    }
+    text
+}
+
+/// Seconds: [`sig`].
+pub fn secs(v: f64) -> String {
+    sig(v)
+}
+
+/// `mean ± stddev`, the stddev to as many decimals as the mean shows (`mean` alone without a
+/// stddev).
+pub fn mean_sd(mean: f64, sd: Option<f64>) -> String {
+    let m = sig(mean);
+    match sd {
+        Some(sd) => {
+            let places = m.split_once('.').map_or(0, |(_, d)| d.len());
+            format!("{m} ± {sd:.places$}")
+        }
+        None => m,
+    }
+}
+
+/// A speedup: `1.84×`.
+pub fn times(v: f64) -> String {
+    format!("{}×", sig(v))
+}
+
+/// A percentage: `8.3 %`.
+pub fn percent(v: f64) -> String {
+    format!("{} %", sig(v))
+}
+
+/// ` [low–high]`, or nothing without an interval.
+pub fn interval(i: Option<Interval>) -> String {
+    i.map_or_else(String::new, |i| {
+        format!(" [{}–{}]", sig(i.low), sig(i.high))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_have_at_most_three_significant_digits() {
+        assert_eq!(sig(39.74), "39.7");
+        assert_eq!(sig(0.54433), "0.544");
+        assert_eq!(sig(2.0), "2.00");
+        assert_eq!(sig(1234.5), "1230");
+        assert_eq!(sig(9.996), "10.0");
+        assert_eq!(sig(0.0), "0");
+        assert_eq!(sig(-0.0123456), "-0.0123");
+        assert_eq!(times(1.8365), "1.84×");
+        assert_eq!(mean_sd(1.0886, Some(0.0218)), "1.09 ± 0.02");
+        assert_eq!(percent(8.333), "8.33 %");
+        let i = Interval {
+            low: 0.40123,
+            high: 0.4234,
+        };
+        assert_eq!(interval(Some(i)), " [0.401–0.423]");
+    }
+}

@@ -1,0 +1,131 @@
+//! The results directory of a sweep: choosing it, locking it, and what may already be in it.
+//!
+//! A new sweep's directory must be new or empty, or hold only a sweep's own earlier output
+//! (`trials.csv`, `summary.csv`, its `meta.json`, `sweep.lock`, and the report the sweep drew:
+//! `REPORT.md` and chart PNGs); that earlier output is replaced only with `--force`, and then
+//! all of it, so no REPORT.md or chart of the old data stays beside the new. Trace directories
+//! inside are left alone. Anything else is refused (see [`crate::output::claim`]).
+//!
+//! Before looking inside, the sweep takes the directory's lock ([`super::lock`]), so of two
+//! sweeps started on the same directory at the same moment, the loser is always refused with
+//! a message about that directory.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+
+use super::lock::{self, DirLock, LOCK_FILE};
+use super::meta::Meta;
+use super::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
+use crate::output::claim::{self, Owner};
+
+/// The default results directory: `results/<UTC timestamp>`, or with `-2`, `-3`, … when a
+/// sweep started in the same second took that name. Created here, exclusively.
+pub fn new_default() -> anyhow::Result<PathBuf> {
+    let parent = Path::new("results");
+    std::fs::create_dir_all(parent)
+        .with_context(|| format!("cannot create directory '{}'", parent.display()))?;
+    let stamp = super::meta::timestamp_dir_name();
+    for k in 1..1000 {
+        let name = if k == 1 {
+            stamp.clone()
+        } else {
+            format!("{stamp}-{k}")
+        };
+        let dir = parent.join(name);
+        match std::fs::create_dir(&dir) {
+            Ok(()) => return Ok(dir),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => {
+                return Err(e)
+                    .with_context(|| format!("cannot create directory '{}'", dir.display()));
+            }
+        }
+    }
+    bail!(
+        "cannot choose a results directory: results/{stamp} to results/{stamp}-999 all exist; \
+         pass --out DIR"
+    )
+}
+
+/// Locks `dir` for a new sweep and makes it ready: refuses foreign files (unless `force`)
+/// and a sweep's earlier output (unless `force`, which removes it). Returns the held lock.
+pub fn open_new(dir: &Path, force: bool) -> anyhow::Result<DirLock> {
+    if dir.exists() && !dir.is_dir() {
+        bail!("--out '{}' exists and is not a directory", dir.display());
+    }
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create results directory '{}'", dir.display()))?;
+    let held = lock::acquire(dir)?;
+    let owner = Owner {
+        command: "bench-sph sweep",
+        option: "--out",
+        owns: &owned,
+        tolerates: &is_trace_dir,
+    };
+    let claimed = claim::claim(dir, &owner, force)?;
+    for name in [
+        TRIALS_FILE,
+        SUMMARY_FILE,
+        META_FILE,
+        crate::report::REPORT_FILE,
+    ] {
+        claimed.check_writable(name)?;
+    }
+    let earlier: Vec<&PathBuf> = claimed
+        .earlier()
+        .iter()
+        .filter(|p| !p.ends_with(LOCK_FILE))
+        .collect();
+    if !earlier.is_empty() {
+        if !force {
+            bail!(
+                "results directory '{}' already holds a sweep's results; continue that sweep \
+                 with `--resume {}`, or replace them (and their report) with `--force`",
+                dir.display(),
+                dir.display()
+            );
+        }
+        for path in earlier {
+            std::fs::remove_file(path)
+                .with_context(|| format!("cannot replace '{}'", path.display()))?;
+        }
+    }
+    Ok(held)
+}
+
+/// Locks an existing sweep's directory for `--resume`.
+pub fn open_existing(dir: &Path) -> anyhow::Result<DirLock> {
+    let meta = dir.join(META_FILE);
+    if !dir.is_dir() {
+        bail!("cannot resume '{}': no such directory", dir.display());
+    }
+    if !Meta::is_sweep_meta(&meta) {
+        bail!(
+            "cannot resume '{}': it has no sweep's {META_FILE}, so it is not a sweep's results \
+             directory",
+            dir.display()
+        );
+    }
+    lock::acquire(dir)
+}
+
+/// Whether a top-level entry of a results directory is a sweep's own output.
+fn owned(path: &Path) -> bool {
+    let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
+        return false;
+    };
+    if !path.is_file() {
+        return false;
+    }
+    match name {
+        TRIALS_FILE | SUMMARY_FILE | LOCK_FILE => true,
+        META_FILE => Meta::is_sweep_meta(path),
+        _ => crate::report::is_own_file(name),
+    }
+}
+
+/// Trace directories may sit inside a results directory (the report embeds them).
+fn is_trace_dir(path: &Path) -> bool {
+    path.is_dir() && path.join("timeline.png").is_file() && path.join("stats.csv").is_file()
+}

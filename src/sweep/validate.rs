@@ -1,0 +1,256 @@
+//! Whether a cell read back from a results directory can be believed: every number finite and
+//! in range, and the summary row's statistics those of its trial rows.
+//!
+//! `sweep --resume` runs a kept cell through [`cell`] and runs it again when it fails;
+//! `bench-sph report` drops such a cell with a listed warning. A hand-edited or corrupted row
+//! must never become a number in a chart.
+
+use super::rows::{Status, SummaryRow, TrialRow};
+use super::stats::{Stats, mean};
+use crate::limits;
+
+/// Relative tolerance between a summary statistic and the same statistic recomputed from the
+/// trial rows (the CSV holds shortest round-trip floats, so they agree exactly; the slack is
+/// for files written by other tools).
+const TOLERANCE: f64 = 1e-9;
+
+/// Why the cell cannot be believed, or `Ok`.
+pub fn cell(summary: &SummaryRow, trials: &[TrialRow]) -> Result<(), String> {
+    summary_alone(summary)?;
+    if trials.len() != summary.trials {
+        return Err(format!(
+            "the summary counts {} trials but trials.csv holds {}",
+            summary.trials,
+            trials.len()
+        ));
+    }
+    for t in trials {
+        if !(t.wall_s.is_finite() && t.wall_s > 0.0) {
+            return Err(format!(
+                "trial {}: wall_s = {} is not a positive time",
+                t.trial, t.wall_s
+            ));
+        }
+        if !(t.cpu_s.is_finite() && t.cpu_s >= 0.0) {
+            return Err(format!(
+                "trial {}: cpu_s = {} is not a time",
+                t.trial, t.cpu_s
+            ));
+        }
+        for (name, value) in [
+            ("foreign_cpu_s", t.foreign_cpu_s),
+            ("steal_s", t.steal_s),
+            ("load1", t.load1),
+        ] {
+            if let Some(v) = value
+                && !(v.is_finite() && v >= 0.0)
+            {
+                return Err(format!(
+                    "trial {}: {name} = {v} is not a non-negative number",
+                    t.trial
+                ));
+            }
+        }
+        if summary.status == Status::Ok && t.checksum != summary.checksum {
+            return Err(format!(
+                "trial {}: checksum {} differs from the cell's {}",
+                t.trial, t.checksum, summary.checksum
+            ));
+        }
+    }
+    if summary.status == Status::Failed {
+        return Ok(());
+    }
+    let walls: Vec<f64> = trials.iter().map(|t| t.wall_s).collect();
+    let cpus: Vec<f64> = trials.iter().map(|t| t.cpu_s).collect();
+    let Some(stats) = Stats::of(&walls) else {
+        return Err("an ok cell without trials".to_owned());
+    };
+    let expected = [
+        ("mean_s", summary.mean_s, Some(stats.mean)),
+        ("min_s", summary.min_s, Some(stats.min)),
+        ("median_s", summary.median_s, Some(stats.median)),
+        ("max_s", summary.max_s, Some(stats.max)),
+        ("stddev_s", summary.stddev_s, stats.stddev),
+        ("cpu_mean_s", summary.cpu_mean_s, Some(mean(&cpus))),
+    ];
+    for (name, found, want) in expected {
+        if !agrees(found, want) {
+            return Err(format!(
+                "{name} = {} disagrees with its trial rows ({})",
+                show(found),
+                show(want)
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The checks that need no trial rows: ranges, finite positive statistics, a consistent
+/// efficiency and interval.
+pub fn summary_alone(row: &SummaryRow) -> Result<(), String> {
+    limits::check("cores", row.cores, 1, limits::MAX_CORES).map_err(|e| e.to_string())?;
+    limits::check("n", row.n, 1, limits::MAX_PARTICLES).map_err(|e| e.to_string())?;
+    limits::check("steps", row.steps, 1, limits::MAX_STEPS).map_err(|e| e.to_string())?;
+    limits::check("trials", row.trials, 1, limits::MAX_TRIALS).map_err(|e| e.to_string())?;
+    if let Some(k) = row.chunks {
+        limits::check("chunks", k, 1, limits::MAX_CHUNKS).map_err(|e| e.to_string())?;
+    }
+    if row.status == Status::Failed {
+        return Ok(());
+    }
+    let positive = [
+        ("mean_s", row.mean_s),
+        ("min_s", row.min_s),
+        ("median_s", row.median_s),
+        ("max_s", row.max_s),
+        ("speedup", row.speedup),
+        ("efficiency", row.efficiency),
+        ("mean_ci_low_s", row.mean_ci_low_s),
+        ("mean_ci_high_s", row.mean_ci_high_s),
+        ("speedup_ci_low", row.speedup_ci_low),
+        ("speedup_ci_high", row.speedup_ci_high),
+    ];
+    for (name, value) in positive {
+        if let Some(v) = value
+            && !(v.is_finite() && v > 0.0)
+        {
+            return Err(format!("{name} = {v} is not a finite positive number"));
+        }
+    }
+    let non_negative = [
+        ("stddev_s", row.stddev_s),
+        ("cpu_mean_s", row.cpu_mean_s),
+        ("foreign_cpu_mean_s", row.foreign_cpu_mean_s),
+    ];
+    for (name, value) in non_negative {
+        if let Some(v) = value
+            && !(v.is_finite() && v >= 0.0)
+        {
+            return Err(format!("{name} = {v} is not a finite non-negative number"));
+        }
+    }
+    let (Some(min), Some(mean), Some(max)) = (row.min_s, row.mean_s, row.max_s) else {
+        return Err("an ok cell without mean_s, min_s and max_s".to_owned());
+    };
+    if !(min <= mean && mean <= max) {
+        return Err(format!(
+            "mean_s = {mean} lies outside min_s..max_s = {min}..{max}"
+        ));
+    }
+    if let (Some(s), Some(e)) = (row.speedup, row.efficiency)
+        && !close(e, s / row.cores as f64)
+    {
+        return Err(format!("efficiency = {e} is not speedup / cores"));
+    }
+    if let (Some(low), Some(high)) = (row.mean_ci_low_s, row.mean_ci_high_s)
+        && low > high
+    {
+        return Err(format!("the interval {low}..{high} of mean_s is reversed"));
+    }
+    if let (Some(low), Some(high)) = (row.speedup_ci_low, row.speedup_ci_high)
+        && low > high
+    {
+        return Err(format!("the interval {low}..{high} of speedup is reversed"));
+    }
+    Ok(())
+}
+
+fn agrees(found: Option<f64>, want: Option<f64>) -> bool {
+    match (found, want) {
+        (None, None) => true,
+        (Some(a), Some(b)) => close(a, b),
+        _ => false,
+    }
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= TOLERANCE * a.abs().max(b.abs())
+}
+
+fn show(v: Option<f64>) -> String {
+    v.map_or_else(|| "empty".to_owned(), |v| v.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::clock::Elapsed;
+    use crate::sph::neighbors::NeighborMode;
+    use crate::sph::params::Preset;
+    use crate::sweep::plan::{Cell, Group};
+    use crate::sweep::rows::{Measured, summary_row, test_context, trial_rows};
+    use sph_strategies::StrategyName;
+
+    fn rows() -> (SummaryRow, Vec<TrialRow>) {
+        let cell = Cell {
+            group: Group {
+                preset: Preset::Seed,
+                neighbors: NeighborMode::AllPairs,
+                n: 60,
+                steps: 3,
+            },
+            strategy: StrategyName::RayonChunks,
+            cores: 2,
+            chunks: Some(4),
+        };
+        let measured: Vec<Measured> = [0.5, 0.6, 0.7]
+            .iter()
+            .map(|&w| Measured {
+                elapsed: Elapsed {
+                    wall_s: w,
+                    cpu_s: 2.0 * w,
+                    foreign: None,
+                },
+                load1: None,
+                checksum: "00000000000000ff".to_owned(),
+            })
+            .collect();
+        let seq = [1.0, 1.1, 1.2];
+        let ctx = test_context(Some(&seq), 2);
+        (
+            summary_row(&cell, &measured, None, &ctx),
+            trial_rows(&cell, &measured, None),
+        )
+    }
+
+    #[test]
+    fn a_cell_as_the_sweep_writes_it_passes() {
+        let (s, t) = rows();
+        assert_eq!(cell(&s, &t), Ok(()));
+    }
+
+    #[test]
+    fn a_nan_or_negative_trial_time_is_refused() {
+        let (s, mut t) = rows();
+        t[1].wall_s = f64::NAN;
+        assert!(cell(&s, &t).unwrap_err().contains("wall_s = NaN"));
+        let (s, mut t) = rows();
+        t[0].cpu_s = -5.0;
+        assert!(cell(&s, &t).unwrap_err().contains("cpu_s = -5"));
+    }
+
+    #[test]
+    fn a_summary_that_disagrees_with_its_trials_is_refused() {
+        let (mut s, t) = rows();
+        s.mean_s = Some(0.4);
+        assert!(cell(&s, &t).unwrap_err().contains("mean_s = 0.4"));
+        let (s, t) = rows();
+        assert!(cell(&s, &t[..2]).unwrap_err().contains("counts 3 trials"));
+    }
+
+    #[test]
+    fn impossible_summary_numbers_are_refused_without_trials() {
+        for edit in [
+            (|s: &mut SummaryRow| s.mean_s = Some(-0.5)) as fn(&mut SummaryRow),
+            |s| s.speedup = Some(f64::INFINITY),
+            |s| s.cores = 1_000_000_000,
+            |s| s.min_s = Some(0.0),
+            |s| s.efficiency = Some(0.9),
+        ] {
+            let (mut s, _) = rows();
+            edit(&mut s);
+            assert!(summary_alone(&s).is_err(), "{s:?}");
+        }
+    }
+}

@@ -1,0 +1,215 @@
+//! `bench-sph report` given hostile input: impossible rows, the same cells twice, a foreign
+//! output directory, stale charts and a partial study. Every case ends in a clear message;
+//! nothing impossible becomes a number.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// A small finished sweep under fake times: seq, rayon-chunks and rayon-iter at 1 and 2 cores.
+fn sweep(dir: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "sweep",
+        "--n",
+        "60",
+        "--steps",
+        "3",
+        "--trials",
+        "3",
+        "--warmup",
+        "0",
+        "--cores",
+        "1..2",
+        "--chunks",
+        "4",
+        "--strategies",
+        "seq,rayon-chunks,rayon-iter",
+        "--fake-timings",
+        "1.0,1.1,0.9,0.5,0.55,0.6,0.7,0.8,0.75",
+        "--no-plots",
+        "--out",
+        dir.to_str().unwrap(),
+    ];
+    args.extend(extra);
+    run(&args)
+}
+
+fn finished(dir: &Path) {
+    let o = sweep(dir, &[]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+}
+
+/// Replaces field `column` of the summary row of `strategy` at `cores` with `value`.
+fn edit_summary(dir: &Path, strategy: &str, cores: &str, column: &str, value: &str) {
+    let path = dir.join("summary.csv");
+    let body = std::fs::read_to_string(&path).unwrap();
+    let mut lines: Vec<String> = body.lines().map(str::to_owned).collect();
+    let header: Vec<&str> = lines[0].split(',').collect();
+    let at = header.iter().position(|h| *h == column).unwrap();
+    let line = lines
+        .iter_mut()
+        .find(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            f[0] == strategy && f[5] == cores
+        })
+        .unwrap();
+    let mut fields: Vec<String> = line.split(',').map(str::to_owned).collect();
+    fields[at] = value.to_owned();
+    *line = fields.join(",");
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+}
+
+#[test]
+fn impossible_rows_are_left_out_with_a_listed_warning() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (case, (column, value, reason)) in [
+        ("mean_s", "NaN", "mean_s = NaN"),
+        ("mean_s", "-0.5", "mean_s = -0.5"),
+        ("min_s", "0", "min_s = 0"),
+        ("speedup", "inf", "speedup = inf"),
+        ("mean_s", "0.7501", "disagrees with its trial rows"),
+        ("cores", "1000000000", "cores must be between 1 and 1024"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let dir = tmp.path().join(format!("case{case}"));
+        finished(&dir);
+        edit_summary(&dir, "rayon-iter", "2", column, value);
+        let o = run(&["report", dir.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", text(&o.stderr));
+        let err = text(&o.stderr);
+        assert!(
+            err.contains("cell left out of the report") && err.contains(reason),
+            "{column}={value}: {err}"
+        );
+        let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
+        assert!(md.contains("1 cell left out"), "{md}");
+        let tables: Vec<&str> = md.lines().filter(|l| l.starts_with('|')).collect();
+        assert!(
+            !tables
+                .iter()
+                .any(|l| l.contains("-0.5") || l.contains("NaN")),
+            "{md}"
+        );
+    }
+}
+
+#[test]
+fn the_same_directory_twice_or_the_same_cells_in_two_directories_are_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let a = tmp.path().join("a");
+    finished(&a);
+    let o = run(&["report", a.to_str().unwrap(), a.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o.stderr).contains("is given twice"),
+        "{}",
+        text(&o.stderr)
+    );
+
+    let b = tmp.path().join("b");
+    finished(&b);
+    let out = tmp.path().join("out");
+    let o = run(&[
+        "report",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let err = text(&o.stderr);
+    assert!(
+        err.starts_with("Error: the cell") && err.contains("is in both"),
+        "{err}"
+    );
+    assert!(!out.join("REPORT.md").exists());
+}
+
+#[test]
+fn an_out_directory_with_foreign_files_is_refused_unless_force_which_keeps_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    finished(&dir);
+    let out = tmp.path().join("out");
+    std::fs::create_dir(&out).unwrap();
+    std::fs::write(out.join("dambreak.gif"), "mine").unwrap();
+    let o = run(&[
+        "report",
+        dir.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("'dambreak.gif'") && err.contains("--force"),
+        "{err}"
+    );
+    assert!(!out.join("REPORT.md").exists());
+
+    let o = run(&[
+        "report",
+        dir.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--force",
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(out.join("REPORT.md").is_file());
+    assert_eq!(
+        std::fs::read_to_string(out.join("dambreak.gif")).unwrap(),
+        "mine"
+    );
+}
+
+#[test]
+fn charts_of_an_earlier_report_that_are_not_drawn_again_are_removed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    finished(&dir);
+    let stale = dir.join("seed-all-pairs-n999-s3-4-speedup.png");
+    std::fs::write(&stale, "old chart").unwrap();
+    let o = run(&["report", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(!stale.exists(), "the stale chart stayed");
+    assert!(dir.join("seed-all-pairs-n60-s3-4-speedup.png").is_file());
+    // No temporary file is left behind.
+    for e in std::fs::read_dir(&dir).unwrap() {
+        let name = e.unwrap().file_name().to_string_lossy().into_owned();
+        assert!(!name.ends_with(".tmp"), "{name}");
+    }
+}
+
+#[test]
+fn a_partial_study_says_so_at_the_top_naming_the_strategies_never_measured() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    let o = sweep(&dir, &["--stop-after-cells", "3"]);
+    assert!(!o.status.success());
+    let o = run(&["report", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
+    let banner = md
+        .lines()
+        .find(|l| l.contains("Partial study"))
+        .unwrap_or_else(|| panic!("no banner:\n{md}"));
+    assert!(
+        banner.contains("3 of 5 planned cells measured")
+            && banner.contains("never measured: rayon-chunks"),
+        "{banner}"
+    );
+    let first_section = md.find("## ").unwrap();
+    assert!(md.find("Partial study").unwrap() < first_section);
+}

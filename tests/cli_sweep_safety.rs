@@ -1,0 +1,511 @@
+//! `bench-sph sweep` under a busy machine, concurrent use, a closed standard output and an
+//! edited results directory: contention is recorded, nothing is lost, nothing panics or hangs.
+//! No test asserts a duration.
+
+use std::collections::HashMap;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+type Row = HashMap<String, String>;
+
+/// A tiny sweep of seq and rayon-chunks under fake times.
+const TINY: &[&str] = &[
+    "sweep",
+    "--n",
+    "60",
+    "--steps",
+    "3",
+    "--trials",
+    "3",
+    "--warmup",
+    "0",
+    "--cores",
+    "1..2",
+    "--chunks",
+    "4",
+    "--strategies",
+    "seq,rayon-chunks",
+    "--fake-timings",
+    "1.0,1.1,0.9,0.5,0.55,0.6",
+];
+
+fn bench_sph() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+}
+
+fn run(args: &[&str]) -> Output {
+    bench_sph().args(args).output().expect("binary runs")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+fn tiny(dir: &Path, extra: &[&str]) -> Output {
+    let mut args = TINY.to_vec();
+    args.extend(["--out", dir.to_str().unwrap()]);
+    args.extend(extra);
+    run(&args)
+}
+
+fn rows(path: &Path) -> Vec<Row> {
+    let mut r = csv::Reader::from_path(path).unwrap();
+    let header = r.headers().unwrap().clone();
+    r.records()
+        .map(|rec| {
+            let rec = rec.unwrap();
+            header
+                .iter()
+                .zip(rec.iter())
+                .map(|(k, v)| (k.to_owned(), v.to_owned()))
+                .collect()
+        })
+        .collect()
+}
+
+fn no_panic(o: &Output) {
+    let err = text(&o.stderr);
+    assert!(!err.contains("panicked"), "panicked:\n{err}");
+}
+
+#[test]
+fn fake_contention_marks_cells_contended_and_warns_in_the_output_and_the_report() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    let o = tiny(&dir, &["--fake-contention", "0.5"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert!(err.contains("cores busy with other work"), "{err}");
+    assert!(err.contains("saw other work on the machine"), "{err}");
+    let summary = rows(&dir.join("summary.csv"));
+    assert!(
+        summary.iter().all(|r| r["contended"] == "true"),
+        "{summary:?}"
+    );
+    let trials = rows(&dir.join("trials.csv"));
+    assert!(
+        trials
+            .iter()
+            .all(|r| r["foreign_cpu_s"].parse::<f64>().unwrap() > 0.0)
+    );
+    let report = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
+    assert!(report.contains("contended"), "{report}");
+}
+
+#[test]
+fn a_quiet_fake_machine_gives_no_contended_cell_and_intervals_around_the_mean() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    let o = tiny(&dir, &["--no-plots"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(!text(&o.stderr).contains("busy with other work"));
+    for r in rows(&dir.join("summary.csv")) {
+        assert_eq!(r["contended"], "false", "{r:?}");
+        let num = |k: &str| r[k].parse::<f64>().unwrap();
+        assert!(num("mean_ci_low_s") <= num("mean_s") && num("mean_s") <= num("mean_ci_high_s"));
+        if r["strategy"] != "seq" {
+            assert!(num("speedup_ci_low") <= num("speedup"));
+            assert!(num("speedup") <= num("speedup_ci_high"));
+        }
+    }
+}
+
+/// Busy loops in other processes, one per hardware thread, killed on drop.
+struct Busy(Vec<Child>);
+
+impl Busy {
+    fn start() -> Busy {
+        let hw = std::thread::available_parallelism().map_or(1, |n| n.get());
+        Busy(
+            (0..hw)
+                .map(|_| {
+                    Command::new("sh")
+                        .args(["-c", "while :; do :; done"])
+                        .spawn()
+                        .expect("sh runs")
+                })
+                .collect(),
+        )
+    }
+}
+
+impl Drop for Busy {
+    fn drop(&mut self) {
+        for c in &mut self.0 {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+    }
+}
+
+#[test]
+fn a_sweep_beside_busy_processes_measures_their_cpu_and_marks_its_cells_contended() {
+    if !Path::new("/proc/stat").exists() {
+        return; // Not Linux: the columns stay empty, tested by the unit tests.
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    let _busy = Busy::start();
+    let o = run(&[
+        "sweep",
+        "--n",
+        "1000",
+        "--steps",
+        "400",
+        "--trials",
+        "2",
+        "--warmup",
+        "0",
+        "--cores",
+        "1",
+        "--strategies",
+        "seq",
+        "--no-plots",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert!(err.contains("cores busy with other work"), "{err}");
+    let summary = rows(&dir.join("summary.csv"));
+    assert_eq!(summary[0]["contended"], "true", "{summary:?}");
+    for t in rows(&dir.join("trials.csv")) {
+        assert!(t["foreign_cpu_s"].parse::<f64>().unwrap() > 0.0, "{t:?}");
+        assert!(!t["load1"].is_empty());
+    }
+}
+
+/// Starts a sweep that runs long enough to be caught holding its directory's lock, and waits
+/// until it holds it.
+fn long_sweep(dir: &Path) -> Child {
+    let child = bench_sph()
+        .args([
+            "sweep",
+            "--n",
+            "2000",
+            "--steps",
+            "1000",
+            "--trials",
+            "50",
+            "--cores",
+            "1",
+            "--strategies",
+            "seq",
+            "--no-plots",
+            "--out",
+            dir.to_str().unwrap(),
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(60);
+    while !std::fs::read_to_string(dir.join("sweep.lock"))
+        .is_ok_and(|s| s.trim() == child.id().to_string())
+    {
+        assert!(Instant::now() < deadline, "the sweep never took its lock");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child
+}
+
+#[test]
+fn a_second_sweep_on_a_directory_in_use_is_refused_naming_the_holders_pid() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    let mut first = long_sweep(&dir);
+    let pid = first.id().to_string();
+    let o = run(&["sweep", "--resume", dir.to_str().unwrap()]);
+    let o2 = tiny(&dir, &["--force"]);
+    first.kill().unwrap();
+    first.wait().unwrap();
+    for o in [o, o2] {
+        assert!(!o.status.success());
+        no_panic(&o);
+        let err = text(&o.stderr);
+        assert!(
+            err.contains("in use by another bench-sph sweep") && err.contains(&pid),
+            "{err}"
+        );
+    }
+    // The lock died with its holder: the directory can be resumed now (stopped at once).
+    let o = run(&[
+        "sweep",
+        "--resume",
+        dir.to_str().unwrap(),
+        "--stop-after-cells",
+        "0",
+    ]);
+    let err = text(&o.stderr);
+    assert!(
+        !err.contains("in use") && err.contains("interrupted"),
+        "{err}"
+    );
+}
+
+#[test]
+fn two_sweeps_racing_for_the_same_new_directory_leave_one_winner_and_a_clear_refusal() {
+    let tmp = tempfile::tempdir().unwrap();
+    for round in 0..3 {
+        let dir = tmp.path().join(format!("same{round}"));
+        let spawn = || {
+            let mut args = TINY.to_vec();
+            args.extend(["--no-plots", "--out", dir.to_str().unwrap()]);
+            bench_sph()
+                .args(&args)
+                .stdout(Stdio::null())
+                .stderr(Stdio::piped())
+                .spawn()
+                .unwrap()
+        };
+        let (a, b) = (spawn(), spawn());
+        let outs = [a.wait_with_output().unwrap(), b.wait_with_output().unwrap()];
+        let ok = outs.iter().filter(|o| o.status.success()).count();
+        assert_eq!(ok, 1, "exactly one wins");
+        let loser = outs.iter().find(|o| !o.status.success()).unwrap();
+        no_panic(loser);
+        let err = text(&loser.stderr);
+        assert!(
+            err.starts_with("Error: results directory")
+                && err.contains(dir.to_str().unwrap())
+                && err.lines().count() == 1,
+            "{err}"
+        );
+        assert_eq!(rows(&dir.join("summary.csv")).len(), 3);
+    }
+}
+
+#[test]
+fn default_directories_of_sweeps_started_in_the_same_second_do_not_collide() {
+    let tmp = tempfile::tempdir().unwrap();
+    let spawn = || {
+        let mut args = TINY.to_vec();
+        args.push("--no-plots");
+        bench_sph()
+            .args(&args)
+            .current_dir(tmp.path())
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let children: Vec<Child> = (0..3).map(|_| spawn()).collect();
+    for c in children {
+        let o = c.wait_with_output().unwrap();
+        assert!(o.status.success(), "{}", text(&o.stderr));
+    }
+    let dirs: Vec<_> = std::fs::read_dir(tmp.path().join("results"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(dirs.len(), 3, "{dirs:?}");
+    for d in dirs {
+        assert_eq!(rows(&d.join("summary.csv")).len(), 3, "{d:?}");
+    }
+}
+
+#[test]
+fn a_closed_standard_output_ends_the_sweep_like_ctrl_c_without_a_panic() {
+    let tmp = tempfile::tempdir().unwrap();
+    // A reader that goes away at once (`sweep | head -0`).
+    let dir = tmp.path().join("pipe");
+    let mut args = TINY.to_vec();
+    args.extend(["--no-plots", "--out", dir.to_str().unwrap()]);
+    let mut child = bench_sph()
+        .args(&args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    assert!(!o.status.success());
+    no_panic(&o);
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("Error: interrupted") && err.contains("--resume"),
+        "{err}"
+    );
+    let meta = std::fs::read_to_string(dir.join("meta.json")).unwrap();
+    assert!(meta.contains("\"status\": \"interrupted\""), "{meta}");
+    // And it resumes to the end.
+    let o = run(&["sweep", "--resume", dir.to_str().unwrap(), "--no-plots"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(rows(&dir.join("summary.csv")).len(), 3);
+
+    // A full device.
+    if Path::new("/dev/full").exists() {
+        let dir = tmp.path().join("full");
+        let mut args = TINY.to_vec();
+        args.extend(["--no-plots", "--out", dir.to_str().unwrap()]);
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let o = bench_sph().args(&args).stdout(full).output().unwrap();
+        assert!(!o.status.success());
+        no_panic(&o);
+        let meta = std::fs::read_to_string(dir.join("meta.json")).unwrap();
+        assert!(meta.contains("\"status\": \"interrupted\""), "{meta}");
+    }
+}
+
+#[test]
+fn the_plan_of_a_huge_all_pairs_sweep_is_printed_before_any_long_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    let mut child = bench_sph()
+        .args([
+            "sweep",
+            "--n",
+            "300000",
+            "--strategies",
+            "seq",
+            "--cores",
+            "1",
+            "--steps",
+            "1",
+            "--trials",
+            "1",
+            "--no-plots",
+            "--out",
+            dir.to_str().unwrap(),
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
+    let mut seen = Vec::new();
+    // The estimate comes from a bounded sample; the full run (an O(N²) step of 300 000
+    // particles) would take minutes. Stop the sweep as soon as the plan is complete.
+    for line in lines.by_ref() {
+        let line = line.unwrap();
+        let done = line.contains("estimated time");
+        seen.push(line);
+        if done {
+            break;
+        }
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    let all = seen.join("\n");
+    assert!(
+        all.contains("group: ") && all.contains("N = 300000"),
+        "{all}"
+    );
+    assert!(all.contains("estimated time: about"), "{all}");
+}
+
+#[test]
+fn resume_rechecks_its_meta_json_and_reruns_corrupt_or_short_cells() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    assert!(tiny(&dir, &["--no-plots"]).status.success());
+    let d = dir.to_str().unwrap();
+    let meta_path = dir.join("meta.json");
+    let meta = std::fs::read_to_string(&meta_path).unwrap();
+
+    // meta.json edited to parameters the command line refuses.
+    for (from, to, needle) in [
+        ("\"trials\": 3", "\"trials\": 0", "trials must be between 1"),
+        (
+            "\"cores\": [\n      1,\n      2\n    ]",
+            "\"cores\": [\n      0\n    ]",
+            "cores must be between 1",
+        ),
+    ] {
+        assert!(meta.contains(from), "{meta}");
+        std::fs::write(&meta_path, meta.replace(from, to)).unwrap();
+        let o = run(&["sweep", "--resume", d, "--no-plots"]);
+        assert!(!o.status.success());
+        no_panic(&o);
+        assert!(text(&o.stderr).contains(needle), "{}", text(&o.stderr));
+    }
+
+    // A corrupt trial row: its cell runs again.
+    std::fs::write(&meta_path, &meta).unwrap();
+    let trials = std::fs::read_to_string(dir.join("trials.csv")).unwrap();
+    let mut lines: Vec<String> = trials.lines().map(str::to_owned).collect();
+    let fields: Vec<&str> = lines[2].split(',').collect();
+    let mut fields: Vec<String> = fields.iter().map(|f| f.to_string()).collect();
+    fields[9] = "NaN".into();
+    fields[10] = "-5".into();
+    lines[2] = fields.join(",");
+    std::fs::write(dir.join("trials.csv"), lines.join("\n") + "\n").unwrap();
+    let o = run(&["sweep", "--resume", d, "--no-plots"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("dropped, will run again") && err.contains("wall_s = NaN"),
+        "{err}"
+    );
+    let again = rows(&dir.join("trials.csv"));
+    assert!(
+        again
+            .iter()
+            .all(|r| r["wall_s"].parse::<f64>().unwrap() > 0.0)
+    );
+    assert_eq!(again.len(), 9);
+
+    // trials changed from 3 to 5: every cell runs again with 5.
+    std::fs::write(&meta_path, meta.replace("\"trials\": 3", "\"trials\": 5")).unwrap();
+    let o = run(&["sweep", "--resume", d, "--no-plots"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(text(&o.stderr).contains("3 trials, but the sweep asks for 5"));
+    let summary = rows(&dir.join("summary.csv"));
+    assert!(summary.iter().all(|r| r["trials"] == "5"), "{summary:?}");
+    assert_eq!(rows(&dir.join("trials.csv")).len(), 15);
+}
+
+#[test]
+fn force_replaces_a_sweeps_earlier_report_and_keeps_foreign_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    assert!(tiny(&dir, &[]).status.success());
+    assert!(dir.join("REPORT.md").is_file());
+    std::fs::write(dir.join("notes.txt"), "mine").unwrap();
+    let o = tiny(&dir, &["--force", "--no-plots"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        !dir.join("REPORT.md").exists(),
+        "no report of the old data stays"
+    );
+    let pngs = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .path()
+                .extension()
+                .is_some_and(|x| x == "png")
+        })
+        .count();
+    assert_eq!(pngs, 0);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("notes.txt")).unwrap(),
+        "mine"
+    );
+
+    // A trace's (or any foreign) meta.json is never overwritten, even with --force.
+    let other = tmp.path().join("other");
+    std::fs::create_dir(&other).unwrap();
+    std::fs::write(other.join("meta.json"), "{\"tool\": \"bench-sph trace\"}").unwrap();
+    let o = tiny(&other, &["--no-plots"]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o.stderr).contains("'meta.json'"),
+        "{}",
+        text(&o.stderr)
+    );
+    let o = tiny(&other, &["--force", "--no-plots"]);
+    assert!(!o.status.success());
+    assert!(text(&o.stderr).contains("was not written by bench-sph sweep"));
+    assert!(
+        std::fs::read_to_string(other.join("meta.json"))
+            .unwrap()
+            .contains("trace")
+    );
+}
