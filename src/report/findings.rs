@@ -111,13 +111,22 @@ fn winner(cores: usize, at: &[(&str, &Best)]) -> Option<String> {
     Some(format!(
         "{where_}, {} are indistinguishable within the trial spread (their 95 % intervals \
          overlap){}{left_out}.",
-        names.join(" and "),
+        and_list(&names),
         match rest {
             0 => String::new(),
             1 => "; the other strategy is slower".to_owned(),
             _ => "; the others are slower".to_owned(),
         }
     ))
+}
+
+/// `a`, `a and b`, `a, b and c`.
+fn and_list(items: &[String]) -> String {
+    match items {
+        [] => String::new(),
+        [one] => one.clone(),
+        [init @ .., last] => format!("{} and {last}", init.join(", ")),
+    }
 }
 
 /// A speedup above 1 at one core is the reference's noise.

@@ -137,7 +137,7 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
              ringed in red in the charts, and left out of every finding. Measure again on a \
              quiet machine.\n",
             crate::sweep::console::plural(contended.len(), "cell was", "cells were"),
-            sig(crate::contention::CONTENDED_SHARE * 100.0),
+            (crate::contention::CONTENDED_SHARE * 100.0).round(),
             if contended.len() == 1 {
                 "it was"
             } else {

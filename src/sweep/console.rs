@@ -107,7 +107,8 @@ pub fn cell_line(position: usize, total: usize, cell: &Cell, row: &SummaryRow) -
 /// The warning before the plan when other work already keeps the machine busy.
 pub fn busy_warning(busy_threads: f64, hardware_threads: usize) -> String {
     format!(
-        "warning: {busy_threads:.1} of {hardware_threads} cores busy with other work: timings          will not be trustworthy (cells that see it are marked contended=true in summary.csv)"
+        "warning: {busy_threads:.1} of {hardware_threads} cores busy with other work: timings will \
+         not be trustworthy (cells that see it are marked contended=true in summary.csv)"
     )
 }
 
@@ -122,7 +123,8 @@ pub fn contended_cells(rows: &[SummaryRow]) -> Option<String> {
         return None;
     }
     let mut text = format!(
-        "warning: {} saw other work on the machine (contended=true in summary.csv); their          times are not trustworthy and the report leaves them out of its findings:",
+        "warning: {} saw other work on the machine (contended=true in summary.csv); \
+         their times are not trustworthy and the report leaves them out of its findings:",
         plural(names.len(), "cell", "cells")
     );
     for name in names {
