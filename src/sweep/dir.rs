@@ -94,12 +94,20 @@ pub fn open_new(dir: &Path, force: bool) -> anyhow::Result<DirLock> {
     Ok(held)
 }
 
-/// Locks an existing sweep's directory for `--resume`.
+/// Locks an existing sweep's directory for `--resume`. Where a lock file exists, the lock is
+/// taken first, so a sweep that has just started there (locked, `meta.json` not yet written)
+/// is reported as the holder; a lock file is never created in a directory that is not a
+/// sweep's.
 pub fn open_existing(dir: &Path) -> anyhow::Result<DirLock> {
     let meta = dir.join(META_FILE);
     if !dir.is_dir() {
         bail!("cannot resume '{}': no such directory", dir.display());
     }
+    let held = if dir.join(LOCK_FILE).is_file() {
+        Some(lock::acquire(dir)?)
+    } else {
+        None
+    };
     if !Meta::is_sweep_meta(&meta) {
         bail!(
             "cannot resume '{}': it has no sweep's {META_FILE}, so it is not a sweep's results \
@@ -107,7 +115,10 @@ pub fn open_existing(dir: &Path) -> anyhow::Result<DirLock> {
             dir.display()
         );
     }
-    lock::acquire(dir)
+    match held {
+        Some(lock) => Ok(lock),
+        None => lock::acquire(dir),
+    }
 }
 
 /// Whether a top-level entry of a results directory is a sweep's own output.
