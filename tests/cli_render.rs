@@ -247,12 +247,12 @@ fn an_unwritable_output_fails_before_anything_is_simulated() {
     fails_with(
         d,
         &[&["render", "--out", "no/such/dir/a.gif"][..], &long].concat(),
-        &["Error:", "cannot write GIF file 'no/such/dir/a.gif'"],
+        &["Error:", "cannot write 'no/such/dir/a.gif'"],
     );
     fails_with(
         d,
         &[&["render", "--frames", "plain-file/frames"][..], &long].concat(),
-        &["Error:", "cannot create frames folder 'plain-file/frames'"],
+        &["Error:", "cannot create directory 'plain-file/frames'"],
     );
 }
 
@@ -265,4 +265,147 @@ fn a_missing_init_file_is_one_clear_error() {
         &["Error:", "cannot read init file 'nope.csv'"],
     );
     assert!(!dir.path().join("dambreak.gif").exists());
+}
+
+/// The names in `dir`, sorted.
+fn names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    v.sort();
+    v
+}
+
+fn frames(count: usize) -> Vec<String> {
+    (0..count).map(|k| format!("frame_{k:05}.png")).collect()
+}
+
+#[test]
+fn fewer_frames_into_the_folder_of_a_longer_render_leave_only_the_new_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let tiny = [
+        "--n", "20", "--every", "1", "--width", "360", "--frames", "f",
+    ];
+    succeeds(
+        dir.path(),
+        &[&["render", "--steps", "10"][..], &tiny].concat(),
+    );
+    assert_eq!(names(&dir.path().join("f")), frames(11));
+    succeeds(
+        dir.path(),
+        &[&["render", "--steps", "2"][..], &tiny].concat(),
+    );
+    assert_eq!(names(&dir.path().join("f")), frames(3));
+}
+
+#[test]
+fn a_frames_folder_with_other_files_is_refused_and_force_writes_beside_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let f = dir.path().join("f");
+    std::fs::create_dir(&f).unwrap();
+    std::fs::write(f.join("notes.txt"), "mine").unwrap();
+    let args = [
+        "render", "--n", "20", "--steps", "1", "--every", "1", "--frames", "f",
+    ];
+    fails_with(
+        dir.path(),
+        &args,
+        &[
+            "Error:",
+            "--frames 'f' holds files that bench-sph render did not write ('notes.txt')",
+            "--force",
+        ],
+    );
+    assert_eq!(names(&f), ["notes.txt"]);
+    succeeds(dir.path(), &[&args[..], &["--force"]].concat());
+    assert_eq!(
+        names(&f),
+        ["frame_00000.png", "frame_00001.png", "notes.txt"]
+    );
+    assert_eq!(
+        std::fs::read_to_string(f.join("notes.txt")).unwrap(),
+        "mine"
+    );
+    fails_with(dir.path(), &["render", "--force"], &["--frames"]);
+}
+
+#[test]
+fn an_interrupted_render_leaves_the_earlier_gif_untouched() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("a.gif"), "earlier").unwrap();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+        .args([
+            "render", "--n", "400", "--steps", "1000000", "--every", "1", "--out", "a.gif",
+        ])
+        .current_dir(dir.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait until frames are being written (the temporary file has grown), then kill it.
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let writing = || {
+        std::fs::read_dir(dir.path()).unwrap().any(|e| {
+            let e = e.unwrap();
+            e.file_name().to_string_lossy().ends_with(".tmp")
+                && e.metadata().unwrap().len() > 20_000
+        })
+    };
+    while !writing() {
+        assert!(std::time::Instant::now() < deadline, "no frames written");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("a.gif")).unwrap(),
+        "earlier"
+    );
+}
+
+#[test]
+fn a_gif_that_cannot_be_written_is_one_error_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = bench_sph_in(
+        dir.path(),
+        &[
+            "render",
+            "--n",
+            "20",
+            "--steps",
+            "2",
+            "--every",
+            "1",
+            "--out",
+            "/dev/full",
+        ],
+    );
+    assert!(!o.status.success());
+    assert_eq!(
+        stderr(&o),
+        "Error: cannot write GIF file '/dev/full': No space left on device (os error 28)\n"
+    );
+    assert!(
+        !std::fs::metadata("/dev/full").unwrap().is_file(),
+        "the device stays a device"
+    );
+}
+
+#[test]
+fn a_render_larger_than_the_available_memory_is_refused_before_anything_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+        .args(["render", "--n", "100000"])
+        .current_dir(dir.path())
+        .env("BENCH_SPH_FAKE_MEM_AVAILABLE", "1000000")
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert_eq!(
+        stderr(&o),
+        "Error: --n 100000 needs about 20 MB of memory (all-pairs search); \
+         this machine has 1.0 MB available\n"
+    );
+    assert!(names(dir.path()).is_empty());
 }

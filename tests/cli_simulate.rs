@@ -2,7 +2,8 @@
 //! `Error: ...` with a non-zero exit for each kind of bad input.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 fn bench_sph(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_bench-sph"))
@@ -102,8 +103,10 @@ fn a_dump_loads_back_with_init_and_continues_exactly_as_an_unbroken_run() {
         "simulate", "--n", "300", "--steps", "20", "--dump", dump, "--json",
     ]);
     let text = std::fs::read_to_string(dump).unwrap();
-    assert!(text.starts_with("i,x,y,vx,vy,fx,fy,rho,p\n"));
-    assert_eq!(text.lines().count(), 301);
+    assert!(
+        text.starts_with("# bench-sph dump: preset=seed n=300 step=20\ni,x,y,vx,vy,fx,fy,rho,p\n")
+    );
+    assert_eq!(text.lines().count(), 302);
     let resumed = json(&["simulate", "--init", dump, "--steps", "20", "--json"]);
     assert_eq!(resumed["n"], 300);
     assert_eq!(resumed["checksum"], whole["checksum"]);
@@ -230,7 +233,7 @@ fn an_unwritable_dump_path_fails_before_the_run() {
     assert!(!o.status.success());
     let err = stderr(&o);
     assert!(
-        err.starts_with("Error: cannot write dump file '/no/such/dir/out.csv'"),
+        err.starts_with("Error: cannot write '/no/such/dir/out.csv'"),
         "{err}"
     );
 }
@@ -248,5 +251,156 @@ fn list_prints_one_strategy_per_line_name_first() {
     assert!(
         out.lines().all(|l| l.split_whitespace().count() > 3),
         "each line has a description"
+    );
+}
+
+/// The names in `dir`, sorted.
+fn names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn a_failed_run_leaves_an_existing_dump_file_as_it_was() {
+    let dir = tempfile::tempdir().unwrap();
+    let dump = write(dir.path(), "final.csv", "earlier results\n");
+    // A worker's panic made into an error of the run (its message says "panicked").
+    let o = bench_sph(&[
+        "simulate",
+        "--n",
+        "50",
+        "--steps",
+        "5",
+        "--inject-panic-at",
+        "7",
+        "--dump",
+        &dump,
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("Error: step 1 failed"),
+        "{}",
+        stderr(&o)
+    );
+    fails_with(&["simulate", "--dump", &dump, "--steps", "zero"], &["zero"]);
+    assert_eq!(std::fs::read_to_string(&dump).unwrap(), "earlier results\n");
+    assert_eq!(
+        names(dir.path()),
+        ["final.csv"],
+        "no temporary file is left"
+    );
+}
+
+#[test]
+fn a_dump_of_one_preset_continues_only_with_that_preset_or_an_explicit_other() {
+    let dir = tempfile::tempdir().unwrap();
+    let dump = dir.path().join("cpp.csv");
+    let dump = dump.to_str().unwrap();
+    let o = bench_sph(&[
+        "simulate", "--preset", "cpp", "--n", "100", "--steps", "3", "--dump", dump,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    fails_with(
+        &["simulate", "--init", dump, "--steps", "1"],
+        &[&format!(
+            "Error: init file '{dump}' was dumped with --preset cpp; pass --preset cpp to \
+             continue it, or --preset seed explicitly to use seed physics"
+        )],
+    );
+    for preset in ["cpp", "seed"] {
+        let o = bench_sph(&[
+            "simulate", "--init", dump, "--steps", "1", "--preset", preset, "--json",
+        ]);
+        assert!(o.status.success(), "{preset}: {}", stderr(&o));
+        assert!(stdout(&o).contains(&format!("\"preset\":\"{preset}\"")));
+    }
+    // A dump from before the info line (no comment) loads with the default preset.
+    let text = std::fs::read_to_string(dump).unwrap();
+    let old = write(dir.path(), "old.csv", text.split_once('\n').unwrap().1);
+    let o = bench_sph(&["simulate", "--init", &old, "--steps", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// Runs `args` and returns its stderr, failing the test if it takes more than 30 s.
+fn stderr_within_30_s(args: &[&str]) -> String {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(30);
+    while child.try_wait().unwrap().is_none() {
+        if Instant::now() > deadline {
+            child.kill().unwrap();
+            panic!("{args:?} did not end");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let o = child.wait_with_output().unwrap();
+    assert!(!o.status.success());
+    stderr(&o)
+}
+
+#[test]
+fn an_endless_init_device_is_refused_at_its_first_overlong_line() {
+    let err = stderr_within_30_s(&["simulate", "--init", "/dev/zero"]);
+    assert_eq!(
+        err,
+        "Error: init file '/dev/zero': line 1 is longer than 4096 bytes (is this a CSV file?)\n"
+    );
+}
+
+#[test]
+fn an_init_line_over_4_kib_is_refused_with_its_number_and_a_directory_as_a_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let long = format!("x,y,note\n100,100,a\n100,116,{}\n", "b".repeat(5000));
+    fails_with(
+        &["simulate", "--init", &write(dir.path(), "long.csv", &long)],
+        &["Error:", "line 3 is longer than 4096 bytes"],
+    );
+    let d = dir.path().to_str().unwrap();
+    fails_with(
+        &["simulate", "--init", d],
+        &[&format!(
+            "Error: init file '{d}' is a directory, not a CSV file"
+        )],
+    );
+}
+
+#[test]
+fn a_run_larger_than_the_available_memory_is_refused_before_allocating() {
+    let o = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+        .args(["simulate", "--n", "100000000", "--neighbors", "grid"])
+        .env("BENCH_SPH_FAKE_MEM_AVAILABLE", "21000000000")
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert_eq!(
+        stderr(&o),
+        "Error: --n 100000000 needs about 23 GB of memory (grid search); \
+         this machine has 21 GB available\n"
+    );
+    fails_with(
+        &["simulate", "--n", "18446744073709551615"],
+        &["particles must be between 1 and 100000000"],
+    );
+}
+
+#[test]
+fn a_full_or_closed_stdout_is_one_error_line_not_a_panic() {
+    let o = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+        .args(["simulate", "--n", "20", "--steps", "2"])
+        .stdout(std::fs::File::create("/dev/full").unwrap())
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    assert_eq!(
+        stderr(&o),
+        "Error: cannot write to standard output: No space left on device (os error 28)\n"
     );
 }

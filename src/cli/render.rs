@@ -11,6 +11,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sph_strategies::{Config, StrategyName};
 
+use super::simulate::say;
 use crate::render::frame::{Caption, MAX_WIDTH, MIN_WIDTH, Painter};
 use crate::render::output::Output;
 use crate::render::scale::{ColorBy, Scale};
@@ -57,9 +58,14 @@ pub struct RenderArgs {
     /// Write an animated GIF here [default: dambreak.gif].
     #[arg(long, value_name = "FILE.gif", conflicts_with = "frames")]
     pub out: Option<PathBuf>,
-    /// Write PNG frames (frame_00000.png, …) into this folder instead of a GIF.
+    /// Write PNG frames (frame_00000.png, …) into this folder instead of a GIF. Frames of an
+    /// earlier render there are replaced (extra ones removed); other files make it refuse.
     #[arg(long, value_name = "DIR")]
     pub frames: Option<PathBuf>,
+    /// With --frames: write into a folder that holds files render did not write (they are
+    /// left as they are; only frame files are replaced).
+    #[arg(long, requires = "frames")]
+    pub force: bool,
 }
 
 /// Runs `render`.
@@ -72,7 +78,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
 
     // Open the output before simulating, so a bad path costs nothing.
     let mut output = match &args.frames {
-        Some(dir) => Output::png_frames(dir)?,
+        Some(dir) => Output::png_frames(dir, args.force)?,
         None => {
             let path = args.out.clone().unwrap_or_else(|| DEFAULT_OUT.into());
             Output::gif(&path, (width, height), &painter.palette(), args.fps)?
@@ -115,15 +121,14 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let place = output.describe();
     output.finish()?;
-    println!(
+    say(&format!(
         "{frames} frames of {width} × {height} px (steps 0 to {}, one every {}) written to {place}",
         sim.steps_done, args.every
-    );
-    println!(
+    ))?;
+    say(&format!(
         "{:.2} s in all, {simulating_s:.2} s of it simulating",
         started.elapsed().as_secs_f64()
-    );
-    Ok(())
+    ))
 }
 
 /// A bar counting frames on stderr; hidden when stderr is not a terminal or the render is tiny.

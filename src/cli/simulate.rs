@@ -1,8 +1,6 @@
 //! `bench-sph simulate`: one run of the dam break, timed.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
@@ -10,7 +8,9 @@ use serde::Serialize;
 use sph_strategies::{Config, StrategyName};
 
 use crate::checksum::checksum_hex;
-use crate::io::dump_csv;
+use crate::io::dump_csv::{self, DumpInfo};
+use crate::io::sink::Sink;
+use crate::output::console;
 use crate::run::{RunError, run_timed};
 use crate::solver::{Simulation, StepError};
 use crate::sph::neighbors::NeighborMode;
@@ -34,7 +34,8 @@ pub struct SimulateArgs {
     /// Chunks per pass, for strategies that use chunks.
     #[arg(long, default_value_t = 10, value_parser = super::chunks)]
     pub chunks: usize,
-    /// Write the final state to CSV (i,x,y,vx,vy,fx,fy,rho,p; exact round-trip).
+    /// Write the final state to CSV (i,x,y,vx,vy,fx,fy,rho,p; exact round-trip), replacing
+    /// FILE only when the run ends.
     #[arg(long, value_name = "FILE.csv")]
     pub dump: Option<PathBuf>,
     /// Print one JSON object instead of text.
@@ -68,11 +69,10 @@ struct Report {
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let (state, domain) = args.scene.initial_state()?;
     let n = state.len();
-    // Open the dump file before the run, so a bad path costs nothing.
-    let mut dump = match &args.dump {
-        Some(path) => Some((path, create(path)?)),
-        None => None,
-    };
+    // Open the dump before the run, so a bad path costs nothing. It is written to a
+    // temporary file and renamed over FILE at the end: a failed or interrupted run leaves
+    // FILE as it was.
+    let mut dump = args.dump.as_deref().map(Sink::create).transpose()?;
     let cores = args.cores.unwrap_or_else(super::hardware_threads);
     let config = Config {
         cores,
@@ -88,9 +88,15 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let outcome = run_timed(&mut sim, args.strategy, &config, args.steps);
 
     let diverged = matches!(outcome, Err(RunError::Step(StepError::Diverged { .. })));
-    if let Some((path, out)) = dump.as_mut().filter(|_| outcome.is_ok() || diverged) {
-        dump_csv::write(&sim.state, out)
-            .with_context(|| format!("cannot write dump file '{}'", path.display()))?;
+    if let Some(mut out) = dump.take().filter(|_| outcome.is_ok() || diverged) {
+        let info = DumpInfo {
+            preset: args.scene.preset,
+            n,
+            step: sim.steps_done,
+        };
+        dump_csv::write(&sim.state, &info, &mut out)
+            .with_context(|| format!("cannot write dump file '{}'", out.path().display()))?;
+        out.commit()?;
     }
     let elapsed = match outcome {
         Ok(e) => e,
@@ -127,31 +133,25 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     print_report(&report, args.json)
 }
 
-fn create(path: &Path) -> anyhow::Result<BufWriter<File>> {
-    let file = File::create(path)
-        .with_context(|| format!("cannot write dump file '{}'", path.display()))?;
-    Ok(BufWriter::new(file))
+/// Prints a line on standard output; a closed or full stdout is an error, not a panic.
+pub(super) fn say(text: &str) -> anyhow::Result<()> {
+    console::line(text).context("cannot write to standard output")
 }
 
 fn print_report(r: &Report, json: bool) -> anyhow::Result<()> {
-    let mut out = std::io::stdout().lock();
     if json {
-        serde_json::to_writer(&mut out, r)?;
-        writeln!(out)?;
-        return Ok(());
+        return say(&serde_json::to_string(r)?);
     }
     let chunks = r.chunks.map_or_else(|| "n/a".to_owned(), |c| c.to_string());
-    writeln!(
-        out,
+    say(&format!(
         "preset {}, {} neighbours, strategy {} (cores {}, chunks {chunks})",
         r.preset, r.neighbors, r.strategy, r.cores
-    )?;
-    writeln!(out, "N = {} particles, {} steps", r.n, r.steps)?;
-    writeln!(
-        out,
+    ))?;
+    say(&format!("N = {} particles, {} steps", r.n, r.steps))?;
+    say(&format!(
         "wall {:.3} s, CPU {:.3} s (user+sys), {:.3e} particle-steps/s",
         r.wall_s, r.cpu_s, r.particle_steps_per_s
-    )?;
-    writeln!(out, "checksum {}", r.checksum)?;
+    ))?;
+    say(&format!("checksum {}", r.checksum))?;
     Ok(())
 }

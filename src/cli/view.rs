@@ -5,6 +5,7 @@ use sph_strategies::{Config, StrategyName};
 
 use crate::render::frame::{MAX_WIDTH, MIN_WIDTH};
 use crate::render::scale::ColorBy;
+use crate::scene::memory;
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
 use crate::viewer::scene::Settings;
@@ -16,7 +17,7 @@ pub struct ViewArgs {
     #[arg(long, value_enum, default_value_t = Preset::Seed)]
     pub preset: Preset,
     /// Number of particles at start (+ and - double and halve it).
-    #[arg(long, default_value_t = 1000, value_parser = super::positive)]
+    #[arg(long, default_value_t = 1000, value_parser = super::particles)]
     pub n: usize,
     /// Steps between two frames on screen.
     #[arg(long, value_name = "K", default_value_t = 5, value_parser = super::positive)]
@@ -47,6 +48,13 @@ pub struct ViewArgs {
 
 /// Runs `view`.
 pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
+    // Checked before the window opens; + doubles N only up to the viewer's own bound.
+    memory::check(
+        args.preset,
+        args.neighbors,
+        args.n,
+        super::scene::memory_available(),
+    )?;
     crate::viewer::run(Settings {
         preset: args.preset,
         n: args.n,

@@ -1,9 +1,25 @@
 //! `--init FILE.csv`: a header row, columns `x,y` required, `vx,vy` optional (default 0),
-//! other columns ignored; one particle per row.
+//! other columns ignored; one particle per row. Lines starting with `#` are comments; a
+//! dump's first line ([`DumpInfo`]) is read back into [`InitRows::dumped`].
+//!
+//! Reading is bounded, so that any path ends quickly: a line may hold at most
+//! [`MAX_LINE_BYTES`](crate::io::bounded::MAX_LINE_BYTES) (4096) bytes and the file at most
+//! [`MAX_LINES`] lines (the most particles any command accepts, a header and
+//! [`MAX_COMMENT_LINES`] comments). `/dev/zero` is refused after 4 KiB; a directory is refused
+//! before reading.
 
 use std::path::Path;
 
+use crate::io::bounded::{BoundedLines, Overrun, overrun};
+use crate::io::dump_csv::DumpInfo;
+use crate::limits::MAX_PARTICLES;
 use crate::sph::state::{Domain, State};
+
+/// Comment lines an init file may hold besides its header and particles.
+pub const MAX_COMMENT_LINES: u64 = 1000;
+
+/// The most lines an init file may hold.
+pub const MAX_LINES: u64 = MAX_PARTICLES as u64 + 1 + MAX_COMMENT_LINES;
 
 /// What is wrong with an init file. Line numbers are 1-based and count the header.
 #[derive(Debug, thiserror::Error)]
@@ -15,6 +31,20 @@ pub enum InitError {
         path: String,
         /// The OS error.
         source: std::io::Error,
+    },
+    /// The path is a directory.
+    #[error("init file '{path}' is a directory, not a CSV file")]
+    Directory {
+        /// The path.
+        path: String,
+    },
+    /// The file is not a CSV file of ours: a line too long, or too many lines.
+    #[error("init file '{path}': {overrun}")]
+    Overrun {
+        /// The file.
+        path: String,
+        /// What was too large.
+        overrun: Overrun,
     },
     /// The file has no header, or a header and no rows.
     #[error(
@@ -84,22 +114,46 @@ pub struct InitRows {
     pub state: State,
     /// The 1-based line of each particle.
     pub lines: Vec<u64>,
+    /// What the file's first line says about the run that dumped it, if it is a dump.
+    pub dumped: Option<DumpInfo>,
 }
 
 /// Reads `path`. Checks numbers, not walls (the tank depends on N; see [`check_walls`]).
 pub fn read(path: &Path) -> Result<InitRows, InitError> {
     let shown = path.display().to_string();
-    let file = std::fs::File::open(path).map_err(|source| InitError::Io {
+    let io = |source| InitError::Io {
         path: shown.clone(),
         source,
-    })?;
+    };
+    if std::fs::metadata(path).map_err(io)?.is_dir() {
+        return Err(InitError::Directory {
+            path: shown.clone(),
+        });
+    }
+    let file = std::fs::File::open(path).map_err(io)?;
     let mut reader = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
-        .from_reader(std::io::BufReader::new(file));
-    let malformed = |e: csv::Error, shown: &str| InitError::Malformed {
-        path: shown.to_owned(),
-        line: e.position().map_or(0, |p| p.line()),
-        message: e.to_string(),
+        .comment(Some(b'#'))
+        .from_reader(BoundedLines::new(file, MAX_LINES));
+    let malformed = |e: csv::Error, shown: &str| {
+        let (line, message) = (e.position().map_or(0, |p| p.line()), e.to_string());
+        match e.into_kind() {
+            csv::ErrorKind::Io(source) => match overrun(&source) {
+                Some(overrun) => InitError::Overrun {
+                    path: shown.to_owned(),
+                    overrun,
+                },
+                None => InitError::Io {
+                    path: shown.to_owned(),
+                    source,
+                },
+            },
+            _ => InitError::Malformed {
+                path: shown.to_owned(),
+                line,
+                message,
+            },
+        }
     };
     let headers = reader.headers().map_err(|e| malformed(e, &shown))?.clone();
     if headers.is_empty() || headers.iter().all(str::is_empty) {
@@ -142,9 +196,19 @@ pub fn read(path: &Path) -> Result<InitRows, InitError> {
     if x.is_empty() {
         return Err(InitError::Empty { path: shown });
     }
+    let dumped = DumpInfo::parse(&String::from_utf8_lossy(reader.get_ref().first_line()));
+    let n = x.len();
+    let state = State::try_from_kinematics(x, y, vx, vy).map_err(|e| InitError::Io {
+        path: shown,
+        source: std::io::Error::new(
+            std::io::ErrorKind::OutOfMemory,
+            format!("no memory for {n} particles: {e}"),
+        ),
+    })?;
     Ok(InitRows {
-        state: State::from_kinematics(x, y, vx, vy),
+        state,
         lines,
+        dumped,
     })
 }
 

@@ -1,12 +1,18 @@
-//! Where an animation's frames go: one GIF file or a folder of PNG files. The file or folder
-//! is created when the output is opened, so a bad path fails before anything is simulated.
+//! Where an animation's frames go: one GIF file or a folder of PNG files, opened before
+//! anything is simulated so that a bad path fails at once.
+//!
+//! Nothing half-written is ever left at a destination: the GIF is written to a temporary file
+//! and renamed over its path by [`Output::finish`] (see [`crate::io::sink`]), so a failed or
+//! interrupted render leaves the earlier file, or none; each PNG frame is written whole the
+//! same way, and the folder is claimed ([`crate::output::claim`]) so that frames of an earlier,
+//! longer render are removed rather than mixed with the new ones.
 
-use std::fs::File;
-use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use gif::EncodingError;
 
+use crate::io::sink::Sink;
 use crate::render::gif_writer::GifWriter;
 use crate::render::image::Image;
 use crate::render::png_frames::PngFrames;
@@ -18,14 +24,23 @@ pub enum Output {
         /// The file.
         path: PathBuf,
         /// Its encoder.
-        writer: GifWriter<BufWriter<File>>,
+        writer: GifWriter<Sink>,
     },
     /// Numbered PNG files.
     Frames(PngFrames),
 }
 
+/// A GIF encoder's error as one message: its I/O errors say the same thing as their source,
+/// so only the source is kept.
+fn flatten(err: EncodingError) -> anyhow::Error {
+    match err {
+        EncodingError::Io(io) => io.into(),
+        other => anyhow::anyhow!("{other}"),
+    }
+}
+
 impl Output {
-    /// Creates the GIF file `path` for `width × height` frames drawn in `palette`, played at
+    /// Starts the GIF file `path` for `width × height` frames drawn in `palette`, played at
     /// `fps` frames per second (GIF delays are whole centiseconds, at least 2).
     pub fn gif(
         path: &Path,
@@ -34,26 +49,22 @@ impl Output {
         fps: u32,
     ) -> anyhow::Result<Output> {
         let cannot = || format!("cannot write GIF file '{}'", path.display());
-        let file = File::create(path).with_context(cannot)?;
+        let sink = Sink::create(path)?;
         let size = |v: u32| u16::try_from(v).with_context(|| format!("{v} px is too large"));
         let delay_cs = (100.0 / f64::from(fps.max(1))).round().max(2.0) as u16;
-        let writer = GifWriter::new(
-            BufWriter::new(file),
-            size(width)?,
-            size(height)?,
-            palette,
-            delay_cs,
-        )
-        .with_context(cannot)?;
+        let writer = GifWriter::new(sink, size(width)?, size(height)?, palette, delay_cs)
+            .map_err(flatten)
+            .with_context(cannot)?;
         Ok(Output::Gif {
             path: path.to_owned(),
             writer,
         })
     }
 
-    /// Creates the folder `dir` (and its parents) for PNG frames.
-    pub fn png_frames(dir: &Path) -> anyhow::Result<Output> {
-        Ok(Output::Frames(PngFrames::create(dir)?))
+    /// Claims the folder `dir` (created with its parents if missing) for PNG frames; see
+    /// [`PngFrames::create`] for what it may already hold, and `force`.
+    pub fn png_frames(dir: &Path, force: bool) -> anyhow::Result<Output> {
+        Ok(Output::Frames(PngFrames::create(dir, force)?))
     }
 
     /// Adds a frame.
@@ -61,23 +72,24 @@ impl Output {
         match self {
             Output::Gif { path, writer } => writer
                 .push(image)
+                .map_err(flatten)
                 .with_context(|| format!("cannot write GIF file '{}'", path.display())),
             Output::Frames(frames) => frames.push(image).map(drop),
         }
     }
 
-    /// Completes the file (the GIF's last frame and trailer) and flushes it.
+    /// Completes the output: the GIF's last frame and trailer, then the rename over its
+    /// path; or the removal of earlier frames this render did not write again.
     pub fn finish(self) -> anyhow::Result<()> {
         match self {
             Output::Gif { path, writer } => {
-                let cannot = || format!("cannot write GIF file '{}'", path.display());
-                writer
+                let sink = writer
                     .finish()
-                    .with_context(cannot)?
-                    .flush()
-                    .with_context(cannot)
+                    .map_err(flatten)
+                    .with_context(|| format!("cannot write GIF file '{}'", path.display()))?;
+                sink.commit()
             }
-            Output::Frames(_) => Ok(()),
+            Output::Frames(frames) => frames.finish(),
         }
     }
 
@@ -86,9 +98,7 @@ impl Output {
         match self {
             Output::Gif { path, .. } => format!("'{}'", path.display()),
             Output::Frames(frames) => {
-                let first = frames.path_of(0);
-                let dir = first.parent().unwrap_or(Path::new("."));
-                format!("'{}'", dir.join("frame_*.png").display())
+                format!("'{}'", frames.dir().join("frame_*.png").display())
             }
         }
     }

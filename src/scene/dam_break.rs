@@ -13,9 +13,11 @@
 //! column, so the dam keeps about its share of the tank. The domain therefore depends only on
 //! (preset, N), and a state dumped with `--dump` loads back with `--init`.
 
+use std::collections::TryReserveError;
+
 use crate::scene::splitmix::SplitMix64;
 use crate::sph::params::Preset;
-use crate::sph::state::{Domain, State};
+use crate::sph::state::{Domain, State, try_zeros};
 
 /// Width and height of both presets' tank before growth, px (1.5 × an 800 × 600 window).
 const BASE_DOMAIN: Domain = Domain {
@@ -84,17 +86,28 @@ pub fn domain(preset: Preset, n: usize) -> Domain {
 }
 
 /// The initial dam break: `n` particles at rest, x jittered by the seeded generator.
+///
+/// # Panics
+/// If memory runs out (commands call [`try_initial_state`], after [`super::memory::check`]).
 pub fn initial_state(preset: Preset, n: usize, seed: u64) -> State {
+    try_initial_state(preset, n, seed)
+        .unwrap_or_else(|e| panic!("no memory for {n} particles: {e}"))
+}
+
+/// [`initial_state`], with an allocator's refusal as an error instead of an abort.
+pub fn try_initial_state(preset: Preset, n: usize, seed: u64) -> Result<State, TryReserveError> {
     let layout = Layout::of(preset);
     let columns = layout.columns(n);
     let mut rng = SplitMix64::new(seed);
-    let (mut x, mut y) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let (mut x, mut y) = (Vec::new(), Vec::new());
+    x.try_reserve_exact(n)?;
+    y.try_reserve_exact(n)?;
     for k in 0..n {
         let (row, col) = (k / columns, k % columns);
         x.push((layout.x0 + SPACING * col as f64) + rng.next_f64());
         y.push(layout.y0 + SPACING * row as f64);
     }
-    State::from_kinematics(x, y, vec![0.0; n], vec![0.0; n])
+    State::try_from_kinematics(x, y, try_zeros(n)?, try_zeros(n)?)
 }
 
 #[cfg(test)]

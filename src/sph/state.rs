@@ -1,5 +1,7 @@
 //! The particle state, one array per field (struct of arrays).
 
+use std::collections::TryReserveError;
+
 use glam::DVec2;
 
 /// The simulation domain: walls at x = 0, x = `width`, y = 0, y = `height` (px).
@@ -43,23 +45,39 @@ impl State {
     /// A state with the given positions and velocities; force, density and pressure zero.
     ///
     /// # Panics
-    /// If the four arrays differ in length.
+    /// If the four arrays differ in length, or memory runs out.
     pub fn from_kinematics(x: Vec<f64>, y: Vec<f64>, vx: Vec<f64>, vy: Vec<f64>) -> Self {
+        let n = x.len();
+        Self::try_from_kinematics(x, y, vx, vy)
+            .unwrap_or_else(|e| panic!("no memory for {n} particles: {e}"))
+    }
+
+    /// [`State::from_kinematics`], but an allocator's refusal is an error instead of an abort
+    /// (the commands use this; [`crate::scene::memory`] checks the size first).
+    ///
+    /// # Panics
+    /// If the four arrays differ in length.
+    pub fn try_from_kinematics(
+        x: Vec<f64>,
+        y: Vec<f64>,
+        vx: Vec<f64>,
+        vy: Vec<f64>,
+    ) -> Result<Self, TryReserveError> {
         let n = x.len();
         assert!(
             y.len() == n && vx.len() == n && vy.len() == n,
             "field lengths differ"
         );
-        State {
+        Ok(State {
             x,
             y,
             vx,
             vy,
-            fx: vec![0.0; n],
-            fy: vec![0.0; n],
-            rho: vec![0.0; n],
-            p: vec![0.0; n],
-        }
+            fx: try_zeros(n)?,
+            fy: try_zeros(n)?,
+            rho: try_zeros(n)?,
+            p: try_zeros(n)?,
+        })
     }
 
     /// Number of particles.
@@ -102,6 +120,14 @@ impl State {
             .zip(self.fields())
             .find_map(|(name, values)| first_non_finite(values).map(|i| (*name, i)))
     }
+}
+
+/// `n` zeros, or the allocator's refusal as an error (where `vec![0.0; n]` would abort).
+pub fn try_zeros(n: usize) -> Result<Vec<f64>, TryReserveError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)?;
+    v.resize(n, 0.0);
+    Ok(v)
 }
 
 /// Index of the first NaN or infinity in `values`. Blocks are checked without branching

@@ -1,0 +1,209 @@
+//! How much memory a run needs, and a refusal when the machine does not have it, so that a
+//! huge `--n` ends as one `Error: ...` line rather than an allocation abort or the OOM killer.
+//!
+//! The estimate counts the arrays that grow with N, from the sizes of their element types:
+//! - the particle state: [`FIELD_NAMES`]`.len()` arrays of `f64` (64 B per particle);
+//! - the neighbour lists: a count and [`SLOTS`] slots per particle, `u32` each (132 B);
+//! - with `--neighbors grid`, the cell list: particle order and cell (`u32` each), sorted
+//!   positions (`f64` × 2), and one `u32` start per cell of the tank, which widens with N
+//!   (see [`crate::scene::dam_break`]).
+//!
+//! A unit test holds the estimate equal to what a [`crate::solver::Simulation`] allocates.
+//! Fixed costs (the binary, thread stacks, a frame of an animation) are not counted: they are
+//! megabytes, against the gigabytes this check is about.
+
+use std::mem::size_of;
+
+use crate::limits::MAX_PARTICLES;
+use crate::scene::dam_break;
+use crate::sph::neighbors::{NeighborMode, SLOTS};
+use crate::sph::params::Preset;
+use crate::sph::state::FIELD_NAMES;
+
+/// Why a run was refused.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum MemoryError {
+    /// More particles than any command accepts.
+    #[error("--n {n} is more than the {MAX_PARTICLES} particles any command accepts")]
+    TooMany {
+        /// The particle count asked for.
+        n: usize,
+    },
+    /// More memory than the machine has available.
+    #[error(
+        "--n {n} needs about {} of memory ({neighbors} search); this machine has {} available",
+        human_bytes(*.needs), human_bytes(*.available)
+    )]
+    TooLarge {
+        /// The particle count asked for.
+        n: usize,
+        /// The neighbour search.
+        neighbors: NeighborMode,
+        /// Estimated bytes ([`estimate`]).
+        needs: u64,
+        /// Bytes available ([`available_bytes`]).
+        available: u64,
+    },
+}
+
+/// Bytes the arrays of a run of `n` particles of `preset` with `neighbors` search hold (see
+/// the module docs). Saturates instead of overflowing, so any `n` gives an answer.
+pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
+    let n64 = n as u64;
+    let per_particle = FIELD_NAMES.len() * size_of::<f64>() + (1 + SLOTS) * size_of::<u32>();
+    let mut bytes = n64.saturating_mul(per_particle as u64);
+    if neighbors == NeighborMode::Grid {
+        let grid_per_particle = 2 * size_of::<u32>() + 2 * size_of::<f64>();
+        let params = preset.params();
+        let domain = dam_break::domain(preset, n);
+        // As `Grid::new` sizes it: floor(extent / h) + 1 cells along each axis, and one start
+        // more than there are cells. Float-to-int casts saturate.
+        let cols = (domain.width / params.h) as u64 + 1;
+        let rows = (domain.height / params.h) as u64 + 1;
+        let starts = cols.saturating_mul(rows).saturating_add(1);
+        bytes = bytes
+            .saturating_add(n64.saturating_mul(grid_per_particle as u64))
+            .saturating_add(starts.saturating_mul(size_of::<u32>() as u64));
+    }
+    bytes
+}
+
+/// Refuses a run of `n` particles that exceeds [`MAX_PARTICLES`], or whose [`estimate`]
+/// exceeds `available` bytes. With `available` unknown (`None`), only the hard limit applies.
+pub fn check(
+    preset: Preset,
+    neighbors: NeighborMode,
+    n: usize,
+    available: Option<u64>,
+) -> Result<(), MemoryError> {
+    if n > MAX_PARTICLES {
+        return Err(MemoryError::TooMany { n });
+    }
+    let needs = estimate(preset, neighbors, n);
+    match available {
+        Some(available) if needs > available => Err(MemoryError::TooLarge {
+            n,
+            neighbors,
+            needs,
+            available,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// The memory the kernel says can be allocated without swapping (`MemAvailable` in
+/// `/proc/meminfo`), bytes; `None` where that cannot be read (not Linux, old kernels).
+pub fn available_bytes() -> Option<u64> {
+    parse_mem_available(&std::fs::read_to_string("/proc/meminfo").ok()?)
+}
+
+/// `MemAvailable: 123 kB` from the text of `/proc/meminfo`, in bytes.
+fn parse_mem_available(meminfo: &str) -> Option<u64> {
+    let line = meminfo.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let mut words = line.split_whitespace().skip(1);
+    let value: u64 = words.next()?.parse().ok()?;
+    match words.next() {
+        Some("kB") => value.checked_mul(1024),
+        None => Some(value),
+        Some(_) => None,
+    }
+}
+
+/// `bytes` in SI units to two significant digits: `230 GB`, `21 GB`, `5.4 GB`, `950 MB`.
+pub fn human_bytes(bytes: u64) -> String {
+    const UNITS: [(&str, f64); 4] = [("GB", 1e9), ("MB", 1e6), ("kB", 1e3), ("B", 1.0)];
+    let b = bytes as f64;
+    let (unit, scale) = UNITS
+        .into_iter()
+        .find(|&(_, scale)| b >= scale)
+        .unwrap_or(UNITS[3]);
+    let v = b / scale;
+    if v >= 100.0 {
+        format!("{:.0} {unit}", (v / 10.0).round() * 10.0)
+    } else if v >= 10.0 || unit == "B" {
+        format!("{v:.0} {unit}")
+    } else {
+        format!("{v:.1} {unit}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::Simulation;
+
+    #[test]
+    fn the_estimate_is_what_a_simulation_allocates() {
+        for preset in Preset::ALL {
+            for mode in NeighborMode::ALL {
+                for n in [1, 1000, 5000] {
+                    let state = dam_break::initial_state(preset, n, 1);
+                    let domain = dam_break::domain(preset, n);
+                    let state_bytes: usize = state
+                        .fields()
+                        .iter()
+                        .map(|f| std::mem::size_of_val(*f))
+                        .sum();
+                    let sim = Simulation::new(preset.params(), domain, state, mode);
+                    let held = (state_bytes + sim.neighbor_heap_bytes()) as u64;
+                    assert_eq!(estimate(preset, mode, n), held, "{preset} {mode} {n}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_billion_particles_on_the_grid_need_about_230_gb_and_are_refused_on_21() {
+        let needs = estimate(Preset::Seed, NeighborMode::Grid, 1_000_000_000);
+        assert_eq!(human_bytes(needs), "230 GB");
+        // The hard limit comes first; below it the same rule gives the same sentence.
+        assert_eq!(
+            check(Preset::Seed, NeighborMode::Grid, 1_000_000_000, None),
+            Err(MemoryError::TooMany { n: 1_000_000_000 })
+        );
+        let err = MemoryError::TooLarge {
+            n: 1_000_000_000,
+            neighbors: NeighborMode::Grid,
+            needs,
+            available: 21_300_000_000,
+        };
+        assert_eq!(
+            err.to_string(),
+            "--n 1000000000 needs about 230 GB of memory (grid search); \
+             this machine has 21 GB available"
+        );
+    }
+
+    #[test]
+    fn a_run_that_fits_passes_and_one_that_does_not_is_refused() {
+        let n = MAX_PARTICLES;
+        let needs = estimate(Preset::Cpp, NeighborMode::AllPairs, n);
+        assert!(check(Preset::Cpp, NeighborMode::AllPairs, n, Some(needs)).is_ok());
+        assert!(check(Preset::Cpp, NeighborMode::AllPairs, n, None).is_ok());
+        let err = check(Preset::Cpp, NeighborMode::AllPairs, n, Some(needs - 1)).unwrap_err();
+        assert!(err.to_string().contains("(all-pairs search)"), "{err}");
+        assert_eq!(
+            check(Preset::Seed, NeighborMode::Grid, usize::MAX, Some(u64::MAX)),
+            Err(MemoryError::TooMany { n: usize::MAX })
+        );
+        assert_eq!(
+            estimate(Preset::Seed, NeighborMode::Grid, usize::MAX),
+            u64::MAX
+        );
+    }
+
+    #[test]
+    fn mem_available_is_read_in_kilobytes() {
+        let text = "MemTotal:       24000000 kB\nMemAvailable:   21000000 kB\n";
+        assert_eq!(parse_mem_available(text), Some(21_000_000 * 1024));
+        assert_eq!(parse_mem_available("MemTotal: 5 kB\n"), None);
+    }
+
+    #[test]
+    fn sizes_are_shown_to_two_significant_digits() {
+        assert_eq!(human_bytes(21_900_000_000), "22 GB");
+        assert_eq!(human_bytes(5_440_000_000), "5.4 GB");
+        assert_eq!(human_bytes(950_000_000), "950 MB");
+        assert_eq!(human_bytes(12), "12 B");
+    }
+}
