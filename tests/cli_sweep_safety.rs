@@ -509,3 +509,34 @@ fn force_replaces_a_sweeps_earlier_report_and_keeps_foreign_files() {
             .contains("trace")
     );
 }
+
+#[test]
+fn a_group_larger_than_the_available_memory_is_refused_before_anything_is_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    let o = bench_sph()
+        .args([
+            "sweep",
+            "--n",
+            "1000,200000",
+            "--neighbors",
+            "grid",
+            "--strategies",
+            "seq",
+            "--out",
+            dir.to_str().unwrap(),
+        ])
+        .env("BENCH_SPH_FAKE_MEM_AVAILABLE", "10000000")
+        .output()
+        .unwrap();
+    assert!(!o.status.success());
+    no_panic(&o);
+    let err = text(&o.stderr);
+    assert!(
+        err.starts_with("Error: the group preset seed, grid, N = 200000")
+            && err.contains("needs about")
+            && err.contains("available"),
+        "{err}"
+    );
+    assert!(!dir.exists(), "nothing is written");
+}

@@ -13,11 +13,6 @@ use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
 use crate::sph::state::{Domain, State};
 
-/// Hidden, for tests: the bytes of memory to take as available instead of `MemAvailable` in
-/// `/proc/meminfo`, so that the refusal of a run too large for the machine can be tested on
-/// any machine (e.g. `BENCH_SPH_FAKE_MEM_AVAILABLE=1000000`).
-pub const FAKE_MEM_AVAILABLE_VAR: &str = "BENCH_SPH_FAKE_MEM_AVAILABLE";
-
 /// Which scene to simulate, and with which neighbour search.
 #[derive(Debug, Clone)]
 pub struct SceneArgs {
@@ -89,12 +84,9 @@ impl Args for SceneArgs {
     }
 }
 
-/// The memory available to a run: [`FAKE_MEM_AVAILABLE_VAR`] if set, else the kernel's figure.
+/// The memory available to a run (see [`memory::available_for_run`]).
 pub(super) fn memory_available() -> Option<u64> {
-    match std::env::var(FAKE_MEM_AVAILABLE_VAR) {
-        Ok(bytes) => bytes.parse().ok(),
-        Err(_) => memory::available_bytes(),
-    }
+    memory::available_for_run()
 }
 
 impl SceneArgs {

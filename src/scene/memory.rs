@@ -91,6 +91,20 @@ pub fn check(
     }
 }
 
+/// Hidden, for tests: the bytes of memory to take as available instead of `MemAvailable` in
+/// `/proc/meminfo`, so that the refusal of a run too large for the machine can be tested on
+/// any machine (e.g. `BENCH_SPH_FAKE_MEM_AVAILABLE=1000000`).
+pub const FAKE_MEM_AVAILABLE_VAR: &str = "BENCH_SPH_FAKE_MEM_AVAILABLE";
+
+/// The memory available to a run: [`FAKE_MEM_AVAILABLE_VAR`] if set, else
+/// [`available_bytes`].
+pub fn available_for_run() -> Option<u64> {
+    match std::env::var(FAKE_MEM_AVAILABLE_VAR) {
+        Ok(bytes) => bytes.parse().ok(),
+        Err(_) => available_bytes(),
+    }
+}
+
 /// The memory the kernel says can be allocated without swapping (`MemAvailable` in
 /// `/proc/meminfo`), bytes; `None` where that cannot be read (not Linux, old kernels).
 pub fn available_bytes() -> Option<u64> {

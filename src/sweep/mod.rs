@@ -275,6 +275,25 @@ fn finished_references(
         .collect()
 }
 
+/// Refuses, before anything is allocated, a group too large for the machine's memory: a run
+/// needs [`memory::estimate`] bytes, and the sweep keeps one more copy of the group's
+/// initial state (its positions and velocities: 4 f64 per particle) to start every run from.
+fn check_memory(plan: &Plan) -> anyhow::Result<()> {
+    use crate::scene::memory;
+    let available = memory::available_for_run();
+    for g in &plan.groups {
+        let copy = (g.n as u64).saturating_mul(4 * 8);
+        memory::check(
+            g.preset,
+            g.neighbors,
+            g.n,
+            available.map(|a| a.saturating_sub(copy)),
+        )
+        .with_context(|| format!("the group {} cannot run here", g.label()))?;
+    }
+    Ok(())
+}
+
 /// What the check before the plan saw.
 #[derive(Debug, Clone, Copy)]
 struct Busy {
@@ -389,6 +408,7 @@ fn start_new(
     session: Session,
 ) -> anyhow::Result<Opened> {
     params.validate()?;
+    check_memory(&Plan::new(params))?;
     let dir = match out {
         Some(dir) => dir.to_path_buf(),
         None => dir::new_default()?,
@@ -421,6 +441,7 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
         )
     })?;
     let plan = Plan::new(&meta.params);
+    check_memory(&plan)?;
     let planned: HashSet<CellKey> = plan.cells.iter().map(|c| c.key()).collect();
     let trials = meta.params.trials;
     let check = |row: &SummaryRow| -> Result<(), String> {
