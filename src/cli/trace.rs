@@ -106,10 +106,13 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
         tolerates: &claim::nothing,
     };
     let claimed = claim::claim(&args.out, &owner, args.force)?;
-    let paths = files::ALL
-        .iter()
-        .map(|name| claimed.check_writable(name))
-        .collect::<anyhow::Result<Vec<PathBuf>>>()?;
+    let path = |name| claimed.check_writable(name);
+    let paths = [
+        path(files::TRACE_JSON)?,
+        path(files::TIMELINE_PNG)?,
+        path(files::STATS_CSV)?,
+        path(files::META_JSON)?,
+    ];
 
     let info = args.strategy.info();
     let config = TraceConfig {
@@ -131,48 +134,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
             args.scene.neighbors,
         )
     };
-    let traced = |sim: &mut Simulation| -> anyhow::Result<TracedRun> {
-        Ok(run_traced(
-            sim,
-            args.strategy,
-            &strategy_config,
-            args.steps,
-            args.warmup,
-        )?)
-    };
-
-    let mut comparison = Comparison {
-        untraced: Vec::new(),
-        traced: Vec::new(),
-    };
-    let mut last = None;
-    for _ in 0..args.compare.unwrap_or(0) {
-        let mut plain = fresh();
-        let elapsed = run_untraced(
-            &mut plain,
-            args.strategy,
-            &strategy_config,
-            args.steps,
-            args.warmup,
-        )?;
-        comparison.untraced.push(elapsed.wall_s);
-        let mut sim = fresh();
-        let run = traced(&mut sim)?;
-        comparison.traced.push(run.elapsed.wall_s);
-        anyhow::ensure!(
-            checksum_hex(&sim.state) == checksum_hex(&plain.state),
-            "the traced run's final state differs from the untraced run's (a bug)"
-        );
-        last = Some((sim, run));
-    }
-    let (sim, run) = match last {
-        Some(last) => last,
-        None => {
-            let mut sim = fresh();
-            let run = traced(&mut sim)?;
-            (sim, run)
-        }
-    };
+    let (sim, run, comparison) = record(args, &strategy_config, fresh)?;
 
     size::check_recorded(
         args.strategy,
@@ -211,17 +173,60 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
     print(&lines, &claimed)
 }
 
+/// The traced run whose files are written, after `--compare`'s alternating untraced and
+/// traced runs when asked for (each from a `fresh` simulation).
+fn record(
+    args: &TraceArgs,
+    config: &Config,
+    fresh: impl Fn() -> Simulation,
+) -> anyhow::Result<(Simulation, TracedRun, Comparison)> {
+    let traced = |sim: &mut Simulation| -> anyhow::Result<TracedRun> {
+        Ok(run_traced(
+            sim,
+            args.strategy,
+            config,
+            args.steps,
+            args.warmup,
+        )?)
+    };
+    let mut comparison = Comparison {
+        untraced: Vec::new(),
+        traced: Vec::new(),
+    };
+    let mut last = None;
+    for _ in 0..args.compare.unwrap_or(0) {
+        let mut plain = fresh();
+        let elapsed = run_untraced(&mut plain, args.strategy, config, args.steps, args.warmup)?;
+        comparison.untraced.push(elapsed.wall_s);
+        let mut sim = fresh();
+        let run = traced(&mut sim)?;
+        comparison.traced.push(run.elapsed.wall_s);
+        anyhow::ensure!(
+            checksum_hex(&sim.state) == checksum_hex(&plain.state),
+            "the traced run's final state differs from the untraced run's (a bug)"
+        );
+        last = Some((sim, run));
+    }
+    let (sim, run) = match last {
+        Some(last) => last,
+        None => {
+            let mut sim = fresh();
+            let run = traced(&mut sim)?;
+            (sim, run)
+        }
+    };
+    Ok((sim, run, comparison))
+}
+
 /// Writes the four files, each to a temporary name, and renames them into place only once
 /// all four are complete (meta.json last): an error leaves the earlier files as they were.
 fn write_files(
-    paths: &[PathBuf],
+    paths: &[PathBuf; 4],
     run: &TracedRun,
     stats: &Stats,
     meta: &Meta<'_>,
 ) -> anyhow::Result<()> {
-    let [trace_json, timeline_png, stats_csv, meta_json] = paths else {
-        unreachable!("one path per file of files::ALL");
-    };
+    let [trace_json, timeline_png, stats_csv, meta_json] = paths;
     let config = meta.config;
     let mut out = AtomicFile::create(trace_json)?;
     chrome::write(&run.trace, &stats.workers, config, &mut out)

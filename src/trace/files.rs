@@ -16,8 +16,6 @@ pub const TIMELINE_PNG: &str = "timeline.png";
 pub const STATS_CSV: &str = "stats.csv";
 /// The configuration and totals.
 pub const META_JSON: &str = "meta.json";
-/// Every file `trace` writes, in the order it commits them (`meta.json` last).
-pub const ALL: [&str; 4] = [TRACE_JSON, TIMELINE_PNG, STATS_CSV, META_JSON];
 
 /// The first bytes of every PNG file.
 pub const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n'];
