@@ -1,11 +1,13 @@
 //! `bench-sph trace` driven through the built binary: for every strategy, trace.json holds
 //! exactly one complete event per kernel call, covering every particle of every pass of every
 //! step once, on at most `cores` workers whose events never overlap; timeline.png and
-//! stats.csv are there and well formed; bad input is one `Error: ...` line and a non-zero
-//! exit. No test asserts a duration.
+//! stats.csv are there and well formed; the output directory is claimed (foreign files are
+//! refused, never replaced) and every file is written whole; an oversized trace is refused
+//! before it runs; `report` embeds only valid trace directories; bad input is one
+//! `Error: ...` line and a non-zero exit. No test asserts a duration.
 
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use serde_json::Value;
@@ -343,10 +345,7 @@ fn an_unwritable_output_directory_is_an_error_before_anything_runs() {
     ]);
     let err = stderr(&o);
     assert!(!o.status.success());
-    assert!(
-        err.starts_with("Error: cannot create output directory"),
-        "{err}"
-    );
+    assert!(err.starts_with("Error: cannot create directory"), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
 
@@ -395,6 +394,251 @@ fn bad_counts_and_names_are_rejected() {
         &[&base[..], &["seq", "--compare", "x"]].concat(),
         "whole number",
     );
+    fails_with(
+        &[&base[..], &["seq", "--warmup", "1001"]].concat(),
+        "warm-ups must be between 0 and 1000, not 1001",
+    );
     fails_with(&["trace", "--strategy", "seq"], "--out");
     assert!(!Path::new("unused-dir").exists());
+}
+
+/// Runs and expects exactly one `Error: ...` line containing `needle` and a failure.
+fn one_error_line(o: &Output, needle: &str) -> String {
+    let err = stderr(o);
+    assert!(!o.status.success(), "succeeded: {}", stdout(o));
+    assert!(err.starts_with("Error: ") && err.contains(needle), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    err
+}
+
+/// The names in `dir`, sorted.
+fn names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
+/// The bytes of every file in `dir`, by name.
+fn contents(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    names(dir)
+        .into_iter()
+        .map(|n| {
+            let bytes = std::fs::read(dir.join(&n)).unwrap();
+            (n, bytes)
+        })
+        .collect()
+}
+
+/// A finished sweep: the report fixture's meta.json, summary.csv and trials.csv.
+fn finished_sweep(dir: &Path) {
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/report-results");
+    std::fs::create_dir_all(dir).unwrap();
+    for name in ["meta.json", "summary.csv", "trials.csv"] {
+        std::fs::copy(fixture.join(name), dir.join(name)).unwrap();
+    }
+}
+
+fn meta(dir: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn trace_into_a_finished_sweep_directory_is_refused_and_the_sweep_is_untouched() {
+    let tmp = tempfile::tempdir().unwrap();
+    let sweep = tmp.path().join("sweep");
+    finished_sweep(&sweep);
+    let before = contents(&sweep);
+    let o = trace(StrategyName::Seq, &sweep, &[]);
+    one_error_line(
+        &o,
+        "holds files that bench-sph trace did not write ('meta.json', ",
+    );
+    assert!(stderr(&o).contains("--force"), "{}", stderr(&o));
+    let o = trace(StrategyName::Seq, &sweep, &["--force"]);
+    one_error_line(
+        &o,
+        "meta.json': it exists and was not written by bench-sph trace",
+    );
+    assert_eq!(contents(&sweep), before, "nothing of the sweep changed");
+}
+
+#[test]
+fn force_writes_beside_foreign_files_and_leaves_them_as_they_are() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(tmp.path().join("notes.txt"), "mine").unwrap();
+    let o = trace(StrategyName::Seq, tmp.path(), &[]);
+    one_error_line(&o, "('notes.txt')");
+    let o = trace(StrategyName::Seq, tmp.path(), &["--force"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        names(tmp.path()),
+        [
+            "meta.json",
+            "notes.txt",
+            "stats.csv",
+            "timeline.png",
+            "trace.json"
+        ]
+    );
+    assert_eq!(
+        std::fs::read_to_string(tmp.path().join("notes.txt")).unwrap(),
+        "mine"
+    );
+}
+
+#[test]
+fn a_second_trace_replaces_its_own_files_and_meta_json_names_the_tool_and_warm_up() {
+    let tmp = tempfile::tempdir().unwrap();
+    let o = trace(StrategyName::RayonChunks, tmp.path(), &["--warmup", "2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = trace(StrategyName::Seq, tmp.path(), &["--warmup", "0"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let m = meta(tmp.path());
+    assert_eq!(m["tool"], "bench-sph trace");
+    assert_eq!(m["strategy"], "seq");
+    assert_eq!(m["warmup_steps"], 0);
+    assert_eq!(
+        names(tmp.path()),
+        ["meta.json", "stats.csv", "timeline.png", "trace.json"],
+        "no temporary files remain"
+    );
+    assert!(stdout(&o).contains("2 steps recorded after 0 warm-up steps"));
+}
+
+#[test]
+fn a_failed_trace_leaves_an_earlier_trace_in_its_directory_as_it_was() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("t");
+    let o = trace(StrategyName::Seq, &out, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let before = contents(&out);
+    let init = tmp.path().join("boom.csv");
+    std::fs::write(&init, "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n").unwrap();
+    let o = bench_sph(&[
+        "trace",
+        "--strategy",
+        "seq",
+        "--init",
+        init.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    one_error_line(&o, "diverged at step 1");
+    assert_eq!(contents(&out), before);
+}
+
+#[test]
+fn a_trace_too_large_is_refused_before_it_runs_naming_the_estimate_and_what_to_lower() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("big");
+    let o = bench_sph(&[
+        "trace",
+        "--strategy",
+        "rayon-spawn",
+        "--n",
+        "20000",
+        "--steps",
+        "50",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    one_error_line(
+        &o,
+        "a trace of rayon-spawn with N = 20000 over 50 steps would record about 3000100 events \
+         (about 510 MB of trace.json); the most is 1000000: lower --steps or --n",
+    );
+    assert!(!out.exists(), "nothing was created");
+}
+
+#[test]
+fn when_only_one_of_two_workers_ran_kernels_the_summary_says_so_plainly() {
+    let tmp = tempfile::tempdir().unwrap();
+    // One particle: std-static makes one block per pass, so one of its two workers never
+    // gets one.
+    let o = bench_sph(&[
+        "trace",
+        "--strategy",
+        "std-static",
+        "--cores",
+        "2",
+        "--n",
+        "1",
+        "--out",
+        tmp.path().to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(
+        out.contains(
+            "\nonly 1 of 2 workers ran kernels in the recorded steps; the timeline does not \
+             show parallel execution\n"
+        ),
+        "{out}"
+    );
+    assert_eq!(meta(tmp.path())["workers_used"], 1);
+}
+
+/// A copy of a real trace in `dir`.
+fn real_trace(dir: &Path) {
+    let o = trace(StrategyName::RayonChunks, dir, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+fn report(results: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["report", results.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    bench_sph(&args)
+}
+
+#[test]
+fn report_refuses_a_named_trace_directory_whose_timeline_is_not_a_png() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    finished_sweep(&results);
+    let junk: PathBuf = tmp.path().join("junk");
+    real_trace(&junk);
+    std::fs::write(junk.join("timeline.png"), "not a png").unwrap();
+    let o = report(&results, &["--trace", junk.to_str().unwrap()]);
+    one_error_line(&o, "is not a valid trace: timeline.png is not a PNG image");
+}
+
+#[test]
+fn report_skips_a_junk_trace_found_under_the_results_with_a_warning_and_embeds_a_good_one() {
+    let tmp = tempfile::tempdir().unwrap();
+    let results = tmp.path().join("results");
+    finished_sweep(&results);
+    real_trace(&results.join("trace-good"));
+    let junk = results.join("trace-junk");
+    real_trace(&junk);
+    std::fs::write(junk.join("stats.csv"), "kind,name\nnonsense,1\n").unwrap();
+    let o = report(&results, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let warning = err
+        .lines()
+        .find(|l| l.contains("trace-junk"))
+        .unwrap_or_else(|| panic!("no warning about trace-junk:\n{err}"));
+    assert!(
+        warning.starts_with("warning: skipping trace directory '")
+            && warning.ends_with("': stats.csv does not have the trace's columns (kind,name,threads,kernel_calls,busy_ms,span_ms,idle_pct,imbalance)"),
+        "{warning}"
+    );
+    let md = std::fs::read_to_string(results.join("REPORT.md")).unwrap();
+    assert!(md.contains("](trace-good/timeline.png)"), "{md}");
+    assert!(!md.contains("trace-junk"), "{md}");
+    let traces = &md[md.find("## Traces").unwrap()..];
+    for number in traces
+        .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+        .filter(|w| w.contains('.') && w.len() > 1)
+    {
+        let digits = number
+            .trim_start_matches(['0', '.'])
+            .chars()
+            .filter(char::is_ascii_digit)
+            .count();
+        assert!(digits <= 3, "{number} has more than 3 significant digits");
+    }
 }

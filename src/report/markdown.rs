@@ -93,7 +93,7 @@ pub fn render(input: &Input<'_>) -> String {
     }
     across_groups(&mut md, input);
     failed(&mut md, &rows);
-    traces(&mut md, input.traces);
+    md.push_str(&super::traces::markdown(input.traces));
     md
 }
 
@@ -450,72 +450,6 @@ fn failed(md: &mut String, rows: &[SummaryRow]) {
         );
     }
     md.push('\n');
-}
-
-fn traces(md: &mut String, traces: &[TraceDir]) {
-    if traces.is_empty() {
-        return;
-    }
-    let _ = writeln!(
-        md,
-        "## Traces\n\nTimelines from `bench-sph trace` (one bar per kernel call; white where a \
-         worker is idle).\n"
-    );
-    for t in traces {
-        let _ = writeln!(md, "### {}\n", t.title);
-        let _ = writeln!(md, "![timeline: {}]({})\n", t.title, t.image);
-        let _ = writeln!(
-            md,
-            "| pass | kernel calls | busy (ms) | span (ms) | idle % | imbalance |\n|---|---:|---:|---:|---:|---:|"
-        );
-        for r in t.stats.iter().filter(|r| r.kind == "pass") {
-            let _ = writeln!(
-                md,
-                "| {} | {} | {:.3} | {:.3} | {:.1} | {} |",
-                r.name,
-                r.kernel_calls,
-                r.busy_ms,
-                r.span_ms,
-                r.idle_pct,
-                r.imbalance
-                    .map_or_else(|| "—".to_owned(), |v| format!("{v:.2}"))
-            );
-        }
-        if let Some(total) = t.stats.iter().find(|r| r.kind == "total") {
-            let _ = writeln!(
-                md,
-                "\nIn total {} kernel calls on {} threads; the workers were idle {:.1} % of the \
-                 {:.3} ms loop.",
-                total.kernel_calls,
-                total.threads.unwrap_or(0),
-                total.idle_pct,
-                total.span_ms
-            );
-            let _ = writeln!(md, "\n{}", trace_reading(total));
-        }
-        md.push('\n');
-    }
-}
-
-/// One sentence on what a timeline shows: how much work a kernel call carries and what the
-/// idle share says about per-call overhead.
-fn trace_reading(total: &super::traces::StatsRow) -> String {
-    let per_call_us = 1000.0 * total.busy_ms / total.kernel_calls.max(1) as f64;
-    let grain = format!("a kernel call carries {per_call_us:.1} µs of work on average");
-    if total.idle_pct > 50.0 {
-        format!(
-            "What it shows: {grain}, too little to pay for scheduling it — the workers spend most \
-             of the loop ({:.0} %) between calls, which is why this strategy loses to larger chunks.",
-            total.idle_pct
-        )
-    } else {
-        format!(
-            "What it shows: {grain}, enough to hide the scheduling cost — the workers stay busy \
-             {:.0} % of the loop, and the gaps are the short forces and integrate passes and the \
-             waits at the end of each pass.",
-            100.0 - total.idle_pct
-        )
-    }
 }
 
 #[cfg(test)]

@@ -9,14 +9,19 @@
 //! nor the threads, and untraced runs never see it, so they pay nothing. The calling thread's
 //! serial work between passes (grid rebuild, divergence check) is recorded too.
 //!
+//! Before recording, a few unrecorded warm-up steps wake the pool's threads ([`session`]);
+//! before anything runs, the trace's size is estimated and capped ([`size::MAX_EVENTS`]).
+//!
 //! The [`Trace`] then becomes `trace.json` ([`chrome`], for Perfetto or `chrome://tracing`),
 //! `timeline.png` ([`timeline`], a Gantt chart) and `stats.csv` ([`stats`]), all written by
-//! pure exporters to `impl Write`.
+//! pure exporters to `impl Write`; [`files`] names them and recognises a trace directory.
 
 pub mod chrome;
 pub mod executor;
+pub mod files;
 pub mod recorder;
 pub mod session;
+pub mod size;
 pub mod stats;
 pub mod timeline;
 
@@ -27,7 +32,7 @@ use crate::sph::params::Preset;
 
 pub use executor::TracingExecutor;
 pub use recorder::{KernelEvent, Recorder, SerialEvent, SerialWork, ThreadInfo, Trace};
-pub use session::{TracedRun, expected_workers, run_traced};
+pub use session::{TracedRun, expected_workers, run_traced, run_untraced};
 
 /// What was traced: shown in titles and written to `trace.json`'s `otherData` and `meta.json`.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]

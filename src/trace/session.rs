@@ -1,13 +1,23 @@
 //! A traced run: the same step loop as [`crate::run::run_timed`], pass by pass, so that every
 //! kernel call is known to belong to one pass of one step.
+//!
+//! Both traced and untraced runs here first **warm up** the strategy's threads: a few
+//! untimed, unrecorded steps on a copy of the initial state, on the same pool, right before
+//! the recorded steps. A freshly built pool's threads are still starting or asleep, and a
+//! first few steps of small chunks can then all run on the thread that started them; the
+//! committed `rayon-chunks` timeline once showed 405 kernel calls on one of two workers for
+//! that reason. The copy leaves the recorded steps exactly those of an untraced run from the
+//! same state.
 
 use sph_strategies::{Config, Executor, Session, StrategyName};
 
 use super::executor::TracingExecutor;
 use super::recorder::{Phase, Recorder, SerialWork, Trace};
+use super::size::{MAX_EVENTS, Plan};
 use crate::clock::{Elapsed, Stopwatch};
 use crate::run::RunError;
 use crate::solver::{Pass, Simulation, StepError};
+use crate::sph::neighbors::NeighborMode;
 
 /// What a traced run gives back.
 #[derive(Debug)]
@@ -27,26 +37,47 @@ pub fn expected_workers(strategy: StrategyName, cores: usize) -> usize {
     }
 }
 
-/// A guess of the kernel calls one worker makes over `steps` steps of `n` particles,
-/// used only to preallocate its event buffer (buffers still grow if it is short).
+/// The kernel calls one worker is expected to make (from [`Plan::kernel_calls`], counting the
+/// grid rebuild's calls whichever search runs), used only to preallocate its event buffer
+/// (buffers still grow if it is short).
 fn capacity_hint(strategy: StrategyName, config: &Config, n: usize, steps: usize) -> usize {
-    let per_pass = if strategy.info().uses_chunks {
-        config.chunks.min(n)
-    } else {
-        n
-    };
-    // Three passes and the grid rebuild's (at most two) calls per step.
-    let total = per_pass * (Pass::ALL.len() + 2) * steps;
-    // Twice a fair share, so that a moderately unbalanced run never reallocates.
-    (2 * total)
-        .div_ceil(expected_workers(strategy, config.cores))
+    let total = Plan {
+        strategy,
+        n,
+        chunks: config.chunks,
+        cores: config.cores,
+        steps,
+        neighbors: NeighborMode::Grid,
+    }
+    .kernel_calls();
+    // Twice a fair share, so that a moderately unbalanced run never reallocates, but never
+    // more than `MAX_EVENTS` preallocated over all workers (a buffer that fills grows).
+    let workers = expected_workers(strategy, config.cores);
+    total
+        .saturating_mul(2)
+        .div_ceil(workers)
         .min(total)
-        .min(1 << 22)
+        .min(MAX_EVENTS / workers)
+}
+
+/// Runs `steps` steps of a copy of `sim` on `exec`, discarding the copy. A copy that diverges
+/// only ends the warm-up early (the recorded run reports its own divergence, if it reaches
+/// it); a kernel's panic is an error.
+fn warm_up<E: Executor>(exec: &E, sim: &Simulation, steps: usize) -> Result<(), StepError> {
+    if steps == 0 {
+        return Ok(());
+    }
+    let mut copy = sim.clone();
+    match copy.advance(exec, steps) {
+        Ok(()) | Err(StepError::Diverged { .. }) => Ok(()),
+        Err(e) => Err(e),
+    }
 }
 
 struct TracedSteps<'a> {
     sim: &'a mut Simulation,
     steps: usize,
+    warmup: usize,
     recorder: &'a Recorder,
 }
 
@@ -55,6 +86,7 @@ impl Session for TracedSteps<'_> {
 
     fn run<E: Executor>(self, exec: &E) -> Self::Output {
         let (sim, rec) = (self.sim, self.recorder);
+        warm_up(exec, sim, self.warmup)?;
         let watch = Stopwatch::start();
         let loop_start = rec.now_ns();
         for _ in 0..self.steps {
@@ -91,8 +123,10 @@ impl Session for TracedSteps<'_> {
     }
 }
 
-/// Runs `steps` steps of `sim` with `strategy`, recording every kernel call (and the caller's
-/// grid rebuild and divergence check), and returns the timing and the trace.
+/// Runs `warmup` unrecorded steps on a copy of `sim`, then `steps` steps of `sim` with
+/// `strategy`, recording every kernel call (and the caller's grid rebuild and divergence
+/// check), and returns the timing and the trace. The caller checks the trace's size first
+/// ([`Plan::check`]).
 ///
 /// The physics is exactly that of an untraced run (the same passes, chunks and threads), so
 /// the final state has the same bits.
@@ -101,6 +135,7 @@ pub fn run_traced(
     strategy: StrategyName,
     config: &Config,
     steps: usize,
+    warmup: usize,
 ) -> Result<TracedRun, RunError> {
     let workers = expected_workers(strategy, config.cores);
     let per_worker = capacity_hint(strategy, config, sim.state.len(), steps);
@@ -108,6 +143,7 @@ pub fn run_traced(
     let session = TracedSteps {
         sim,
         steps,
+        warmup,
         recorder: &recorder,
     };
     let result = sph_strategies::run(strategy, config, session)
@@ -119,13 +155,44 @@ pub fn run_traced(
     })
 }
 
+struct UntracedSteps<'a> {
+    sim: &'a mut Simulation,
+    steps: usize,
+    warmup: usize,
+}
+
+impl Session for UntracedSteps<'_> {
+    type Output = Result<Elapsed, StepError>;
+
+    fn run<E: Executor>(self, exec: &E) -> Self::Output {
+        warm_up(exec, self.sim, self.warmup)?;
+        let watch = Stopwatch::start();
+        self.sim.advance(exec, self.steps)?;
+        Ok(watch.stop())
+    }
+}
+
+/// [`run_traced`] without the recording: the same warm-up, then `steps` timed steps. The
+/// untraced side of `trace --compare`.
+pub fn run_untraced(
+    sim: &mut Simulation,
+    strategy: StrategyName,
+    config: &Config,
+    steps: usize,
+    warmup: usize,
+) -> Result<Elapsed, RunError> {
+    let session = UntracedSteps { sim, steps, warmup };
+    let result = sph_strategies::run(strategy, config, session)
+        .map_err(|source| RunError::Build { strategy, source })?;
+    Ok(result?)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::checksum::checksum_hex;
     use crate::run::run_timed;
     use crate::scene::dam_break;
-    use crate::sph::neighbors::NeighborMode;
     use crate::sph::params::Preset;
 
     fn sim(n: usize) -> Simulation {
@@ -148,9 +215,16 @@ mod tests {
             let mut plain = sim(90);
             run_timed(&mut plain, strategy, &config, 3).unwrap();
             let mut traced = sim(90);
-            let run = run_traced(&mut traced, strategy, &config, 3).unwrap();
+            let run = run_traced(&mut traced, strategy, &config, 3, 2).unwrap();
             assert_eq!(checksum_hex(&traced.state), checksum_hex(&plain.state));
-            assert_eq!(traced.steps_done, 3);
+            assert_eq!(traced.steps_done, 3, "the warm-up ran on a copy");
+            let steps: Vec<usize> = run.trace.kernels.iter().map(|e| e.step).collect();
+            assert_eq!(
+                steps.iter().min(),
+                Some(&1),
+                "{strategy}: warm-up not recorded"
+            );
+            assert_eq!(steps.iter().max(), Some(&3), "{strategy}");
             assert_eq!(run.trace.serial.len(), 2 * 3, "{strategy}");
             assert!(
                 run.trace.workers <= expected_workers(strategy, 2),
@@ -169,7 +243,7 @@ mod tests {
             cores: 2,
             chunks: 3,
         };
-        let err = run_traced(&mut s, StrategyName::RayonChunks, &config, 5).unwrap_err();
+        let err = run_traced(&mut s, StrategyName::RayonChunks, &config, 5, 0).unwrap_err();
         assert!(
             matches!(err, RunError::Step(StepError::Diverged { step: 1, .. })),
             "{err}"

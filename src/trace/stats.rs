@@ -67,6 +67,8 @@ pub struct TotalStats {
     pub kernel_calls: usize,
     /// Distinct OS threads that ran kernel calls.
     pub worker_threads: usize,
+    /// Worker tracks that ran at least one kernel call (see [`idle_workers_note`]).
+    pub workers_used: usize,
     /// Nanoseconds inside kernel calls, summed over workers.
     pub busy_ns: u64,
     /// Nanoseconds of serial work (grid rebuild, divergence check) on the calling thread.
@@ -131,6 +133,7 @@ pub fn compute(trace: &Trace) -> Stats {
     let total = TotalStats {
         kernel_calls: trace.kernels.len(),
         worker_threads: trace.threads.len(),
+        workers_used: workers.iter().filter(|w| w.kernel_calls > 0).count(),
         busy_ns,
         serial_ns: trace.serial.iter().map(|e| e.end_ns - e.start_ns).sum(),
         wall_ns: trace.wall_ns,
@@ -141,6 +144,23 @@ pub fn compute(trace: &Trace) -> Stats {
         passes,
         total,
     }
+}
+
+/// The plain fact when only `used` of the trace's `workers` worker tracks ran kernel calls,
+/// or `None` when every one did. A timeline on one worker shows no parallel execution, and
+/// the summary and the report say so rather than explain the idle share.
+pub fn idle_workers_note(used: usize, workers: usize) -> Option<String> {
+    if used >= workers {
+        return None;
+    }
+    let shows = if used <= 1 {
+        "the timeline does not show parallel execution".to_owned()
+    } else {
+        format!("the timeline shows at most {used} of them running at once")
+    };
+    Some(format!(
+        "only {used} of {workers} workers ran kernels in the recorded steps; {shows}"
+    ))
 }
 
 /// Per step of one pass: kernel calls, busy time per worker, first start and last end.
@@ -364,6 +384,22 @@ mod tests {
         assert_eq!(s.passes[2].kernel_calls, 0);
         assert_eq!(s.workers[1].thread_label(), "idle");
         assert_eq!(s.workers[1].idle_pct, 100.0);
+        assert_eq!((s.total.workers_used, s.workers.len()), (1, 2));
+    }
+
+    #[test]
+    fn a_trace_where_only_some_workers_ran_says_so_plainly() {
+        assert_eq!(idle_workers_note(2, 2), None);
+        assert_eq!(
+            idle_workers_note(1, 2).unwrap(),
+            "only 1 of 2 workers ran kernels in the recorded steps; the timeline does not show \
+             parallel execution"
+        );
+        assert_eq!(
+            idle_workers_note(3, 4).unwrap(),
+            "only 3 of 4 workers ran kernels in the recorded steps; the timeline shows at most 3 \
+             of them running at once"
+        );
     }
 
     #[test]
