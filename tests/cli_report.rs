@@ -190,12 +190,15 @@ fn trace_directories_under_the_results_or_given_with_trace_are_embedded() {
     let dir = tmp.path().join("results");
     filtered_fixture(&dir, |l| l.contains(",all-pairs,seed,60,"));
     let stats = "kind,name,threads,kernel_calls,busy_ms,span_ms,idle_pct,imbalance\n\
-                 worker,0,1,90,10.0,12.0,16.7,\npass,density,,90,9.5,5.0,5.0,1.10\n\
-                 total,all,2,180,19.0,12.0,20.8,\n";
+                 worker,0,1,90,10.0,12.0,16.7,\nworker,1,1,90,9.0,12.0,25.0,\n\
+                 pass,density,,90,9.5,5.0,5.0,1.10\ntotal,all,2,180,19.0,12.0,20.8,\n";
+    let meta = r#"{"tool":"bench-sph trace","strategy":"rayon-chunks","cores":2,"chunks":45,"n":1000,"steps":3}"#;
     for t in [dir.join("trace-inside"), tmp.path().join("trace-outside")] {
         std::fs::create_dir_all(&t).unwrap();
-        std::fs::write(t.join("timeline.png"), b"not checked").unwrap();
+        // Only the PNG signature is checked.
+        std::fs::write(t.join("timeline.png"), b"\x89PNG\r\n\x1a\n").unwrap();
         std::fs::write(t.join("stats.csv"), stats).unwrap();
+        std::fs::write(t.join("meta.json"), meta).unwrap();
     }
     let outside = tmp.path().join("trace-outside");
     report(&[dir.to_str().unwrap(), "--trace", outside.to_str().unwrap()]);
@@ -205,7 +208,7 @@ fn trace_directories_under_the_results_or_given_with_trace_are_embedded() {
     assert!(md.contains("](trace-outside-timeline.png)"), "{md}");
     assert!(dir.join("trace-outside-timeline.png").is_file());
     assert!(
-        md.contains("| density | 90 | 9.500 | 5.000 | 5.0 | 1.10 |"),
+        md.contains("| density | 90 | 9.50 | 5.00 | 5.00 | 1.10 |"),
         "{md}"
     );
     report_fails(
