@@ -5,26 +5,37 @@
 //! `crossbeam::scope` and keeps them for the whole session; the session itself runs on the
 //! first of them (the calling thread only waits for it). For each pass that thread cuts the
 //! output into `min(chunks, len)` balanced chunks, publishes one job on a job board, works on
-//! the job itself, and waits until every other worker has finished it. Each worker pulls chunk
-//! indices from a shared atomic counter until the chunks run out — so fast workers take more
-//! chunks — and takes the chunk out of its slot (a `Mutex<Option<_>>` per chunk, locked once,
-//! uncontended).
+//! the job itself, and, once it finds no chunk left, waits for the workers still busy with one.
+//! Each thread in the job pulls chunk indices from a shared atomic counter until the chunks
+//! run out — so fast workers take more chunks — and takes the chunk out of its slot (a
+//! `Mutex<Option<_>>` per chunk, locked once, uncontended).
 //!
 //! **Cost.** No thread start-up per pass; per pass one publication and one completion
-//! rendezvous. Waiting threads spin for up to 200 µs before they sleep on a condition
-//! variable, so back-to-back passes need no wake-up (waking a sleeping thread costs tens of
-//! microseconds, far more on a virtual machine); the spinning shows up as CPU time. Per chunk
-//! one atomic `fetch_add` and one uncontended lock. Nothing per element.
+//! rendezvous, per chunk one atomic `fetch_add` and one uncontended lock, nothing per element.
+//! A waiting thread (a worker between passes, the session's thread at the end of a pass)
+//! watches an atomic hint for up to 200 µs before it sleeps on a condition variable, so
+//! back-to-back passes need no wake-up (waking a sleeping thread costs tens of microseconds,
+//! far more on a virtual machine); the watching shows up as CPU time.
+//!
+//! **Contention.** The pool must not collapse when its cores are shared (another busy
+//! process, more threads than cores). So the watching spins only a few short rounds and then
+//! yields the core between checks, leaving it to whichever thread — ours or not — is ready to
+//! run; and a pass never waits for a worker that has not joined it: the pass closes when the
+//! session's thread finds no chunk left, and only the workers already inside it (each busy
+//! with a chunk it took) are waited for. A descheduled worker thus costs the pass its help,
+//! not a scheduling round-trip.
 //!
 //! **Panics.** A kernel panic is caught per chunk; the first one is returned as
 //! [`KernelPanic`] once the pass has finished, and the workers keep serving later passes.
 //!
-//! **Shut-down.** When the session returns — or unwinds — a guard tells the workers to exit,
-//! so the scope always joins them.
+//! **Thread limits and shut-down.** If the operating system refuses a thread, the run fails
+//! with [`BuildError::ThreadStart`] before the session starts. Whenever the scope ends — the
+//! session returned or unwound, or a thread was refused — a guard first tells the workers to
+//! exit, so the scope always joins them.
 //!
 //! Handing a job borrowed for one pass to threads that outlive it needs lifetime erasure;
 //! that `unsafe` is confined to the private module `erased_job`, whose safe API returns only
-//! after every worker is done with the job.
+//! after every worker that joined the pass is done with the job.
 
 use std::cell::Cell;
 use std::marker::PhantomData;
@@ -32,6 +43,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Mutex, PoisonError};
 
 use crate::erased_job::JobBoard;
+use crate::thread_start::ThreadStarts;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Session, Split, Strategy, balanced_chunks,
     panic,
@@ -42,6 +54,7 @@ use crate::{
 pub struct CrossbeamPool {
     cores: usize,
     chunks: usize,
+    starts: ThreadStarts,
 }
 
 impl Strategy for CrossbeamPool {
@@ -58,6 +71,7 @@ impl Strategy for CrossbeamPool {
         Ok(CrossbeamPool {
             cores: config.cores,
             chunks: config.chunks,
+            starts: ThreadStarts::default(),
         })
     }
 
@@ -65,36 +79,38 @@ impl Strategy for CrossbeamPool {
     /// others.
     ///
     /// # Panics
-    /// If the operating system refuses to start a worker thread, and re-raises a panic of
-    /// `session` itself once the workers have been joined.
-    fn run<S: Session>(&self, session: S) -> S::Output {
-        let board = JobBoard::new(self.cores - 1);
+    /// Re-raises a panic of `session` itself once the workers have been joined.
+    fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError> {
+        let board = JobBoard::new();
         let executor = PoolExecutor {
             board: &board,
             chunks: self.chunks,
             not_sync: PhantomData,
         };
+        let cores = self.cores;
         let outcome = crossbeam::scope(|scope| {
             // Created before the first worker, so that every way out of this closure — a
-            // return, a failed spawn, a panicking session — releases the workers first.
+            // return, a refused thread, a panicking session — releases the workers first.
             let _stop = ShutDownOnDrop(&board);
-            for i in 1..self.cores {
+            for i in 1..cores {
+                self.starts.start(i, cores, || {
+                    scope
+                        .builder()
+                        .name(format!("crossbeam-pool-{i}"))
+                        .spawn(|_| board.serve())
+                })?;
+            }
+            let session_thread = self.starts.start(0, cores, || {
                 scope
                     .builder()
-                    .name(format!("crossbeam-pool-{i}"))
-                    .spawn(|_| board.serve())
-                    .expect("could not start a crossbeam-pool worker thread");
-            }
-            scope
-                .builder()
-                .name("crossbeam-pool-0".to_owned())
-                .spawn(move |_| session.run(&executor))
-                .expect("could not start a crossbeam-pool worker thread")
-                .join()
+                    .name("crossbeam-pool-0".to_owned())
+                    .spawn(move |_| session.run(&executor))
+            })?;
+            Ok(session_thread.join())
         })
         // A serving thread cannot panic: `serve` catches whatever a job throws.
         .expect("a crossbeam-pool worker thread panicked");
-        outcome.unwrap_or_else(|payload| std::panic::resume_unwind(payload))
+        outcome.map(|joined| joined.unwrap_or_else(|payload| std::panic::resume_unwind(payload)))
     }
 }
 
@@ -168,7 +184,7 @@ impl Executor for PoolExecutor<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::{distinct, thread_ids_per_pass};
+    use crate::testing::{distinct, run_counting, thread_ids_per_pass};
 
     #[test]
     fn passes_are_spread_over_more_than_one_thread() {
@@ -182,5 +198,28 @@ mod tests {
         let all: Vec<_> = passes.concat();
         assert!(distinct(&all) <= 3, "{passes:?}");
         assert!(!all.contains(&std::thread::current().id()));
+    }
+
+    #[test]
+    fn a_worker_thread_the_system_refuses_fails_the_run_before_the_session_starts() {
+        // Thread 1 runs the session and is started last; threads 2..4 serve the board.
+        for (refuse, message) in [
+            (2, "could not start worker thread 3 of 4"),
+            (0, "could not start worker thread 1 of 4"),
+        ] {
+            let strategy = CrossbeamPool {
+                cores: 4,
+                chunks: 8,
+                starts: ThreadStarts {
+                    refuse: Some(refuse),
+                },
+            };
+            // The workers are scoped threads: `run` returning (within the watchdog) means the
+            // ones already started were told to stop and have been joined.
+            let counted = run_counting(strategy, 100, 5);
+            let err = counted.run.expect_err("the refused thread is an error");
+            assert_eq!(err.to_string(), message);
+            assert_eq!((counted.started, counted.ended), (0, 0), "{message}");
+        }
     }
 }

@@ -33,10 +33,12 @@ mod rayon_pool;
 pub mod rayon_spawn;
 mod registry;
 pub mod seq;
+mod spin_wait;
 mod split;
 pub mod std_static;
 #[cfg(test)]
 mod testing;
+mod thread_start;
 
 pub use panic::KernelPanic;
 pub use registry::{StrategyName, UnknownStrategy, run};
@@ -63,7 +65,7 @@ pub struct Info {
     pub uses_chunks: bool,
 }
 
-/// Why a strategy could not be built.
+/// Why a strategy could not be built, or could not start the threads of a run.
 #[derive(Debug, thiserror::Error)]
 pub enum BuildError {
     /// `cores` was zero.
@@ -72,9 +74,20 @@ pub enum BuildError {
     /// `chunks` was zero.
     #[error("chunks must be at least 1")]
     ZeroChunks,
-    /// The operating system refused to start threads.
+    /// The operating system refused to start a rayon pool's threads.
     #[error("could not start the thread pool: {0}")]
     Pool(String),
+    /// The operating system refused to start one of the threads a run (or, for `std-static`,
+    /// a pass) needs; the threads already started have been stopped and joined.
+    #[error("could not start worker thread {thread} of {threads}")]
+    ThreadStart {
+        /// Which thread, 1-based.
+        thread: usize,
+        /// How many the run or pass needed.
+        threads: usize,
+        /// The operating system's reason (e.g. `EAGAIN` under a process or thread limit).
+        source: std::io::Error,
+    },
 }
 
 impl Config {
@@ -126,5 +139,9 @@ pub trait Strategy: Sized {
     fn build(config: &Config) -> Result<Self, BuildError>;
 
     /// Runs `session`, giving it an executor backed by this strategy's threads.
-    fn run<S: Session>(&self, session: S) -> S::Output;
+    ///
+    /// Fails with [`BuildError::ThreadStart`] if the operating system refuses a thread the run
+    /// needs — before the session starts, or (`std-static`) during a pass, whose error then
+    /// ends the session; the session's output is discarded. No thread is left behind.
+    fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError>;
 }

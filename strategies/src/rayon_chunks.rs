@@ -44,7 +44,7 @@ impl Strategy for RayonChunks {
         })
     }
 
-    fn run<S: Session>(&self, session: S) -> S::Output {
+    fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError> {
         // The session runs on one of the pool's threads: see `rayon_pool::run_inside`.
         crate::rayon_pool::run_inside(
             &self.pool,

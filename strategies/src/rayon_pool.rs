@@ -16,10 +16,15 @@ pub(crate) fn build(config: &Config, name: &'static str) -> Result<rayon::Thread
 /// The step loop's serial parts then run on a worker, which also takes part in every pass:
 /// the pool's `cores` threads do all the work (the caller only waits for the result), and a
 /// pass starts and ends without handing work to, and waking, a thread outside the pool.
-pub(crate) fn run_inside<S, E>(pool: &rayon::ThreadPool, session: S, exec: E) -> S::Output
+/// Never fails: the pool's threads were started in [`build`].
+pub(crate) fn run_inside<S, E>(
+    pool: &rayon::ThreadPool,
+    session: S,
+    exec: E,
+) -> Result<S::Output, BuildError>
 where
     S: Session,
     E: Executor + Sync,
 {
-    pool.install(|| session.run(&exec))
+    Ok(pool.install(|| session.run(&exec)))
 }

@@ -38,7 +38,7 @@ impl Strategy for RayonSpawn {
         })
     }
 
-    fn run<S: Session>(&self, session: S) -> S::Output {
+    fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError> {
         // The session runs on one of the pool's threads: see `rayon_pool::run_inside`.
         crate::rayon_pool::run_inside(&self.pool, session, RayonSpawnExecutor { pool: &self.pool })
     }

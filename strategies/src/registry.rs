@@ -34,6 +34,9 @@ macro_rules! registry {
 
         /// Builds the named strategy for `config` and runs `session` on it. The only place
         /// where a strategy is chosen by name: everything below it is statically dispatched.
+        ///
+        /// Fails if the strategy cannot be built or cannot start its threads (see
+        /// [`Strategy::run`]).
         pub fn run<S: Session>(
             name: StrategyName,
             config: &Config,
@@ -41,7 +44,7 @@ macro_rules! registry {
         ) -> Result<S::Output, BuildError> {
             match name {
                 $(StrategyName::$variant => {
-                    Ok(<crate::$module::$ty as Strategy>::build(config)?.run(session))
+                    <crate::$module::$ty as Strategy>::build(config)?.run(session)
                 })*
             }
         }

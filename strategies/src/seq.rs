@@ -19,8 +19,8 @@ impl Strategy for Seq {
         Ok(Seq)
     }
 
-    fn run<S: Session>(&self, session: S) -> S::Output {
-        session.run(&SeqExecutor)
+    fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError> {
+        Ok(session.run(&SeqExecutor))
     }
 }
 

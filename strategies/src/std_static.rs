@@ -9,9 +9,15 @@
 //! the timed region; nothing per element.
 //!
 //! **Panics.** Every thread is joined; a panicked one becomes [`KernelPanic`] (the first, in
-//! block order), and because every handle is joined the scope does not re-panic. If the
-//! operating system refuses to start a thread, the pass panics (after joining the others).
+//! block order), and because every handle is joined the scope does not re-panic.
+//!
+//! **Thread limits.** If the operating system refuses to start a block's thread, the blocks
+//! already started are joined, the pass returns an error (so the session stops) and the run
+//! fails with [`BuildError::ThreadStart`] instead of returning the session's output.
 
+use std::cell::RefCell;
+
+use crate::thread_start::ThreadStarts;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Session, Split, Strategy, balanced_chunks,
 };
@@ -20,6 +26,7 @@ use crate::{
 #[derive(Debug, Clone, Copy)]
 pub struct StdStatic {
     cores: usize,
+    starts: ThreadStarts,
 }
 
 impl Strategy for StdStatic {
@@ -34,15 +41,30 @@ impl Strategy for StdStatic {
         config.validate()?;
         Ok(StdStatic {
             cores: config.cores,
+            starts: ThreadStarts::default(),
         })
     }
 
-    fn run<S: Session>(&self, session: S) -> S::Output {
-        session.run(self)
+    fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError> {
+        let exec = StdStaticExecutor {
+            strategy: *self,
+            refused: RefCell::new(None),
+        };
+        let output = session.run(&exec);
+        match exec.refused.into_inner() {
+            Some(refused) => Err(refused),
+            None => Ok(output),
+        }
     }
 }
 
-impl Executor for StdStatic {
+/// Starts the threads of each pass and remembers the first thread the system refused.
+struct StdStaticExecutor {
+    strategy: StdStatic,
+    refused: RefCell<Option<BuildError>>,
+}
+
+impl Executor for StdStaticExecutor {
     fn for_each_chunk<O, F>(&self, out: O, kernel: F) -> Result<(), KernelPanic>
     where
         O: Split,
@@ -52,11 +74,23 @@ impl Executor for StdStatic {
             return Ok(());
         }
         let kernel = &kernel;
+        let blocks = balanced_chunks(out, self.strategy.cores);
+        let count = blocks.len();
         std::thread::scope(|scope| {
-            let threads: Vec<_> = balanced_chunks(out, self.cores)
-                .into_iter()
-                .map(|(first, block)| scope.spawn(move || kernel(first, block)))
-                .collect();
+            let mut threads = Vec::with_capacity(count);
+            let mut refused = None;
+            for (index, (first, block)) in blocks.into_iter().enumerate() {
+                let started = self.strategy.starts.start(index, count, || {
+                    std::thread::Builder::new().spawn_scoped(scope, move || kernel(first, block))
+                });
+                match started {
+                    Ok(thread) => threads.push(thread),
+                    Err(e) => {
+                        refused = Some(e);
+                        break;
+                    }
+                }
+            }
             let mut result = Ok(());
             for thread in threads {
                 if let Err(payload) = thread.join()
@@ -64,6 +98,12 @@ impl Executor for StdStatic {
                 {
                     result = Err(KernelPanic::from_payload(payload));
                 }
+            }
+            if let Some(e) = refused {
+                // The pass's error only stops the session; `run` reports the refusal itself.
+                let message = e.to_string();
+                self.refused.borrow_mut().get_or_insert(e);
+                return Err(KernelPanic { message });
             }
             result
         })
@@ -73,7 +113,7 @@ impl Executor for StdStatic {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::testing::{distinct, thread_ids_per_pass};
+    use crate::testing::{distinct, run_counting, thread_ids_per_pass};
 
     #[test]
     fn passes_are_spread_over_more_than_one_thread() {
@@ -85,5 +125,26 @@ mod tests {
     fn every_pass_starts_its_own_threads() {
         let passes = thread_ids_per_pass::<StdStatic>(2, 1, 16, 3);
         assert_eq!(distinct(&passes.concat()), 6, "{passes:?}");
+    }
+
+    #[test]
+    fn a_block_thread_the_system_refuses_fails_the_run_after_joining_the_blocks_started() {
+        let strategy = StdStatic {
+            cores: 4,
+            starts: ThreadStarts { refuse: Some(2) },
+        };
+        let counted = run_counting(strategy, 100, 5);
+        let err = counted.run.expect_err("the refused thread is an error");
+        assert_eq!(err.to_string(), "could not start worker thread 3 of 4");
+        assert!(matches!(
+            err,
+            BuildError::ThreadStart {
+                thread: 3,
+                threads: 4,
+                ..
+            }
+        ));
+        // Blocks 1 and 2 ran to the end before `run` returned; the session stopped there.
+        assert_eq!((counted.started, counted.ended), (2, 2));
     }
 }
