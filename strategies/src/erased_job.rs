@@ -151,6 +151,10 @@ impl JobBoard {
             state = self.wait_as_dispatcher(state);
         }
         assert!(!state.shutdown, "job board used after shut-down");
+        // From publishing the job until no worker is inside it, an unwind out of `run` would
+        // free the job's borrow under a running worker: the guard turns any unwind in that
+        // window (even one from a clock read while waiting) into an abort.
+        let guard = AbortOnUnwind;
         state.in_flight = true;
         state.job = Some(ErasedJob::new(job));
         state.epoch += 1;
@@ -162,11 +166,9 @@ impl JobBoard {
             self.to_workers.notify_all();
         }
         // The dispatcher's own share: a plain call through the live borrow. Its panic is
-        // caught, and the guard turns any unwind that still escapes into an abort, so that
-        // the wait below can never be skipped.
-        let guard = AbortOnUnwind;
+        // caught; an unwind that still escapes aborts (the guard above), so that the wait
+        // below can never be skipped.
         let own = panic::catch(job);
-        mem::forget(guard);
         let mut state = self.lock();
         if let Err(p) = own {
             state.escaped.get_or_insert(p);
@@ -178,8 +180,8 @@ impl JobBoard {
         // under the lock, only after its call has returned or unwound. Once `job` is withdrawn
         // here, nobody can take it again, so when the loop below sees `running == 0` under the
         // lock, no thread is inside the job or can enter it. Nothing below can panic (lock
-        // poisoning is ignored), so `run` cannot return before that. This holds whatever
-        // number of threads serve the board.
+        // poisoning is ignored, and the guard aborts on any unwind all the same), so `run`
+        // cannot return before that. This holds whatever number of threads serve the board.
         state.job = None;
         while state.running > 0 {
             drop(state);
@@ -189,6 +191,7 @@ impl JobBoard {
                 state = self.wait_as_dispatcher(state);
             }
         }
+        mem::forget(guard);
         state.in_flight = false;
         let escaped = state.escaped.take();
         let wake_dispatchers = state.asleep.dispatchers > 0;
@@ -238,7 +241,6 @@ impl JobBoard {
             // unwind escape `catch` all the same.
             let guard = AbortOnUnwind;
             let outcome = panic::catch(|| unsafe { job.call() });
-            mem::forget(guard);
 
             // From here on `job` is never called again; the next iteration overwrites it.
             let mut state = self.lock();
@@ -247,6 +249,8 @@ impl JobBoard {
             }
             state.running -= 1;
             self.running_hint.store(state.running, Ordering::Release);
+            // Counted out: an unwind from here on could no longer leave the dispatcher waiting.
+            mem::forget(guard);
             // Only a dispatcher whose pass is closed waits for `running` to reach zero.
             if state.running == 0 && state.job.is_none() && state.asleep.dispatchers > 0 {
                 self.to_dispatcher.notify_all();

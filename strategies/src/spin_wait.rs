@@ -6,7 +6,7 @@
 //! the end of one, first watches an atomic hint. How it watches matters when cores are
 //! shared: a thread that only spins keeps its core from the very thread it waits for, or from
 //! another process, for the whole time. So it spins busily only a few short rounds
-//! (`crossbeam`'s `Backoff`, about a hundred pause instructions in all), then yields its core
+//! (`crossbeam`'s `Backoff`, 127 pause instructions in all), then yields its core
 //! between checks (`yield_now`: immediate when the core is free, a real hand-over when
 //! another thread wants it), and after [`LIMIT`] gives up, so the caller sleeps.
 
