@@ -23,7 +23,11 @@
 //! run; and a pass never waits for a worker that has not joined it: the pass closes when the
 //! session's thread finds no chunk left, and only the workers already inside it (each busy
 //! with a chunk it took) are waited for. A descheduled worker thus costs the pass its help,
-//! not a scheduling round-trip.
+//! not a scheduling round-trip. And when the pool's threads do not get their cores at all
+//! (the process's CPU time falls short of its threads × wall time), the session's thread runs
+//! the next passes alone for a while (see the `degrade` module), so a 2-core run on a shared
+//! machine does not fall below the strategy's own 1-core speed. The results are the same
+//! bits.
 //!
 //! **Panics.** A kernel panic is caught per chunk; the first one is returned as
 //! [`KernelPanic`] once the pass has finished, and the workers keep serving later passes.
@@ -37,17 +41,17 @@
 //! that `unsafe` is confined to the private module `erased_job`, whose safe API returns only
 //! after every worker that joined the pass is done with the job.
 
-use std::cell::Cell;
-use std::marker::PhantomData;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Mutex, PoisonError};
-
+use crate::degrade::Degrade;
 use crate::erased_job::JobBoard;
 use crate::thread_start::ThreadStarts;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Session, Split, Strategy, balanced_chunks,
     panic,
 };
+use std::cell::{Cell, RefCell};
+use std::marker::PhantomData;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Mutex, PoisonError};
 
 /// A pool of `cores` long-lived crossbeam scoped threads pulling chunks dynamically.
 #[derive(Debug, Clone, Copy)]
@@ -85,6 +89,10 @@ impl Strategy for CrossbeamPool {
         let executor = PoolExecutor {
             board: &board,
             chunks: self.chunks,
+            degrade: RefCell::new(Degrade::new(
+                self.cores,
+                std::thread::available_parallelism().map_or(1, |n| n.get()),
+            )),
             not_sync: PhantomData,
         };
         let cores = self.cores;
@@ -114,6 +122,16 @@ impl Strategy for CrossbeamPool {
     }
 }
 
+/// CPU time (user + system) of the whole process so far.
+fn process_cpu_time() -> Option<std::time::Duration> {
+    use nix::sys::resource::{UsageWho, getrusage};
+    let usage = getrusage(UsageWho::RUSAGE_SELF).ok()?;
+    let secs = |t: nix::sys::time::TimeVal| {
+        std::time::Duration::new(t.tv_sec() as u64, t.tv_usec() as u32 * 1000)
+    };
+    Some(secs(usage.user_time()) + secs(usage.system_time()))
+}
+
 /// Tells the workers to exit when dropped, including during unwinding.
 struct ShutDownOnDrop<'a>(&'a JobBoard);
 
@@ -130,6 +148,8 @@ impl Drop for ShutDownOnDrop<'_> {
 struct PoolExecutor<'a> {
     board: &'a JobBoard,
     chunks: usize,
+    /// Whether the next passes run on the session's thread alone (see `degrade`).
+    degrade: RefCell<Degrade>,
     not_sync: PhantomData<Cell<()>>,
 }
 
@@ -169,7 +189,14 @@ impl Executor for PoolExecutor<'_> {
                 }
             }
         };
-        let escaped = self.board.run(&job);
+        let mut degrade = self.degrade.borrow_mut();
+        let escaped = if degrade.solo_pass() {
+            // Alone: the same job, every chunk on this thread.
+            panic::catch(job)
+        } else {
+            degrade.before_parallel_pass(process_cpu_time);
+            self.board.run(&job)
+        };
 
         let caught = first_panic
             .into_inner()

@@ -25,6 +25,7 @@
 //! returns only once every worker is done with the kernel; see the `// SAFETY:` notes there).
 
 pub mod crossbeam_pool;
+mod degrade;
 mod erased_job;
 mod panic;
 pub mod rayon_chunks;

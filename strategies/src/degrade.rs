@@ -1,0 +1,182 @@
+//! When `crossbeam-pool` stops asking for help: graceful degradation on shared cores.
+//!
+//! On a machine where another process keeps cores busy, the pool's threads do not get the
+//! cores they were started for: two of them may take turns on one core, or one may be
+//! descheduled in the middle of a chunk and hold the pass up for a scheduling round. Then
+//! every pass still pays for its rendezvous and its hand-overs, and gains nothing: a 2-core
+//! run beside one busy process was slower than the same strategy on 1 core.
+//!
+//! So the session's thread measures what its threads actually get. Over a window of passes
+//! (at least [`WINDOW`] of wall time) it compares the process's CPU time with the wall time:
+//! a pool of p threads on p free cores uses about p CPU-seconds per second (waiting threads
+//! spin or yield, which counts), so a shortfall of more than [`SHORTFALL`] cores means the
+//! cores are shared. The next passes then run on the session's thread alone (the workers
+//! sleep and leave their cores to the competing work): [`FIRST_SOLO`] passes after the first
+//! such window, doubling while the shortfall persists, up to [`MAX_SOLO`]; then a window asks
+//! for help again, and a window without shortfall ends the degradation. p counts at most the
+//! machine's hardware threads, so deliberate oversubscription (more threads than cores) is
+//! not mistaken for a busy machine.
+//!
+//! The results are the same bits either way: every chunk is computed by the same kernel on
+//! the same data, whichever thread runs it. On a quiet machine the pool keeps its cores busy
+//! and nothing changes.
+
+use std::time::{Duration, Instant};
+
+/// The shortest window whose CPU time is compared with its wall time.
+pub(crate) const WINDOW: Duration = Duration::from_millis(5);
+/// How many cores' worth of CPU time may be missing before the pool runs alone.
+pub(crate) const SHORTFALL: f64 = 0.5;
+/// Passes run alone after the first short window.
+pub(crate) const FIRST_SOLO: u32 = 64;
+/// The most passes run alone before help is asked for again.
+pub(crate) const MAX_SOLO: u32 = 4096;
+
+/// Whether a window in which the process used `cpu` over `wall` with a pool of `threads`
+/// threads (at most the hardware threads) fell short of its cores.
+pub(crate) fn short_of_cores(threads: usize, cpu: Duration, wall: Duration) -> bool {
+    if threads < 2 || wall.is_zero() {
+        return false;
+    }
+    cpu.as_secs_f64() / wall.as_secs_f64() < threads as f64 - SHORTFALL
+}
+
+/// The start of a measuring window.
+#[derive(Debug, Clone, Copy)]
+struct Window {
+    wall: Instant,
+    cpu: Duration,
+}
+
+/// The degradation state of one session (used by its thread only).
+#[derive(Debug, Clone)]
+pub(crate) struct Degrade {
+    /// Pool threads that can run at once: min(cores, hardware threads).
+    threads: usize,
+    /// Passes still to run alone.
+    left: u32,
+    /// The length of the last solo period (0: not degraded).
+    span: u32,
+    /// The window being measured (`None`: start one at the next pass with help).
+    window: Option<Window>,
+    /// Passes run alone so far.
+    solo_total: u64,
+}
+
+impl Degrade {
+    /// The state of a pool of `cores` threads on a machine with `hardware_threads`.
+    pub(crate) fn new(cores: usize, hardware_threads: usize) -> Degrade {
+        Degrade {
+            threads: cores.min(hardware_threads),
+            left: 0,
+            span: 0,
+            window: None,
+            solo_total: 0,
+        }
+    }
+
+    /// Whether the next pass runs on the session's thread alone (and counts it).
+    pub(crate) fn solo_pass(&mut self) -> bool {
+        if self.left == 0 {
+            return false;
+        }
+        self.left -= 1;
+        self.solo_total += 1;
+        true
+    }
+
+    /// Called before a pass with help, with the clock and the process's CPU time (read only
+    /// when a window starts or ends).
+    pub(crate) fn before_parallel_pass(&mut self, cpu_now: impl Fn() -> Option<Duration>) {
+        if self.threads < 2 {
+            return;
+        }
+        let now = Instant::now();
+        match self.window {
+            None => {
+                self.window = cpu_now().map(|cpu| Window { wall: now, cpu });
+            }
+            Some(w) if now - w.wall >= WINDOW => {
+                self.window = None;
+                let Some(cpu) = cpu_now() else { return };
+                self.decide(cpu.saturating_sub(w.cpu), now - w.wall);
+            }
+            Some(_) => {}
+        }
+    }
+
+    /// Ends a window that used `cpu` over `wall`.
+    fn decide(&mut self, cpu: Duration, wall: Duration) {
+        if short_of_cores(self.threads, cpu, wall) {
+            self.span = (self.span * 2).clamp(FIRST_SOLO, MAX_SOLO);
+            self.left = self.span;
+        } else {
+            self.span = 0;
+        }
+    }
+
+    /// Passes run alone so far.
+    #[cfg(test)]
+    pub(crate) fn solo_total(&self) -> u64 {
+        self.solo_total
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ms(v: u64) -> Duration {
+        Duration::from_millis(v)
+    }
+
+    #[test]
+    fn a_pool_that_gets_its_cores_is_not_short_and_one_that_shares_them_is() {
+        assert!(!short_of_cores(2, ms(198), ms(100)));
+        assert!(
+            short_of_cores(2, ms(100), ms(100)),
+            "two threads on one core"
+        );
+        assert!(
+            !short_of_cores(1, ms(10), ms(100)),
+            "one thread never degrades"
+        );
+        // 4 threads on a 2-core machine are capped at 2: oversubscription is not contention.
+        let d = Degrade::new(4, 2);
+        assert_eq!(d.threads, 2);
+    }
+
+    #[test]
+    fn short_windows_make_the_solo_periods_double_and_a_full_window_ends_them() {
+        let mut d = Degrade::new(2, 2);
+        assert!(!d.solo_pass());
+        d.decide(ms(100), ms(100));
+        assert_eq!((0..10_000).filter(|_| d.solo_pass()).count(), 64);
+        d.decide(ms(100), ms(100));
+        assert_eq!((0..10_000).filter(|_| d.solo_pass()).count(), 128);
+        d.decide(ms(200), ms(100));
+        assert!(!d.solo_pass());
+        d.decide(ms(100), ms(100));
+        assert_eq!((0..10_000).filter(|_| d.solo_pass()).count(), 64);
+        assert_eq!(d.solo_total(), 256);
+        for _ in 0..20 {
+            d.decide(ms(100), ms(100));
+        }
+        assert_eq!(
+            (0..10_000).filter(|_| d.solo_pass()).count(),
+            MAX_SOLO as usize
+        );
+    }
+
+    #[test]
+    fn a_window_closes_only_after_its_minimum_wall_time() {
+        let mut d = Degrade::new(2, 2);
+        // The CPU clock says nothing was used: a shortfall, once the window is long enough.
+        d.before_parallel_pass(|| Some(Duration::ZERO));
+        d.before_parallel_pass(|| Some(Duration::ZERO));
+        assert!(!d.solo_pass(), "the window is still open");
+        std::thread::sleep(WINDOW);
+        d.before_parallel_pass(|| Some(Duration::ZERO));
+        assert!(d.solo_pass());
+    }
+}
