@@ -72,8 +72,13 @@ fn winner(cores: usize, at: &[(&str, &Best)]) -> Option<String> {
         )
     };
     if trusted.len() == 1 {
+        let only = if contended > 0 {
+            "was measured without contention"
+        } else {
+            "was measured"
+        };
         return Some(format!(
-            "{where_}, only {} was measured without contention{left_out}.",
+            "{where_}, only {} {only}{left_out}.",
             describe(w, wb)
         ));
     }
@@ -94,9 +99,13 @@ fn winner(cores: usize, at: &[(&str, &Best)]) -> Option<String> {
         .collect();
     if ties.is_empty() {
         let (r, rb) = trusted[1];
-        let speed = wb.speedup.map_or_else(String::new, |s| {
-            format!(", {}{} over seq", times(s), interval(wb.speedup_ci))
-        });
+        // At one core a speedup is the reference's noise (said separately), not a result.
+        let speed = wb
+            .speedup
+            .filter(|_| cores > 1)
+            .map_or_else(String::new, |s| {
+                format!(", {}{} over seq", times(s), interval(wb.speedup_ci))
+            });
         return Some(format!(
             "{where_}, **{}** is fastest{speed}; its 95 % interval does not overlap the \
              runner-up {}, which takes {} more time{left_out}.",
