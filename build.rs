@@ -32,13 +32,25 @@ fn main() {
     }
 }
 
-/// `git rev-parse HEAD`, plus `-dirty` when tracked files differ from it.
+/// `git rev-parse HEAD`, plus `-dirty` when tracked files that go into the build differ from
+/// it (measured results and reports in `results/` and `report/` do not change the program).
 fn git_commit() -> String {
     let Some(commit) = output(Command::new("git").args(["rev-parse", "HEAD"])) else {
         return "unknown".to_owned();
     };
-    let dirty = output(Command::new("git").args(["status", "--porcelain", "--untracked-files=no"]))
-        .is_some_and(|s| !s.is_empty());
+    let dirty = output(Command::new("git").args([
+        "status",
+        "--porcelain",
+        "--untracked-files=no",
+        "--",
+        "Cargo.toml",
+        "Cargo.lock",
+        "build.rs",
+        "src",
+        "strategies",
+        "assets",
+    ]))
+    .is_some_and(|s| !s.is_empty());
     if dirty {
         format!("{commit}-dirty")
     } else {
