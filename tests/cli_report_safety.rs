@@ -213,3 +213,39 @@ fn a_partial_study_says_so_at_the_top_naming_the_strategies_never_measured() {
     let first_section = md.find("## ").unwrap();
     assert!(md.find("Partial study").unwrap() < first_section);
 }
+
+#[test]
+fn a_one_cell_report_reads_naturally() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    let o = run(&[
+        "sweep",
+        "--n",
+        "60",
+        "--steps",
+        "3",
+        "--trials",
+        "2",
+        "--strategies",
+        "seq",
+        "--cores",
+        "1",
+        "--fake-timings",
+        "1.0,1.1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
+    assert!(md.contains(": 1 cell in 1 group."), "{md}");
+    assert!(
+        md.contains(
+            "Charts 3–5 (against cores) are not drawn: no parallel strategy has a usable cell."
+        ),
+        "{md}"
+    );
+    assert!(
+        !md.contains("1 cells") && !md.contains("only no core"),
+        "{md}"
+    );
+}
