@@ -1,6 +1,13 @@
 //! The `bench-sph` command.
 
+use std::io::Write;
 use std::process::ExitCode;
+
+/// Writes a line to standard error, ignoring failure: with standard error closed too
+/// (`bench-sph sweep 2>&1 | head`), there is nobody left to tell, and `eprintln!` would panic.
+fn tell(text: &str) {
+    let _ = writeln!(std::io::stderr().lock(), "{text}");
+}
 
 fn main() -> ExitCode {
     // A panic is a bug. Strategies turn a kernel's panic into an error of the run; this hook
@@ -15,12 +22,12 @@ fn main() -> ExitCode {
             .map(|s| (*s).to_owned())
             .or_else(|| info.payload().downcast_ref::<String>().cloned())
             .unwrap_or_default();
-        eprintln!("bench-sph: internal panic{location}: {message}");
+        tell(&format!("bench-sph: internal panic{location}: {message}"));
     }));
     match bench_sph::cli::run() {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
-            eprintln!("Error: {err:#}");
+            tell(&format!("Error: {err:#}"));
             ExitCode::FAILURE
         }
     }

@@ -540,3 +540,24 @@ fn a_group_larger_than_the_available_memory_is_refused_before_anything_is_writte
     );
     assert!(!dir.exists(), "nothing is written");
 }
+
+#[test]
+fn a_sweep_whose_stdout_and_stderr_are_both_closed_still_exits_cleanly() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("both");
+    let mut args = TINY.to_vec();
+    args.extend(["--no-plots", "--out", dir.to_str().unwrap()]);
+    // `bench-sph sweep 2>&1 | head -0`: nobody reads either stream.
+    let mut child = bench_sph()
+        .args(&args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    drop(child.stderr.take());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(1), "an exit, not a signal: {status:?}");
+    let meta = std::fs::read_to_string(dir.join("meta.json")).unwrap();
+    assert!(meta.contains("\"status\": \"interrupted\""), "{meta}");
+}

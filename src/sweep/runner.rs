@@ -46,12 +46,12 @@ pub fn interrupted() -> bool {
 pub fn install_ctrlc_handler() {
     let _ = ctrlc::set_handler(|| {
         if INTERRUPTED.swap(true, Ordering::SeqCst) {
-            eprintln!("\nCtrl-C again: quitting now; finished cells are saved");
+            crate::output::console::warn("\nCtrl-C again: quitting now; finished cells are saved");
             std::process::exit(130);
         }
-        eprintln!(
+        crate::output::console::warn(
             "\nCtrl-C: stopping after the current run; the cell in progress is discarded \
-             (Ctrl-C again to quit at once)"
+             (Ctrl-C again to quit at once)",
         );
     });
 }
