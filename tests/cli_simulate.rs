@@ -404,3 +404,44 @@ fn a_full_or_closed_stdout_is_one_error_line_not_a_panic() {
         "Error: cannot write to standard output: No space left on device (os error 28)\n"
     );
 }
+
+#[test]
+fn ctrl_c_during_a_dumping_run_keeps_the_earlier_file_and_leaves_no_temporary() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dump = tmp.path().join("d.csv");
+    std::fs::write(&dump, "keep").unwrap();
+    let child = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+        .args(["simulate", "--n", "3000", "--steps", "1000000", "--dump"])
+        .arg(&dump)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait for the temporary file: the run is under way.
+    let deadline = Instant::now() + Duration::from_secs(60);
+    let temporaries = || {
+        std::fs::read_dir(tmp.path())
+            .unwrap()
+            .filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .file_name()
+                    .to_string_lossy()
+                    .ends_with(".tmp")
+            })
+            .count()
+    };
+    while temporaries() == 0 {
+        assert!(Instant::now() < deadline, "the run never started its dump");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130), "{o:?}");
+    assert_eq!(std::fs::read_to_string(&dump).unwrap(), "keep");
+    assert_eq!(temporaries(), 0, "a temporary file was left behind");
+}

@@ -97,7 +97,13 @@ pub enum Command {
 
 /// Parses the command line and runs the command.
 pub fn run() -> anyhow::Result<()> {
-    match Cli::parse().command {
+    let command = Cli::parse().command;
+    if !matches!(command, Command::Sweep(_)) {
+        // The sweep keeps its finished cells on Ctrl-C; every other command just stops, and
+        // must not leave half-written temporary files behind.
+        crate::output::atomic::remove_temporaries_on_ctrl_c();
+    }
+    match command {
         Command::Simulate(args) => simulate::run(&args),
         Command::List => list::run(&mut std::io::stdout().lock()),
         Command::Render(args) => render::run(&args),

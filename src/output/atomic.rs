@@ -1,13 +1,36 @@
 //! Files written whole or not at all: a temporary file `.NAME.PID.tmp` beside the
 //! destination, synced and renamed over it by [`AtomicFile::commit`]. An `AtomicFile` dropped
 //! without a commit (an error, a panic, an early return) removes its temporary file, and the
-//! destination keeps its earlier contents.
+//! destination keeps its earlier contents. Commands that are not a sweep (which handles
+//! Ctrl-C itself) call [`remove_temporaries_on_ctrl_c`], so an interrupted run leaves no
+//! temporary file behind either.
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, PoisonError};
 
 use anyhow::Context;
+
+/// The temporary files being written now, for [`remove_temporaries_on_ctrl_c`].
+static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    LIVE.lock().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Makes Ctrl-C remove every temporary file being written, then exit with status 130 (the
+/// destinations keep their earlier contents). Harmless to call twice; a process has one
+/// handler.
+pub fn remove_temporaries_on_ctrl_c() {
+    let _ = ctrlc::set_handler(|| {
+        for tmp in live().iter() {
+            let _ = std::fs::remove_file(tmp);
+        }
+        super::console::warn("\nCtrl-C: stopped; nothing was written");
+        std::process::exit(130);
+    });
+}
 
 /// The suffix of every temporary file (see [`is_temporary`]).
 pub const TMP_SUFFIX: &str = ".tmp";
@@ -39,6 +62,7 @@ impl AtomicFile {
         ));
         let file =
             File::create(&tmp).with_context(|| format!("cannot write '{}'", dest.display()))?;
+        live().push(tmp.clone());
         Ok(AtomicFile {
             dest: dest.to_path_buf(),
             tmp,
@@ -62,6 +86,7 @@ impl AtomicFile {
         file.sync_all().with_context(context)?;
         drop(file);
         std::fs::rename(&self.tmp, &self.dest).with_context(context)?;
+        forget_live(&self.tmp);
         Ok(())
     }
 }
@@ -81,8 +106,13 @@ impl Drop for AtomicFile {
         if self.out.take().is_some() {
             // Not committed: the destination keeps what it had.
             let _ = std::fs::remove_file(&self.tmp);
+            forget_live(&self.tmp);
         }
     }
+}
+
+fn forget_live(tmp: &Path) {
+    live().retain(|p| p != tmp);
 }
 
 /// Writes `bytes` to `dest` atomically.
