@@ -37,8 +37,11 @@ impl GroupKey {
     /// E.g. `seed preset, all-pairs, N = 1000, 1000 steps`.
     pub fn label(&self) -> String {
         format!(
-            "{} preset, {}, N = {}, {} steps",
-            self.preset, self.neighbors, self.n, self.steps
+            "{} preset, {}, N = {}, {}",
+            self.preset,
+            self.neighbors,
+            self.n,
+            crate::sweep::console::plural(self.steps, "step", "steps")
         )
     }
 

@@ -30,8 +30,11 @@ impl Group {
     /// E.g. `preset seed, all-pairs, N = 1000, 1000 steps`.
     pub fn label(&self) -> String {
         format!(
-            "preset {}, {}, N = {}, {} steps",
-            self.preset, self.neighbors, self.n, self.steps
+            "preset {}, {}, N = {}, {}",
+            self.preset,
+            self.neighbors,
+            self.n,
+            super::console::plural(self.steps, "step", "steps")
         )
     }
 }
@@ -77,8 +80,13 @@ impl CellKey {
             .map(|k| format!(", {k} chunks"))
             .unwrap_or_default();
         format!(
-            "{}, {} {cores}{chunks} (preset {}, {}, N = {}, {} steps)",
-            self.strategy, self.cores, self.preset, self.neighbors, self.n, self.steps
+            "{}, {} {cores}{chunks} (preset {}, {}, N = {}, {})",
+            self.strategy,
+            self.cores,
+            self.preset,
+            self.neighbors,
+            self.n,
+            super::console::plural(self.steps, "step", "steps")
         )
     }
 }
