@@ -24,25 +24,38 @@ pub fn findings(rows: &[SummaryRow], g: &GroupKey) -> Vec<String> {
         .iter()
         .map(|s| (s.clone(), series::best_per_cores(rows, g, s)))
         .collect();
+    // A contended reference makes every speedup doubtful: none enters a finding then.
+    let seq_trusted = !rows
+        .iter()
+        .any(|r| g.contains(r) && r.strategy == "seq" && r.contended == Some(true));
     let mut out = Vec::new();
+    if !seq_trusted {
+        out.push(
+            "The seq reference was contended (other work used the machine while it ran): no \
+             speedup, serial fraction or comparison with the paper is given as a finding."
+                .to_owned(),
+        );
+    }
     for c in series::cores(rows, g) {
         let at: Vec<(&str, &Best)> = bests
             .iter()
             .filter_map(|(s, b)| Some((s.as_str(), b.iter().find(|b| b.cores == c)?)))
             .collect();
-        out.extend(winner(c, &at));
-        if c == 1 {
+        out.extend(winner(c, &at, seq_trusted));
+        if c == 1 && seq_trusted {
             out.extend(one_core_noise(&at));
         }
     }
     out.extend(chunking(rows, g, &strategies));
-    out.extend(karp_flatt(&bests));
-    out.extend(against_paper(rows, g, &bests));
+    if seq_trusted {
+        out.extend(karp_flatt(&bests));
+        out.extend(against_paper(rows, g, &bests));
+    }
     out
 }
 
 /// Who is fastest at `cores`, if anyone can be said to be.
-fn winner(cores: usize, at: &[(&str, &Best)]) -> Option<String> {
+fn winner(cores: usize, at: &[(&str, &Best)], seq_trusted: bool) -> Option<String> {
     let contended = at.iter().filter(|(_, b)| b.contended).count();
     let mut trusted: Vec<(&str, &Best)> =
         at.iter().copied().filter(|(_, b)| !b.contended).collect();
@@ -102,7 +115,7 @@ fn winner(cores: usize, at: &[(&str, &Best)]) -> Option<String> {
         // At one core a speedup is the reference's noise (said separately), not a result.
         let speed = wb
             .speedup
-            .filter(|_| cores > 1)
+            .filter(|_| cores > 1 && seq_trusted)
             .map_or_else(String::new, |s| {
                 format!(", {}{} over seq", times(s), interval(wb.speedup_ci))
             });
@@ -141,6 +154,7 @@ fn and_list(items: &[String]) -> String {
 /// A speedup above 1 at one core is the reference's noise.
 fn one_core_noise(at: &[(&str, &Best)]) -> Vec<String> {
     at.iter()
+        .filter(|(_, b)| !b.contended)
         .filter_map(|(s, b)| {
             let sp = b.speedup.filter(|&sp| sp > 1.0)?;
             Some(format!(
@@ -312,6 +326,17 @@ mod tests {
         assert!(f.contains("at 1 core is noise in the seq reference"), "{f}");
         assert!(f.contains("e = 0.100"), "{f}");
         assert!(!f.contains("no number of cores"), "{f}");
+    }
+
+    #[test]
+    fn a_contended_reference_gives_no_speedup_finding() {
+        let mut seq = row("seq", 1, None, 4.0);
+        seq.contended = Some(true);
+        let rows = vec![seq, row("rayon-chunks", 2, Some(10), 2.2)];
+        let f = findings(&rows, &series::GroupKey::of(&rows[0])).join("\n");
+        assert!(f.contains("The seq reference was contended"), "{f}");
+        assert!(!f.contains("Karp–Flatt") && !f.contains("over seq"), "{f}");
+        assert!(!f.contains("paper's"), "{f}");
     }
 
     #[test]

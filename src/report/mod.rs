@@ -304,9 +304,10 @@ pub fn generate(
     let mut roots = results_dirs.to_vec();
     roots.push(out_dir.to_path_buf());
     let found = traces::find(&roots, trace_dirs)?;
+    let mut copied = Vec::new();
     let traces = found
         .iter()
-        .map(|d| traces::read(d, out_dir))
+        .map(|d| traces::read(d, out_dir, &mut copied))
         .collect::<anyhow::Result<Vec<_>>>()?;
     for t in &traces {
         if !t.image.contains('/') {

@@ -527,6 +527,7 @@ pub fn chunk_table(
             let mut v: Vec<ChunkCell> = ok
                 .iter()
                 .filter(|r| r.strategy == strategy && r.cores == c)
+                .filter(|r| r.contended != Some(true))
                 .filter_map(|r| Some((r.chunks?, r.mean_s?, r.stddev_s.unwrap_or(0.0))))
                 .collect();
             v.sort_by_key(|t| t.0);

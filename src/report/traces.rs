@@ -235,8 +235,9 @@ fn check_meta(path: &Path) -> anyhow::Result<String> {
 
 /// Reads a valid trace directory; its timeline is linked relative to `out_dir` when it lies
 /// inside it, and otherwise copied (atomically) into `out_dir` as
-/// `[trace-]<name>-timeline.png`.
-pub fn read(dir: &Path, out_dir: &Path) -> anyhow::Result<TraceDir> {
+/// `[trace-]<name>-timeline.png` — with `-2`, `-3`, … when an earlier trace of this report
+/// (`copied`) took that name, so two traces with the same directory name never share a copy.
+pub fn read(dir: &Path, out_dir: &Path, copied: &mut Vec<String>) -> anyhow::Result<TraceDir> {
     let Checked { title, stats } =
         check(dir).with_context(|| format!("'{}' is not a valid trace", dir.display()))?;
     let name = dir
@@ -246,11 +247,18 @@ pub fn read(dir: &Path, out_dir: &Path) -> anyhow::Result<TraceDir> {
     let image = match canonical(dir).strip_prefix(&out) {
         Ok(rel) => link(&rel.join(TIMELINE)),
         Err(_) => {
-            let file = if name.starts_with("trace") {
-                format!("{name}-timeline.png")
+            let stem = if name.starts_with("trace") {
+                name.clone()
             } else {
-                format!("trace-{name}-timeline.png")
+                format!("trace-{name}")
             };
+            let mut file = format!("{stem}-timeline.png");
+            let mut k = 1;
+            while copied.contains(&file) {
+                k += 1;
+                file = format!("{stem}-{k}-timeline.png");
+            }
+            copied.push(file.clone());
             let source = dir.join(TIMELINE);
             let bytes = std::fs::read(&source)
                 .with_context(|| format!("cannot read '{}'", source.display()))?;
@@ -416,13 +424,27 @@ mod tests {
     }
 
     #[test]
+    fn two_traces_with_the_same_directory_name_get_copies_of_their_own() {
+        let out = tempfile::tempdir().unwrap();
+        let mut copied = Vec::new();
+        let mut names = Vec::new();
+        for parent in ["a", "b"] {
+            let dir = tempfile::tempdir().unwrap();
+            let t = dir.path().join(parent).join("tr");
+            fake_trace(&t);
+            names.push(read(&t, out.path(), &mut copied).unwrap().image);
+        }
+        assert_eq!(names, ["trace-tr-timeline.png", "trace-tr-2-timeline.png"]);
+    }
+
+    #[test]
     fn trace_directories_are_found_below_a_root_and_linked_relative_to_the_report() {
         let root = tempfile::tempdir().unwrap();
         fake_trace(&root.path().join("traces/trace-a"));
         std::fs::create_dir_all(root.path().join("empty")).unwrap();
         let found = find(&[root.path().to_path_buf()], &[]).unwrap();
         assert_eq!(found.len(), 1);
-        let t = read(&found[0], root.path()).unwrap();
+        let t = read(&found[0], root.path(), &mut Vec::new()).unwrap();
         assert_eq!(t.image, "traces/trace-a/timeline.png");
         assert_eq!(
             t.title,
@@ -438,7 +460,7 @@ mod tests {
         let a = tempfile::tempdir().unwrap();
         let out = tempfile::tempdir().unwrap();
         fake_trace(&a.path().join("t1"));
-        let t = read(&a.path().join("t1"), out.path()).unwrap();
+        let t = read(&a.path().join("t1"), out.path(), &mut Vec::new()).unwrap();
         assert_eq!(t.image, "trace-t1-timeline.png");
         assert!(out.path().join("trace-t1-timeline.png").is_file());
         let err = find(&[], &[a.path().to_path_buf()]).unwrap_err();
@@ -539,7 +561,7 @@ mod tests {
     fn a_trace_on_one_of_two_workers_says_so_instead_of_explaining_the_idle_share() {
         let tmp = tempfile::tempdir().unwrap();
         fake_trace(tmp.path());
-        let mut t = read(tmp.path(), tmp.path()).unwrap();
+        let mut t = read(tmp.path(), tmp.path(), &mut Vec::new()).unwrap();
         t.stats[0].kernel_calls = 5;
         t.stats[1].kernel_calls = 0;
         let md = markdown(&[t]);

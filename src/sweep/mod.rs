@@ -219,12 +219,18 @@ fn finish(
     if let Some(contended) = console::contended_cells(all_rows) {
         console_warn(&contended);
     }
-    if status == SweepStatus::Complete {
-        text.push_str(&render_charts(dir, no_plots)?);
+    let charts = if status == SweepStatus::Complete {
+        render_charts(dir, no_plots)
+    } else {
+        Ok(String::new())
+    };
+    if let Ok(charts) = &charts {
+        text.push_str(charts);
         text.push('\n');
     }
     text.push_str(&paths_text(dir, all_rows));
     let _ = crate::output::console::line(text.trim_end());
+    charts?;
 
     if status == SweepStatus::Interrupted {
         bail!(
@@ -383,8 +389,10 @@ fn render_charts(dir: &Path, no_plots: bool) -> anyhow::Result<String> {
     if no_plots {
         return Ok("Charts: skipped (--no-plots).".to_owned());
     }
+    // The sweep has claimed its directory already (foreign files stay only where its own
+    // --force allowed them): the report writes beside them, never over them.
     let written =
-        crate::report::generate(&[dir.to_path_buf()], dir, &[], false).with_context(|| {
+        crate::report::generate(&[dir.to_path_buf()], dir, &[], true).with_context(|| {
             format!(
                 "the charts and REPORT.md could not be made (the results in '{}' are complete; \
              retry with `bench-sph report {}`)",
@@ -448,7 +456,8 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
         if !planned.contains(&row.key()) {
             return Err("not a cell of this sweep's plan".to_owned());
         }
-        if row.trials != trials {
+        // A failed cell is finished whatever number of trials it got to.
+        if row.status == Status::Ok && row.trials != trials {
             return Err(format!(
                 "{} trials, but the sweep asks for {trials}",
                 row.trials
