@@ -112,16 +112,21 @@ pub struct Threshold {
 
 impl Threshold {
     /// The foreign CPU seconds a window of `wall_s` may contain before it counts as
-    /// contended: [`CONTENDED_SHARE`] of the machine's capacity, plus the counters'
-    /// resolution (one tick per hardware thread at each end of the window).
-    pub fn allowed_s(&self, wall_s: f64) -> f64 {
+    /// contended, for a cell using `cores` threads: the smaller of [`CONTENDED_SHARE`] of the
+    /// machine's capacity and the hardware threads the cell leaves idle plus half a thread
+    /// (so that on a large machine one busy process still counts against a cell that uses
+    /// every core), plus the counters' resolution (one tick per hardware thread at each end
+    /// of the window).
+    pub fn allowed_s(&self, wall_s: f64, cores: usize) -> f64 {
         let threads = self.hardware_threads as f64;
-        CONTENDED_SHARE * threads * wall_s + 2.0 * threads / self.hz
+        let share = CONTENDED_SHARE * threads;
+        let idle = self.hardware_threads.saturating_sub(cores) as f64 + 0.5;
+        share.min(idle) * wall_s + 2.0 * threads / self.hz
     }
 
-    /// Whether `foreign_cpu_s` over `wall_s` is too much.
-    pub fn exceeded(&self, foreign_cpu_s: f64, wall_s: f64) -> bool {
-        foreign_cpu_s > self.allowed_s(wall_s)
+    /// Whether `foreign_cpu_s` over `wall_s` is too much for a cell of `cores` threads.
+    pub fn exceeded(&self, foreign_cpu_s: f64, wall_s: f64, cores: usize) -> bool {
+        foreign_cpu_s > self.allowed_s(wall_s, cores)
     }
 }
 
@@ -182,11 +187,20 @@ mod tests {
             hz: 100.0,
         };
         // 5 % of 2 threads × 1 s = 0.1 s, plus 2 ticks × 2 threads = 0.04 s.
-        assert!((t.allowed_s(1.0) - 0.14).abs() < 1e-12);
-        assert!(!t.exceeded(0.14, 1.0));
-        assert!(t.exceeded(0.15, 1.0));
+        assert!((t.allowed_s(1.0, 2) - 0.14).abs() < 1e-12);
+        assert!(!t.exceeded(0.14, 1.0, 2));
+        assert!(t.exceeded(0.15, 1.0, 2));
         // One core of two kept busy by another process is far beyond it.
-        assert!(t.exceeded(1.0, 1.0));
+        assert!(t.exceeded(1.0, 1.0, 2));
+        // On 64 threads, one busy thread (10 s of foreign CPU over 10 s) is 1.6 % of the
+        // machine, but a cell using all 64 has no idle thread to absorb it; a 1-core cell has
+        // 63.
+        let big = Threshold {
+            hardware_threads: 64,
+            hz: 100.0,
+        };
+        assert!(big.exceeded(10.0, 10.0, 64));
+        assert!(!big.exceeded(10.0, 10.0, 1));
     }
 
     #[test]

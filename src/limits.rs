@@ -9,6 +9,7 @@
 //! | `--steps` | 1 ..= [`MAX_STEPS`] | |
 //! | `--trials` | 1 ..= [`MAX_TRIALS`] | |
 //! | `--warmup` | 0 ..= [`MAX_WARMUP`] | |
+//! | a sweep's cells | at most [`MAX_CELLS`] | the product of its lists |
 
 /// The most worker threads any command accepts.
 pub const MAX_CORES: usize = 1024;
@@ -22,6 +23,9 @@ pub const MAX_STEPS: usize = 1_000_000_000;
 pub const MAX_TRIALS: usize = 1000;
 /// The most untimed warm-up runs per cell of a sweep.
 pub const MAX_WARMUP: usize = 1000;
+/// The most cells one sweep may plan (the lists multiply: cores × chunks × N × …); far
+/// beyond any study that finishes, and small enough that the plan itself fits in memory.
+pub const MAX_CELLS: usize = 1_000_000;
 
 /// A numeric option outside its documented range.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

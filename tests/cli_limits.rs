@@ -59,3 +59,19 @@ fn particle_step_and_trial_counts_beyond_their_ranges_are_refused() {
     refused(&["sweep", "--warmup", "1001"], "between 0 and 1000");
     refused(&["sweep", "--chunks", "99999999999"], "goes above 10000000");
 }
+
+#[test]
+fn a_sweep_whose_lists_multiply_beyond_the_cell_limit_is_refused() {
+    refused(
+        &[
+            "sweep",
+            "--cores",
+            "1..1024",
+            "--chunks",
+            "1..99991:10",
+            "--n",
+            "100..1000000:100",
+        ],
+        "would have more than 1000000 cells",
+    );
+}

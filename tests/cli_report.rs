@@ -195,8 +195,11 @@ fn trace_directories_under_the_results_or_given_with_trace_are_embedded() {
     let meta = r#"{"tool":"bench-sph trace","strategy":"rayon-chunks","cores":2,"chunks":45,"n":1000,"steps":3}"#;
     for t in [dir.join("trace-inside"), tmp.path().join("trace-outside")] {
         std::fs::create_dir_all(&t).unwrap();
-        // Only the PNG signature is checked.
-        std::fs::write(t.join("timeline.png"), b"\x89PNG\r\n\x1a\n").unwrap();
+        // Only the PNG header is read: the signature, and the size (a timeline is 1600 wide).
+        let mut png = b"\x89PNG\r\n\x1a\n\0\0\0\x0dIHDR".to_vec();
+        png.extend(1600u32.to_be_bytes());
+        png.extend(300u32.to_be_bytes());
+        std::fs::write(t.join("timeline.png"), png).unwrap();
         std::fs::write(t.join("stats.csv"), stats).unwrap();
         std::fs::write(t.join("meta.json"), meta).unwrap();
     }

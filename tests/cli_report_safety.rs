@@ -179,8 +179,20 @@ fn charts_of_an_earlier_report_that_are_not_drawn_again_are_removed() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("r");
     finished(&dir);
+    // A chart of a group the data no longer holds (a copy of a real chart).
+    assert!(run(&["report", dir.to_str().unwrap()]).status.success());
     let stale = dir.join("seed-all-pairs-n999-s3-4-speedup.png");
-    std::fs::write(&stale, "old chart").unwrap();
+    std::fs::copy(dir.join("seed-all-pairs-n60-s3-4-speedup.png"), &stale).unwrap();
+    // A user's files that merely look like the report's by name are not its own.
+    std::fs::write(dir.join("seed-holiday.png"), "a photo").unwrap();
+    let o = run(&["report", dir.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(
+        text(&o.stderr).contains("'seed-holiday.png'"),
+        "{}",
+        text(&o.stderr)
+    );
+    std::fs::remove_file(dir.join("seed-holiday.png")).unwrap();
     let o = run(&["report", dir.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(!stale.exists(), "the stale chart stayed");

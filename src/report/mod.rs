@@ -41,17 +41,50 @@ use series::{GroupKey, Metric};
 /// The report's file name.
 pub const REPORT_FILE: &str = "REPORT.md";
 
-/// Whether a file name is one `bench-sph report` writes: `REPORT.md`, a chart
-/// (`<preset>-….png`) or a copied timeline (`…-timeline.png`). A sweep that draws its report
-/// owns these too.
-pub fn is_own_file(name: &str) -> bool {
+/// Whether a file is one `bench-sph report` writes, by name **and** contents, so that a
+/// user's file that merely has a similar name is never replaced or removed: a `REPORT.md`
+/// that starts with `# bench-sph report`, a chart (`<preset>-….png`, a PNG of the charts'
+/// size) or a copied timeline (`…-timeline.png`, a PNG of the timelines' width). A sweep
+/// that draws its report owns these too.
+pub fn is_own_file(path: &Path) -> bool {
     use crate::sph::params::Preset;
-    name == REPORT_FILE
-        || (name.ends_with(".png")
-            && (name.ends_with("-timeline.png")
-                || Preset::ALL
-                    .iter()
-                    .any(|p| name.starts_with(&format!("{}-", p.as_str())))))
+    let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
+        return false;
+    };
+    if name == REPORT_FILE {
+        return starts_with(path, b"# bench-sph report");
+    }
+    if !name.ends_with(".png") {
+        return false;
+    }
+    if name.ends_with("-timeline.png") {
+        return png_size(path).is_some_and(|(w, _)| w == crate::trace::timeline::WIDTH);
+    }
+    Preset::ALL
+        .iter()
+        .any(|p| name.starts_with(&format!("{}-", p.as_str())))
+        && png_size(path) == Some((charts::WIDTH, charts::HEIGHT))
+}
+
+/// Whether the file at `path` begins with `prefix`.
+pub(crate) fn starts_with(path: &Path, prefix: &[u8]) -> bool {
+    use std::io::Read;
+    let mut head = vec![0u8; prefix.len()];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok_and(|()| head == prefix)
+}
+
+/// Width and height from a PNG file's header, if it is one.
+fn png_size(path: &Path) -> Option<(u32, u32)> {
+    use std::io::Read;
+    let mut head = [0u8; 24];
+    std::fs::File::open(path).ok()?.read_exact(&mut head).ok()?;
+    if &head[..8] != b"\x89PNG\r\n\x1a\n" || &head[12..16] != b"IHDR" {
+        return None;
+    }
+    let word = |i: usize| u32::from_be_bytes([head[i], head[i + 1], head[i + 2], head[i + 3]]);
+    Some((word(16), word(20)))
 }
 
 /// Whether an entry of a report's directory may stay beside the report: a sweep's own files
@@ -90,12 +123,7 @@ pub fn generate(
             ));
         }
     }
-    let owns = |p: &Path| {
-        p.is_file()
-            && p.file_name()
-                .and_then(|n| n.to_str())
-                .is_some_and(is_own_file)
-    };
+    let owns = |p: &Path| p.is_file() && is_own_file(p);
     let owner = crate::output::claim::Owner {
         command: "bench-sph report",
         option: "--out",

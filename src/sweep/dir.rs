@@ -56,7 +56,20 @@ pub fn open_new(dir: &Path, force: bool) -> anyhow::Result<DirLock> {
     }
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create results directory '{}'", dir.display()))?;
+    if !dir.join(LOCK_FILE).exists() {
+        // Not a sweep's directory yet: refuse before creating a lock file in it, so that a
+        // refused sweep leaves nothing behind. (The lock file is never deleted: see `lock`.)
+        check_contents(dir, force, false)?;
+    }
     let held = lock::acquire(dir)?;
+    // Again under the lock, which makes it authoritative.
+    check_contents(dir, force, true)?;
+    Ok(held)
+}
+
+/// Refuses foreign files (unless `force`) and a sweep's earlier output (unless `force`; with
+/// `remove`, then removes it).
+fn check_contents(dir: &Path, force: bool, remove: bool) -> anyhow::Result<()> {
     let owner = Owner {
         command: "bench-sph sweep",
         option: "--out",
@@ -86,12 +99,12 @@ pub fn open_new(dir: &Path, force: bool) -> anyhow::Result<DirLock> {
                 dir.display()
             );
         }
-        for path in earlier {
+        for path in earlier.into_iter().filter(|_| remove) {
             std::fs::remove_file(path)
                 .with_context(|| format!("cannot replace '{}'", path.display()))?;
         }
     }
-    Ok(held)
+    Ok(())
 }
 
 /// Locks an existing sweep's directory for `--resume`. Where a lock file exists, the lock is
@@ -130,9 +143,15 @@ fn owned(path: &Path) -> bool {
         return false;
     }
     match name {
-        TRIALS_FILE | SUMMARY_FILE | LOCK_FILE => true,
+        // By contents too: a hand-written trials.csv is not ours to replace (an empty one,
+        // left by a sweep killed as it started, holds nothing to lose).
+        TRIALS_FILE | SUMMARY_FILE => {
+            std::fs::metadata(path).is_ok_and(|m| m.len() == 0)
+                || crate::report::starts_with(path, b"strategy,neighbors,preset,n,steps,")
+        }
+        LOCK_FILE => true,
         META_FILE => Meta::is_sweep_meta(path),
-        _ => crate::report::is_own_file(name),
+        _ => crate::report::is_own_file(path),
     }
 }
 

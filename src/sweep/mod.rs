@@ -110,6 +110,9 @@ const BUSY_CHECK: Duration = Duration::from_millis(300);
 /// Runs a sweep: plan, measure, write, summarise. Errors (after writing all that is done)
 /// when it was interrupted or a cell failed.
 pub fn run(request: Request) -> anyhow::Result<()> {
+    // From the start: a Ctrl-C during the plan or the estimate also ends the sweep as
+    // interrupted (after the estimate), never as a killed "running" one.
+    runner::install_ctrlc_handler();
     let machine = Machine::detect();
     let hardware_threads = machine.hardware_threads;
     let session = Session::start(request.command_line.clone(), machine);
@@ -145,7 +148,8 @@ pub fn run(request: Request) -> anyhow::Result<()> {
     // Say what will happen before anything slow: the plan, the machine's load, then the
     // estimate (from short, bounded seq runs).
     print_plan(&dir, &params, &plan, &todo, hardware_threads);
-    let busy = busy_before(&timing, &threshold);
+    let widest = plan.cells.iter().map(|c| c.cores).max().unwrap_or(1);
+    let busy = busy_before(&timing, &threshold, widest);
     if let Some(session) = meta.sessions.last_mut() {
         session.busy_threads_at_start = busy.map(|b| b.threads);
     }
@@ -155,7 +159,6 @@ pub fn run(request: Request) -> anyhow::Result<()> {
     }
     let run_s = estimate(&plan, &todo, &params, hardware_threads)?;
 
-    runner::install_ctrlc_handler();
     let runs_per_cell = params.warmup + params.trials;
     let run_ms: Vec<u64> = run_s
         .iter()
@@ -173,7 +176,11 @@ pub fn run(request: Request) -> anyhow::Result<()> {
         fresh,
     )
     .context("cannot write the results")?;
-    let progress = progress_bar(todo.iter().map(|&i| run_ms[i] * runs_per_cell as u64).sum());
+    let progress = progress_bar(
+        todo.iter()
+            .map(|&i| run_ms[i].saturating_mul(runs_per_cell as u64))
+            .fold(0u64, u64::saturating_add),
+    );
     let mut runner = Runner {
         plan: &plan,
         warmup: params.warmup,
@@ -309,15 +316,16 @@ struct Busy {
     contended: bool,
 }
 
-/// Watches the machine for [`BUSY_CHECK`] (or takes `--fake-contention`'s first share).
-fn busy_before(timing: &Timing, threshold: &Threshold) -> Option<Busy> {
+/// Watches the machine for [`BUSY_CHECK`] (or takes `--fake-contention`'s first share), and
+/// judges it for the widest cell of the plan (`cores`).
+fn busy_before(timing: &Timing, threshold: &Threshold, cores: usize) -> Option<Busy> {
     let (foreign_s, wall_s) = match timing.fake_busy_threads(threshold.hardware_threads) {
         Some(threads) => (threads * BUSY_CHECK.as_secs_f64(), BUSY_CHECK.as_secs_f64()),
         None => crate::contention::sample_now(BUSY_CHECK)?,
     };
     Some(Busy {
         threads: foreign_s / wall_s,
-        contended: threshold.exceeded(foreign_s, wall_s),
+        contended: threshold.exceeded(foreign_s, wall_s, cores),
     })
 }
 

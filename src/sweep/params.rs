@@ -68,6 +68,23 @@ impl SweepParams {
         check("steps", self.steps, 1, limits::MAX_STEPS)?;
         check("trials", self.trials, 1, limits::MAX_TRIALS)?;
         check("warmup", self.warmup, 0, limits::MAX_WARMUP)?;
+        let lists = [
+            self.presets.len(),
+            self.neighbors.len(),
+            self.n.len(),
+            self.strategies.len(),
+            self.cores.len(),
+            self.chunks.len(),
+        ];
+        let cells = lists.iter().try_fold(1usize, |a, &b| a.checked_mul(b));
+        match cells {
+            Some(c) if c <= limits::MAX_CELLS => {}
+            _ => anyhow::bail!(
+                "the sweep would have more than {} cells (presets × neighbors × n × strategies \
+                 × cores × chunks); split it into smaller sweeps",
+                limits::MAX_CELLS
+            ),
+        }
         super::timing::Timing::new(
             self.fake_timings.as_deref(),
             self.fake_contention.as_deref(),

@@ -129,6 +129,17 @@ impl Cell {
         }
     }
 
+    /// The text that seeds the cell's bootstrap streams ([`super::bootstrap::rng_for`]): frozen,
+    /// so that a display change never changes a results file (`rayon-chunks, 2 cores, 10
+    /// chunks`, `seq, 1 core`).
+    pub fn stream_key(&self) -> String {
+        let cores = if self.cores == 1 { "core" } else { "cores" };
+        match self.chunks {
+            Some(k) => format!("{}, {} {cores}, {k} chunks", self.strategy, self.cores),
+            None => format!("{}, {} {cores}", self.strategy, self.cores),
+        }
+    }
+
     /// E.g. `rayon-chunks, 2 cores, 10 chunks`.
     pub fn label(&self) -> String {
         let cores = if self.cores == 1 { "core" } else { "cores" };

@@ -238,7 +238,7 @@ pub fn summary_row(
     let stats = Stats::of(&walls).filter(|_| failure.is_none());
     let seq_walls = ctx.seq_walls.filter(|w| !w.is_empty());
     let speedup = stats.and_then(|s| seq_walls.map(|seq| mean(seq) / s.mean));
-    let label = cell.label();
+    let label = cell.stream_key();
     let mean_ci = stats.and_then(|_| {
         bootstrap::mean_interval(
             &walls,
@@ -289,7 +289,7 @@ pub fn summary_row(
         contended: foreign.map(|f| {
             f.iter()
                 .zip(&walls)
-                .any(|(&foreign, &wall)| ctx.threshold.exceeded(foreign, wall))
+                .any(|(&foreign, &wall)| ctx.threshold.exceeded(foreign, wall, cell.cores))
         }),
     }
 }

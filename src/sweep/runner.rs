@@ -334,7 +334,7 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
             };
             let (measured, failure) = if let Some(failure) = failure {
                 self.progress
-                    .inc(self.run_ms[index] * (self.warmup + self.trials) as u64);
+                    .inc(self.run_ms[index].saturating_mul((self.warmup + self.trials) as u64));
                 (Vec::new(), Some(failure))
             } else {
                 if input.as_ref().is_none_or(|i| i.group != cell.group) {
