@@ -1,7 +1,9 @@
 //! What the rest of the machine was doing while we measured: the evidence that a timing is
 //! contaminated.
 //!
-//! On Linux, `/proc/stat`'s first line counts every CPU's time since boot, in ticks of
+//! On Linux, `/proc/stat` counts each CPU's time since boot (its `cpuN` lines; we sum those of
+//! the CPUs in this process's affinity mask, or the machine's `cpu` line where the mask is
+//! unknown), in ticks of
 //! `sysconf(_SC_CLK_TCK)` (USER_HZ, 100 per second on every mainstream architecture). Over a
 //! window, the machine's **busy** time is the growth of
 //! `user + nice + system + irq + softirq + steal` (guest time is already inside user and nice); the **foreign** CPU time is that
@@ -32,9 +34,44 @@ pub struct CpuTicks {
 }
 
 impl CpuTicks {
-    /// Parses the first (`cpu `) line of `/proc/stat` text.
+    /// Parses the first (`cpu `) line of `/proc/stat` text: the whole machine.
     pub fn parse(proc_stat: &str) -> Option<CpuTicks> {
         let line = proc_stat.lines().find(|l| l.starts_with("cpu "))?;
+        CpuTicks::parse_line(line)
+    }
+
+    /// Sums the `cpuN` lines of `/proc/stat` text for the CPUs in `cpus` only (those this
+    /// process may run on: under `taskset` or a container's cpuset, work on the others does
+    /// not compete with us). `None` if any of them is missing.
+    pub fn parse_cpus(proc_stat: &str, cpus: &[usize]) -> Option<CpuTicks> {
+        let mut total = CpuTicks {
+            busy: 0,
+            steal: Some(0),
+        };
+        let mut found = 0;
+        for line in proc_stat.lines() {
+            let Some(rest) = line.strip_prefix("cpu") else {
+                continue;
+            };
+            let Some((number, _)) = rest.split_once(' ') else {
+                continue;
+            };
+            let Ok(cpu) = number.parse::<usize>() else {
+                continue;
+            };
+            if !cpus.contains(&cpu) {
+                continue;
+            }
+            let t = CpuTicks::parse_line(line)?;
+            total.busy += t.busy;
+            total.steal = total.steal.zip(t.steal).map(|(a, b)| a + b);
+            found += 1;
+        }
+        (found == cpus.len()).then_some(total)
+    }
+
+    /// One `cpu…` line's counters.
+    fn parse_line(line: &str) -> Option<CpuTicks> {
         let fields: Vec<u64> = line
             .split_whitespace()
             .skip(1)
@@ -49,10 +86,28 @@ impl CpuTicks {
         Some(CpuTicks { busy, steal })
     }
 
-    /// The counters now (`None` where `/proc/stat` cannot be read).
+    /// The counters now, of the CPUs this process may run on (the whole machine where the
+    /// affinity mask cannot be read); `None` where `/proc/stat` cannot be read.
     pub fn now() -> Option<CpuTicks> {
-        CpuTicks::parse(&std::fs::read_to_string("/proc/stat").ok()?)
+        let text = std::fs::read_to_string("/proc/stat").ok()?;
+        match allowed_cpus() {
+            Some(cpus) => CpuTicks::parse_cpus(&text, cpus).or_else(|| CpuTicks::parse(&text)),
+            None => CpuTicks::parse(&text),
+        }
     }
+}
+
+/// The CPUs this process may run on (its affinity mask, read once), or `None` if unknown.
+fn allowed_cpus() -> Option<&'static [usize]> {
+    static CPUS: std::sync::OnceLock<Option<Vec<usize>>> = std::sync::OnceLock::new();
+    CPUS.get_or_init(|| {
+        let set = nix::sched::sched_getaffinity(nix::unistd::Pid::from_raw(0)).ok()?;
+        let cpus: Vec<usize> = (0..nix::sched::CpuSet::count())
+            .filter(|&i| set.is_set(i).unwrap_or(false))
+            .collect();
+        (!cpus.is_empty()).then_some(cpus)
+    })
+    .as_deref()
 }
 
 /// Ticks per second of `/proc/stat` (USER_HZ).
@@ -156,6 +211,11 @@ mod tests {
         let old = CpuTicks::parse("cpu  10 1 2 300 4 5 6\n").unwrap();
         assert_eq!((old.busy, old.steal), (24, None));
         assert_eq!(CpuTicks::parse("cpu0 1 2 3\n"), None);
+        // Only the CPUs we may run on: cpu1 is busy with someone else's work.
+        let stat = "cpu  30 0 0 0 0 0 0 0\ncpu0 10 0 0 0 0 0 0 0\ncpu1 20 0 0 0 0 0 0 0\n";
+        assert_eq!(CpuTicks::parse_cpus(stat, &[0]).unwrap().busy, 10);
+        assert_eq!(CpuTicks::parse_cpus(stat, &[0, 1]).unwrap().busy, 30);
+        assert_eq!(CpuTicks::parse_cpus(stat, &[2]), None);
         assert_eq!(CpuTicks::parse("cpu  1 2 x 4 5 6 7\n"), None);
     }
 

@@ -90,11 +90,11 @@ fn impossible_rows_are_left_out_with_a_listed_warning() {
         assert!(o.status.success(), "{}", text(&o.stderr));
         let err = text(&o.stderr);
         assert!(
-            err.contains("cell left out of the report") && err.contains(reason),
+            err.contains("row left out of the report") && err.contains(reason),
             "{column}={value}: {err}"
         );
         let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
-        assert!(md.contains("1 cell left out"), "{md}");
+        assert!(md.contains("1 row left out"), "{md}");
         let tables: Vec<&str> = md.lines().filter(|l| l.starts_with('|')).collect();
         assert!(
             !tables
@@ -103,6 +103,25 @@ fn impossible_rows_are_left_out_with_a_listed_warning() {
             "{md}"
         );
     }
+}
+
+#[test]
+fn a_line_cut_off_by_a_kill_is_left_out_with_a_warning_not_an_error() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("r");
+    finished(&dir);
+    let mut trials = std::fs::read_to_string(dir.join("trials.csv")).unwrap();
+    trials.push_str("rayon-iter,all-pairs,seed,60,3,2,,,4,0.");
+    std::fs::write(dir.join("trials.csv"), trials).unwrap();
+    let o = run(&["report", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("not a bench-sph trial row"),
+        "{}",
+        text(&o.stderr)
+    );
+    let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
+    assert!(md.contains("1 row left out"), "{md}");
 }
 
 #[test]

@@ -4,6 +4,9 @@
 //!
 //! - Files of this version and of the first release (before the contention and interval
 //!   columns) are read; the missing columns are empty.
+//! - A line that is not a row (cut off by a kill mid-write, or garbled) is left out and
+//!   listed, like a `--resume` would drop it; a file whose header is not a results file's
+//!   is an error.
 //! - A cell whose numbers are impossible (not finite and positive, statistics that are not
 //!   those of its trial rows, counts beyond the documented limits) is dropped, and the report
 //!   lists it with the reason ([`Sweep::dropped`]).
@@ -80,7 +83,9 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
         bail!("results directory '{}' does not exist", dir.display());
     }
     let meta = Meta::read(&dir.join(META_FILE))?;
-    let summary = read_summary(&dir.join(SUMMARY_FILE))?;
+    let mut dropped = Vec::new();
+    let (summary, bad) = read_summary(&dir.join(SUMMARY_FILE))?;
+    dropped.extend(bad);
     if summary.is_empty() {
         bail!(
             "'{}' has no cells: nothing to report",
@@ -89,7 +94,9 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
     }
     let trials_path = dir.join(TRIALS_FILE);
     let trials = if trials_path.is_file() {
-        Some(read_trials(&trials_path)?)
+        let (rows, bad) = read_trials(&trials_path)?;
+        dropped.extend(bad);
+        Some(rows)
     } else {
         None
     };
@@ -99,7 +106,6 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
     }
     let mut seen = HashSet::new();
     let mut rows = Vec::new();
-    let mut dropped = Vec::new();
     for row in summary {
         let checked = if !seen.insert(row.key()) {
             Err("a second summary row of the same cell".to_owned())
@@ -131,23 +137,26 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
     })
 }
 
-/// Reads a `summary.csv` (this version's columns or the first release's).
-pub fn read_summary(path: &Path) -> anyhow::Result<Vec<SummaryRow>> {
+/// Reads a `summary.csv` (this version's columns or the first release's): its rows, and a
+/// note for each line that is not one.
+pub fn read_summary(path: &Path) -> anyhow::Result<(Vec<SummaryRow>, Vec<String>)> {
     read_csv(path, &SUMMARY_COLUMNS, LEGACY_SUMMARY_COLUMNS, "summary")
 }
 
-/// Reads a `trials.csv` (this version's columns or the first release's).
-pub fn read_trials(path: &Path) -> anyhow::Result<Vec<TrialRow>> {
+/// Reads a `trials.csv` (this version's columns or the first release's), as
+/// [`read_summary`].
+pub fn read_trials(path: &Path) -> anyhow::Result<(Vec<TrialRow>, Vec<String>)> {
     read_csv(path, &TRIAL_COLUMNS, LEGACY_TRIAL_COLUMNS, "trial")
 }
 
-/// The rows of a results CSV whose header is `columns` or its first `legacy` columns.
+/// The rows of a results CSV whose header is `columns` or its first `legacy` columns, and a
+/// note naming each line that is not such a row.
 fn read_csv<R: serde::de::DeserializeOwned>(
     path: &Path,
     columns: &[&str],
     legacy: usize,
     what: &str,
-) -> anyhow::Result<Vec<R>> {
+) -> anyhow::Result<(Vec<R>, Vec<String>)> {
     let mut reader = csv::Reader::from_path(path)
         .with_context(|| format!("cannot read '{}'", path.display()))?;
     let header = reader
@@ -163,19 +172,19 @@ fn read_csv<R: serde::de::DeserializeOwned>(
             columns.join(",")
         );
     }
-    reader
-        .deserialize::<R>()
-        .enumerate()
-        .map(|(i, row)| {
-            row.with_context(|| {
-                format!(
-                    "'{}' line {}: not a bench-sph {what} row",
-                    path.display(),
-                    i + 2
-                )
-            })
-        })
-        .collect()
+    let mut rows = Vec::new();
+    let mut bad = Vec::new();
+    for (i, row) in reader.deserialize::<R>().enumerate() {
+        match row {
+            Ok(row) => rows.push(row),
+            Err(_) => bad.push(format!(
+                "'{}' line {}: not a bench-sph {what} row (cut off, or garbled)",
+                path.display(),
+                i + 2
+            )),
+        }
+    }
+    Ok((rows, bad))
 }
 
 #[cfg(test)]
@@ -183,13 +192,14 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_garbled_summary_names_the_file_and_line() {
+    fn a_garbled_row_is_left_out_naming_the_file_and_line_and_a_foreign_header_is_an_error() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("summary.csv");
         let header = SUMMARY_COLUMNS.join(",");
         std::fs::write(&path, format!("{header}\nseq,all-pairs,seed,x\n")).unwrap();
-        let err = format!("{:#}", read_summary(&path).unwrap_err());
-        assert!(err.contains("line 2"), "{err}");
+        let (rows, bad) = read_summary(&path).unwrap();
+        assert!(rows.is_empty());
+        assert!(bad[0].contains("line 2"), "{bad:?}");
         std::fs::write(&path, "a,b\n1,2\n").unwrap();
         let err = format!("{:#}", read_summary(&path).unwrap_err());
         assert!(err.contains("not a bench-sph summary.csv"), "{err}");
@@ -205,7 +215,7 @@ mod tests {
             format!("{header}\nseq,all-pairs,seed,60,3,1,,,2,1.5,0.5,1.0,1.5,2.0,1.5,1.0,1.0,0,false,00000000000000aa,ok,\n"),
         )
         .unwrap();
-        let rows = read_summary(&path).unwrap();
+        let (rows, _) = read_summary(&path).unwrap();
         assert_eq!(rows.len(), 1);
         assert_eq!((rows[0].mean_ci_low_s, rows[0].contended), (None, None));
     }

@@ -162,9 +162,10 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
     if !dropped.is_empty() {
         let _ = writeln!(
             md,
-            "> ⚠ **{} left out** as impossible (numbers not finite and positive, or statistics \
+            "> ⚠ **{} left out** as unreadable or impossible (a line cut off or garbled, \
+             numbers not finite and positive, or statistics \
              that are not those of the trial rows):",
-            crate::sweep::console::plural(dropped.len(), "cell", "cells")
+            crate::sweep::console::plural(dropped.len(), "row", "rows")
         );
         for d in dropped {
             let _ = writeln!(md, "> - {d}");

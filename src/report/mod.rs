@@ -118,7 +118,7 @@ pub fn generate(
     for s in &sweeps {
         for why in &s.dropped {
             crate::output::console::warn(&format!(
-                "warning: '{}': cell left out of the report: {why}",
+                "warning: '{}': row left out of the report: {why}",
                 s.dir.display()
             ));
         }
