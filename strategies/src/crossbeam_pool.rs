@@ -195,7 +195,10 @@ impl Executor for PoolExecutor<'_> {
             panic::catch(job)
         } else {
             degrade.before_parallel_pass(process_cpu_time);
-            self.board.run(&job)
+            let start = std::time::Instant::now();
+            let escaped = self.board.run(&job);
+            degrade.after_parallel_pass(start.elapsed());
+            escaped
         };
 
         let caught = first_panic

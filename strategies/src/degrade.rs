@@ -6,11 +6,14 @@
 //! every pass still pays for its rendezvous and its hand-overs, and gains nothing: a 2-core
 //! run beside one busy process was slower than the same strategy on 1 core.
 //!
-//! So the session's thread measures what its threads actually get. Over a window of passes
-//! (at least [`WINDOW`] of wall time) it compares the process's CPU time with the wall time:
-//! a pool of p threads on p free cores uses about p CPU-seconds per second (waiting threads
-//! spin or yield, which counts), so a shortfall of more than [`SHORTFALL`] cores means the
-//! cores are shared. The next passes then run on the session's thread alone (the workers
+//! So the session's thread measures what its threads actually get. Over a window (at least
+//! [`WINDOW`] of wall time, of which at least [`MIN_IN_PASSES`] inside passes) it compares
+//! the process's CPU time with the time spent inside passes: a pool of p threads on p free
+//! cores uses about p CPU-seconds per second of pass (waiting threads spin or yield, which
+//! counts), and one CPU-second per second of the serial work between passes (the session's
+//! thread alone, the workers asleep), so the CPU time beyond the serial work, divided by the
+//! time in passes, falling short of p by more than [`SHORTFALL`] means the cores are
+//! shared. The next passes then run on the session's thread alone (the workers
 //! sleep and leave their cores to the competing work): [`FIRST_SOLO`] passes after the first
 //! such window, doubling while the shortfall persists, up to [`MAX_SOLO`]; then a window asks
 //! for help again, and a window without shortfall ends the degradation. p counts at most the
@@ -25,6 +28,8 @@ use std::time::{Duration, Instant};
 
 /// The shortest window whose CPU time is compared with its wall time.
 pub(crate) const WINDOW: Duration = Duration::from_millis(5);
+/// The least time inside passes a window must hold to be judged.
+pub(crate) const MIN_IN_PASSES: Duration = Duration::from_millis(2);
 /// How many cores' worth of CPU time may be missing before the pool runs alone.
 pub(crate) const SHORTFALL: f64 = 0.5;
 /// Passes run alone after the first short window.
@@ -41,11 +46,13 @@ pub(crate) fn short_of_cores(threads: usize, cpu: Duration, wall: Duration) -> b
     cpu.as_secs_f64() / wall.as_secs_f64() < threads as f64 - SHORTFALL
 }
 
-/// The start of a measuring window.
+/// A measuring window: when it started, the CPU time then, and the time spent inside passes
+/// since.
 #[derive(Debug, Clone, Copy)]
 struct Window {
     wall: Instant,
     cpu: Duration,
+    in_passes: Duration,
 }
 
 /// The degradation state of one session (used by its thread only).
@@ -85,8 +92,8 @@ impl Degrade {
         true
     }
 
-    /// Called before a pass with help, with the clock and the process's CPU time (read only
-    /// when a window starts or ends).
+    /// Called before a pass with help, with the process's CPU time (read only when a window
+    /// starts or ends).
     pub(crate) fn before_parallel_pass(&mut self, cpu_now: impl Fn() -> Option<Duration>) {
         if self.threads < 2 {
             return;
@@ -94,18 +101,33 @@ impl Degrade {
         let now = Instant::now();
         match self.window {
             None => {
-                self.window = cpu_now().map(|cpu| Window { wall: now, cpu });
+                self.window = cpu_now().map(|cpu| Window {
+                    wall: now,
+                    cpu,
+                    in_passes: Duration::ZERO,
+                });
             }
-            Some(w) if now - w.wall >= WINDOW => {
+            Some(w) if now - w.wall >= WINDOW && w.in_passes >= MIN_IN_PASSES => {
                 self.window = None;
                 let Some(cpu) = cpu_now() else { return };
-                self.decide(cpu.saturating_sub(w.cpu), now - w.wall);
+                let wall = now - w.wall;
+                // The serial work between passes ran on one thread.
+                let serial = wall.saturating_sub(w.in_passes);
+                let in_passes_cpu = cpu.saturating_sub(w.cpu).saturating_sub(serial);
+                self.decide(in_passes_cpu, w.in_passes);
             }
             Some(_) => {}
         }
     }
 
-    /// Ends a window that used `cpu` over `wall`.
+    /// Called after a pass with help that took `elapsed`.
+    pub(crate) fn after_parallel_pass(&mut self, elapsed: Duration) {
+        if let Some(w) = &mut self.window {
+            w.in_passes += elapsed;
+        }
+    }
+
+    /// Ends a window whose passes used `cpu` over `wall`.
     fn decide(&mut self, cpu: Duration, wall: Duration) {
         if short_of_cores(self.threads, cpu, wall) {
             self.span = (self.span * 2).clamp(FIRST_SOLO, MAX_SOLO);
@@ -169,14 +191,32 @@ mod tests {
     }
 
     #[test]
-    fn a_window_closes_only_after_its_minimum_wall_time() {
+    fn a_window_closes_only_after_its_minimum_wall_time_and_time_in_passes() {
         let mut d = Degrade::new(2, 2);
         // The CPU clock says nothing was used: a shortfall, once the window is long enough.
         d.before_parallel_pass(|| Some(Duration::ZERO));
+        d.after_parallel_pass(ms(1));
         d.before_parallel_pass(|| Some(Duration::ZERO));
         assert!(!d.solo_pass(), "the window is still open");
         std::thread::sleep(WINDOW);
         d.before_parallel_pass(|| Some(Duration::ZERO));
+        assert!(!d.solo_pass(), "too little time in passes yet");
+        d.after_parallel_pass(ms(2));
+        d.before_parallel_pass(|| Some(Duration::ZERO));
         assert!(d.solo_pass());
+    }
+
+    #[test]
+    fn serial_work_between_passes_is_not_taken_for_missing_cores() {
+        let mut d = Degrade::new(2, 2);
+        let start = Instant::now();
+        d.before_parallel_pass(|| Some(Duration::ZERO));
+        d.after_parallel_pass(ms(2));
+        // 2 ms of passes on 2 threads (4 ms of CPU) and the rest of the window serial on one.
+        std::thread::sleep(WINDOW);
+        let wall = start.elapsed();
+        let cpu = ms(4) + wall.saturating_sub(ms(2));
+        d.before_parallel_pass(|| Some(cpu));
+        assert!(!d.solo_pass());
     }
 }
