@@ -3,18 +3,10 @@
 //! nothing impossible becomes a number.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 
-fn run(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
+mod common;
+use common::{run, text};
 
 /// A small finished sweep under fake times: seq, rayon-chunks and rayon-iter at 1 and 2 cores.
 fn sweep(dir: &Path, extra: &[&str]) -> Output {

@@ -2,13 +2,13 @@
 //! edited results directory: contention is recorded, nothing is lost, nothing panics or hangs.
 //! No test asserts a duration.
 
-use std::collections::HashMap;
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
-use std::time::{Duration, Instant};
 
-type Row = HashMap<String, String>;
+mod common;
+use common::{bench_sph, no_panic, rows, run, text};
+use std::time::{Duration, Instant};
 
 /// A tiny sweep of seq and rayon-chunks under fake times.
 const TINY: &[&str] = &[
@@ -31,43 +31,11 @@ const TINY: &[&str] = &[
     "1.0,1.1,0.9,0.5,0.55,0.6",
 ];
 
-fn bench_sph() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
-}
-
-fn run(args: &[&str]) -> Output {
-    bench_sph().args(args).output().expect("binary runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
 fn tiny(dir: &Path, extra: &[&str]) -> Output {
     let mut args = TINY.to_vec();
     args.extend(["--out", dir.to_str().unwrap()]);
     args.extend(extra);
     run(&args)
-}
-
-fn rows(path: &Path) -> Vec<Row> {
-    let mut r = csv::Reader::from_path(path).unwrap();
-    let header = r.headers().unwrap().clone();
-    r.records()
-        .map(|rec| {
-            let rec = rec.unwrap();
-            header
-                .iter()
-                .zip(rec.iter())
-                .map(|(k, v)| (k.to_owned(), v.to_owned()))
-                .collect()
-        })
-        .collect()
-}
-
-fn no_panic(o: &Output) {
-    let err = text(&o.stderr);
-    assert!(!err.contains("panicked"), "panicked:\n{err}");
 }
 
 #[test]

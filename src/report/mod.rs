@@ -52,7 +52,7 @@ pub fn is_own_file(path: &Path) -> bool {
         return false;
     };
     if name == REPORT_FILE {
-        return starts_with(path, b"# bench-sph report");
+        return crate::trace::files::starts_with(path, b"# bench-sph report");
     }
     if !name.ends_with(".png") {
         return false;
@@ -66,21 +66,12 @@ pub fn is_own_file(path: &Path) -> bool {
         && png_size(path) == Some((charts::WIDTH, charts::HEIGHT))
 }
 
-/// Whether the file at `path` begins with `prefix`.
-pub(crate) fn starts_with(path: &Path, prefix: &[u8]) -> bool {
-    use std::io::Read;
-    let mut head = vec![0u8; prefix.len()];
-    std::fs::File::open(path)
-        .and_then(|mut f| f.read_exact(&mut head))
-        .is_ok_and(|()| head == prefix)
-}
-
 /// Width and height from a PNG file's header, if it is one.
 fn png_size(path: &Path) -> Option<(u32, u32)> {
     use std::io::Read;
     let mut head = [0u8; 24];
     std::fs::File::open(path).ok()?.read_exact(&mut head).ok()?;
-    if &head[..8] != b"\x89PNG\r\n\x1a\n" || &head[12..16] != b"IHDR" {
+    if head[..8] != crate::trace::files::PNG_SIGNATURE || &head[12..16] != b"IHDR" {
         return None;
     }
     let word = |i: usize| u32::from_be_bytes([head[i], head[i + 1], head[i + 2], head[i + 3]]);

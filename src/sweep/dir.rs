@@ -147,7 +147,7 @@ fn owned(path: &Path) -> bool {
         // left by a sweep killed as it started, holds nothing to lose).
         TRIALS_FILE | SUMMARY_FILE => {
             std::fs::metadata(path).is_ok_and(|m| m.len() == 0)
-                || crate::report::starts_with(path, b"strategy,neighbors,preset,n,steps,")
+                || crate::trace::files::starts_with(path, b"strategy,neighbors,preset,n,steps,")
         }
         LOCK_FILE => true,
         META_FILE => Meta::is_sweep_meta(path),

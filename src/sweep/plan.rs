@@ -140,13 +140,10 @@ impl Cell {
         }
     }
 
-    /// E.g. `rayon-chunks, 2 cores, 10 chunks`.
+    /// E.g. `rayon-chunks, 2 cores, 10 chunks`: today the same text as the frozen
+    /// [`stream_key`](Self::stream_key); a display change goes here, never there.
     pub fn label(&self) -> String {
-        let cores = if self.cores == 1 { "core" } else { "cores" };
-        match self.chunks {
-            Some(k) => format!("{}, {} {cores}, {k} chunks", self.strategy, self.cores),
-            None => format!("{}, {} {cores}", self.strategy, self.cores),
-        }
+        self.stream_key()
     }
 }
 
