@@ -107,7 +107,7 @@ fn bench_scene(c: &mut Criterion, label: &str, mode: NeighborMode, n: usize) {
             .measurement_time(Duration::from_secs(2));
         for &strategy in StrategyName::ALL {
             for &cores in &cores_list {
-                if strategy == StrategyName::Seq && cores > 1 {
+                if strategy.info().effective_cores(cores) < cores {
                     continue;
                 }
                 let mut sim = start.clone();

@@ -63,23 +63,15 @@ fn trace(strategy: StrategyName, out: &Path, extra: &[&str]) -> Output {
 
 /// Kernel calls per pass, where the strategy fixes it (rayon-iter lets rayon decide).
 fn expected_calls(strategy: StrategyName) -> Option<usize> {
-    if strategy.info().uses_chunks {
-        return Some(CHUNKS.min(N));
-    }
-    match strategy {
-        StrategyName::Seq => Some(1),
-        StrategyName::StdStatic => Some(CORES.min(N)),
-        StrategyName::RayonSpawn => Some(N),
-        _ => None,
-    }
+    let config = sph_strategies::Config {
+        cores: CORES,
+        chunks: CHUNKS,
+    };
+    strategy.info().kernel_calls(N, &config)
 }
 
 fn workers(strategy: StrategyName) -> usize {
-    if strategy == StrategyName::Seq {
-        1
-    } else {
-        CORES
-    }
+    strategy.info().effective_cores(CORES)
 }
 
 /// A complete kernel event: (step, pass, worker, tid, first, len, ts, dur).

@@ -5,6 +5,7 @@
 //! the last frame would not be seen, so they are not run).
 
 use std::io::IsTerminal;
+use std::ops::ControlFlow;
 use std::path::PathBuf;
 
 use clap::Args;
@@ -12,11 +13,13 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use sph_strategies::{Config, StrategyName};
 
 use super::simulate::say;
+use crate::clock::Elapsed;
 use crate::render::frame::{Caption, MAX_WIDTH, MIN_WIDTH, Painter};
 use crate::render::output::Output;
 use crate::render::scale::{ColorBy, Scale};
-use crate::run::run_timed;
+use crate::run::{Observer, Steps, run_steps};
 use crate::solver::Simulation;
+use crate::sph::params::Preset;
 
 /// Where the GIF goes when neither `--out` nor `--frames` is given.
 const DEFAULT_OUT: &str = "dambreak.gif";
@@ -77,13 +80,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let (width, height) = (painter.layout().width, painter.layout().height);
 
     // Open the output before simulating, so a bad path costs nothing.
-    let mut output = match &args.frames {
-        Some(dir) => Output::png_frames(dir, args.force)?,
-        None => {
-            let path = args.out.clone().unwrap_or_else(|| DEFAULT_OUT.into());
-            Output::gif(&path, (width, height), &painter.palette(), args.fps)?
-        }
-    };
+    let mut output = open_output(args, &painter)?;
 
     let frames = args.steps / args.every + 1;
     let n = state.len();
@@ -92,35 +89,37 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         chunks: args.chunks,
     };
     let mut sim = Simulation::new(params, domain, state, args.scene.neighbors);
-    let caption = |sim: &Simulation| Caption {
-        step: sim.steps_done,
-        time_s: sim.steps_done as f64 * sim.params.dt,
-        n,
-        preset: args.scene.preset,
-    };
     let bar = progress_bar(frames, n * args.steps);
     let started = std::time::Instant::now();
-    let mut simulating_s = 0.0;
 
-    output.push(&painter.draw(&sim.state, &caption(&sim)))?;
+    output.push(&painter.draw(&sim.state, &Caption::at(0, n, args.scene.preset)))?;
     bar.inc(1);
-    for _ in 1..frames {
-        let shown = sim.steps_done;
-        match run_timed(&mut sim, args.strategy, &config, args.every) {
-            Ok(elapsed) => simulating_s += elapsed.wall_s,
-            Err(err) => {
-                bar.finish_and_clear();
-                let place = output.describe();
-                output.finish()?;
-                anyhow::bail!("{err} (the frames up to step {shown} are in {place})");
-            }
-        }
-        output.push(&painter.draw(&sim.state, &caption(&sim)))?;
-        bar.inc(1);
+    let mut drawn = Frames {
+        painter: &painter,
+        preset: args.scene.preset,
+        output: &mut output,
+        bar: &bar,
+        shown: 0,
+        simulating_s: 0.0,
+        failed: None,
+    };
+    let steps = Steps {
+        total: (frames - 1) * args.every,
+        every: args.every,
+        warmup: 0,
+    };
+    // All frames in one session: one thread pool for the whole animation.
+    let outcome = run_steps(&mut sim, args.strategy, &config, steps, &mut (), &mut drawn);
+    let (shown, simulating_s) = (drawn.shown, drawn.simulating_s);
+    if let Some(err) = drawn.failed {
+        return Err(err);
     }
     bar.finish_and_clear();
     let place = output.describe();
     output.finish()?;
+    if let Err(err) = outcome {
+        anyhow::bail!("{err} (the frames up to step {shown} are in {place})");
+    }
     say(&format!(
         "{frames} frames of {width} × {height} px (steps 0 to {}, one every {}) written to {place}",
         sim.steps_done, args.every
@@ -129,6 +128,50 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         "{:.2} s in all, {simulating_s:.2} s of it simulating",
         started.elapsed().as_secs_f64()
     ))
+}
+
+/// The GIF file or PNG folder the frames go to.
+fn open_output(args: &RenderArgs, painter: &Painter) -> anyhow::Result<Output> {
+    match &args.frames {
+        Some(dir) => Output::png_frames(dir, args.force),
+        None => {
+            let path = args.out.clone().unwrap_or_else(|| DEFAULT_OUT.into());
+            let size = (painter.layout().width, painter.layout().height);
+            Output::gif(&path, size, &painter.palette(), args.fps)
+        }
+    }
+}
+
+/// Draws a frame after every `--every` steps, outside the timed steps, and adds up the time
+/// the steps took.
+struct Frames<'a> {
+    painter: &'a Painter,
+    preset: Preset,
+    output: &'a mut Output,
+    bar: &'a ProgressBar,
+    /// The step of the last frame written.
+    shown: usize,
+    /// Wall time of the steps so far, s.
+    simulating_s: f64,
+    /// Why a frame could not be written (the run then stops).
+    failed: Option<anyhow::Error>,
+}
+
+impl Observer for Frames<'_> {
+    fn segment(&mut self, sim: &Simulation, elapsed: Elapsed) -> ControlFlow<()> {
+        self.simulating_s += elapsed.wall_s;
+        let frame = self.painter.draw(
+            &sim.state,
+            &Caption::at(sim.steps_done, sim.state.len(), self.preset),
+        );
+        if let Err(err) = self.output.push(&frame) {
+            self.failed = Some(err);
+            return ControlFlow::Break(());
+        }
+        self.shown = sim.steps_done;
+        self.bar.inc(1);
+        ControlFlow::Continue(())
+    }
 }
 
 /// A bar counting frames on stderr; hidden when stderr is not a terminal or the render is tiny.

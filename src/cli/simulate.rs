@@ -11,7 +11,8 @@ use crate::checksum::checksum_hex;
 use crate::io::dump_csv::{self, DumpInfo};
 use crate::io::sink::Sink;
 use crate::output::console;
-use crate::run::{RunError, run_timed};
+use crate::run::fault::PanicAt;
+use crate::run::{RunError, run_timed, run_timed_with};
 use crate::solver::{Simulation, StepError};
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
@@ -84,8 +85,13 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         state,
         args.scene.neighbors,
     );
-    sim.inject_panic_at(args.inject_panic_at);
-    let outcome = run_timed(&mut sim, args.strategy, &config, args.steps);
+    let outcome = match args.inject_panic_at {
+        None => run_timed(&mut sim, args.strategy, &config, args.steps),
+        Some(particle) => {
+            let mut fault = PanicAt(particle);
+            run_timed_with(&mut sim, args.strategy, &config, args.steps, 0, &mut fault)
+        }
+    };
 
     let diverged = matches!(outcome, Err(RunError::Step(StepError::Diverged { .. })));
     if let Some(mut out) = dump.take().filter(|_| outcome.is_ok() || diverged) {
@@ -115,12 +121,8 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         preset: args.scene.preset,
         neighbors: args.scene.neighbors,
         strategy: info.name.to_owned(),
-        cores: if args.strategy == StrategyName::Seq {
-            1
-        } else {
-            cores
-        },
-        chunks: info.uses_chunks.then_some(args.chunks),
+        cores: info.effective_cores(cores),
+        chunks: info.effective_chunks(args.chunks),
         seed: args.scene.init.is_none().then_some(args.scene.seed),
         init: args.scene.init.as_ref().map(|p| p.display().to_string()),
         n,

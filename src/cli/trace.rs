@@ -117,8 +117,8 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
     let info = args.strategy.info();
     let config = TraceConfig {
         strategy: info.name.to_owned(),
-        cores: crate::trace::expected_workers(args.strategy, cores),
-        chunks: info.uses_chunks.then_some(args.chunks),
+        cores: info.effective_cores(cores),
+        chunks: info.effective_chunks(args.chunks),
         n: state.len(),
         steps: args.steps,
         preset: args.scene.preset,

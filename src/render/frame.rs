@@ -44,6 +44,18 @@ pub struct Caption {
     pub preset: Preset,
 }
 
+impl Caption {
+    /// The caption after `step` steps of `n` particles on `preset`.
+    pub fn at(step: usize, n: usize, preset: Preset) -> Caption {
+        Caption {
+            step,
+            time_s: step as f64 * preset.params().dt,
+            n,
+            preset,
+        }
+    }
+}
+
 impl fmt::Display for Caption {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(

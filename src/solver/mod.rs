@@ -1,8 +1,13 @@
 //! One step = three passes over all particles, each handed to a strategy's executor, plus the
 //! grid rebuild before them and the divergence check after them. How each pass is cut into
-//! kernel calls lives in [`schedule`].
+//! kernel calls lives in `schedule`; the one step loop ([`Simulation::advance_with`]) and the
+//! [`StepHooks`] through which a caller wraps each phase's executor (tracing, fault injection)
+//! or the check, in `step`.
 
 mod schedule;
+mod step;
+
+pub use step::{Phase, PhaseJob, StepHooks};
 
 use sph_strategies::{Executor, KernelPanic};
 
@@ -46,7 +51,6 @@ pub struct Simulation {
     pub steps_done: usize,
     neighbors: AnyNeighbors,
     lists: NeighborLists,
-    fault: Option<usize>,
 }
 
 /// One pass of a step, for benchmarks and traces.
@@ -97,45 +101,7 @@ impl Simulation {
             steps_done: 0,
             neighbors,
             lists,
-            fault: None,
         }
-    }
-
-    /// Makes the density kernel panic when it reaches `particle` (test-only fault injection,
-    /// checked once per kernel call, to exercise the strategies' panic handling end to end).
-    pub fn inject_panic_at(&mut self, particle: Option<usize>) {
-        self.fault = particle;
-    }
-
-    /// Runs `steps` steps on `exec`. Stops at the first failing step.
-    pub fn advance<E: Executor>(&mut self, exec: &E, steps: usize) -> Result<(), StepError> {
-        for _ in 0..steps {
-            let step = self.steps_done + 1;
-            self.step_once(exec)
-                .map_err(|source| StepError::Kernel { step, source })?;
-            self.steps_done = step;
-            // Any non-finite density, pressure, force or position makes the particle's own
-            // velocity non-finite in the same step, so checking velocities (2 arrays rather
-            // than 8) catches every divergence; the full scan then names the first field.
-            if !self.state.velocities_finite()
-                && let Some((field, particle)) = self.state.first_non_finite()
-            {
-                return Err(StepError::Diverged {
-                    step,
-                    particle,
-                    field,
-                });
-            }
-        }
-        Ok(())
-    }
-
-    /// One step without the divergence check: rebuild the search, then the three passes.
-    fn step_once<E: Executor>(&mut self, exec: &E) -> Result<(), KernelPanic> {
-        self.rebuild_neighbors_on(exec)?;
-        Pass::ALL
-            .into_iter()
-            .try_for_each(|pass| self.run_pass(exec, pass))
     }
 
     /// Brings the neighbour search up to date with the current positions, on `exec`.
@@ -160,7 +126,7 @@ impl Simulation {
         let (s, prm, lists) = (&mut self.state, &self.params, &mut self.lists);
         match pass {
             Pass::Density => {
-                with_search!(&self.neighbors, nb => schedule::density(exec, nb, lists, s, prm, self.fault))
+                with_search!(&self.neighbors, nb => schedule::density(exec, nb, lists, s, prm))
             }
             Pass::Forces => {
                 with_search!(&self.neighbors, nb => schedule::forces(exec, nb, lists, s, prm))

@@ -16,7 +16,6 @@ pub fn density<E: Executor, N: Neighbors>(
     lists: &mut NeighborLists,
     s: &mut State,
     prm: &Params,
-    fault: Option<usize>,
 ) -> Result<(), KernelPanic> {
     let pos = Positions { x: &s.x, y: &s.y };
     let out = (
@@ -26,9 +25,6 @@ pub fn density<E: Executor, N: Neighbors>(
         SlotsMut(&mut lists.slots[..]),
     );
     exec.for_each_chunk(out, |first, (rho, p, count, mut slots)| {
-        if let Some(i) = fault.filter(|i| (first..first + rho.len()).contains(i)) {
-            panic!("injected fault at particle {i}");
-        }
         for (k, ((rho, p), count)) in rho.iter_mut().zip(p).zip(count).enumerate() {
             (*rho, *p, *count) =
                 passes::density_pressure(first + k, pos, nb, prm, slots.particle(k));

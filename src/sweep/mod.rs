@@ -581,7 +581,7 @@ fn chunked_strategies(params: &SweepParams) -> String {
     let names: Vec<&str> = params
         .strategies
         .iter()
-        .filter(|s| s.info().uses_chunks)
+        .filter(|s| s.info().uses_chunks())
         .map(|s| s.as_str())
         .collect();
     if names.is_empty() {

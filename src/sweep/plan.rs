@@ -192,7 +192,7 @@ impl Plan {
                         cores,
                         chunks,
                     };
-                    if strategy.info().uses_chunks {
+                    if strategy.info().uses_chunks() {
                         cells.extend(params.chunks.iter().map(|&k| cell(Some(k))));
                     } else {
                         cells.push(cell(None));
@@ -261,12 +261,12 @@ mod tests {
             .filter(|&&s| s != StrategyName::Seq)
         {
             let cells: Vec<&Cell> = plan.cells.iter().filter(|c| c.strategy == s).collect();
-            let per_cores = if s.info().uses_chunks { 2 } else { 1 };
+            let per_cores = if s.info().uses_chunks() { 2 } else { 1 };
             assert_eq!(cells.len(), 2 * 3 * per_cores, "{s}");
             assert!(
                 cells
                     .iter()
-                    .all(|c| c.chunks.is_some() == s.info().uses_chunks)
+                    .all(|c| c.chunks.is_some() == s.info().uses_chunks())
             );
         }
     }

@@ -81,24 +81,46 @@ fn timed_call<O: Split, F: Fn(usize, O)>(
 pub fn recording_cost_ns(calls: usize) -> f64 {
     let calls = calls.max(1);
     let rec = Recorder::new(1, calls, 0);
+    let start = std::time::Instant::now();
+    record_empty_calls(&rec, calls);
+    start.elapsed().as_nanos() as f64 / calls as f64
+}
+
+/// Records `calls` calls of an empty kernel on `rec`, as density calls of step 1 whose
+/// chunks start at 0, 1, 2, ….
+fn record_empty_calls(rec: &Recorder, calls: usize) {
     let mut data = [0u8; 1];
     let empty = |_: usize, chunk: &mut [u8]| {
         std::hint::black_box(chunk);
     };
-    let start = std::time::Instant::now();
     for i in 0..calls {
         let phase = Phase::Pass(crate::solver::Pass::Density);
-        timed_call(&rec, phase, 1, i, &mut data[..], &empty);
+        timed_call(rec, phase, 1, i, &mut data[..], &empty);
     }
-    start.elapsed().as_nanos() as f64 / calls as f64
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solver::Pass;
 
     #[test]
     fn calibration_records_every_call_and_reports_a_positive_cost() {
         assert!(recording_cost_ns(1000) > 0.0);
+        let rec = Recorder::new(1, 0, 0);
+        record_empty_calls(&rec, 1000);
+        let end = rec.now_ns();
+        let trace = rec.finish(0, end, 1);
+        assert_eq!(trace.kernels.len(), 1000);
+        let mut firsts: Vec<usize> = trace.kernels.iter().map(|e| e.first).collect();
+        firsts.sort_unstable();
+        assert_eq!(firsts, (0..1000).collect::<Vec<_>>());
+        for e in &trace.kernels {
+            assert_eq!(
+                (e.phase, e.step, e.len, e.worker),
+                (Phase::Pass(Pass::Density), 1, 1, 0)
+            );
+            assert!(e.start_ns <= e.end_ns && e.end_ns <= end, "{e:?}");
+        }
     }
 }

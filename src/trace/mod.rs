@@ -1,10 +1,10 @@
 //! `bench-sph trace`: where each worker spends its time — the analogue of the seed paper's
 //! Threadscope timelines and its runtime's `SPARKS:` statistics, for every strategy.
 //!
-//! A traced run ([`session::run_traced`]) drives the same step loop as an untraced one, pass by
-//! pass, on the strategy's own executor wrapped in a [`TracingExecutor`], which reads a
-//! monotonic clock around every kernel call and records one [`KernelEvent`] per call — per
-//! chunk for the chunked strategies, per task for `rayon-spawn`, per leaf for `rayon-iter`,
+//! A traced run ([`session::run_traced`]) drives the same step loop as an untraced one, with
+//! hooks that run each phase on the strategy's own executor wrapped in a [`TracingExecutor`],
+//! which reads a monotonic clock around every kernel call and records one [`KernelEvent`] per
+//! call — per chunk for the chunked strategies, per task for `rayon-spawn`, per leaf for `rayon-iter`,
 //! per block for `std-static` — never per particle. The wrapper changes neither the chunks
 //! nor the threads, and untraced runs never see it, so they pay nothing. The calling thread's
 //! serial work between passes (grid rebuild, divergence check) is recorded too.
@@ -32,7 +32,7 @@ use crate::sph::params::Preset;
 
 pub use executor::TracingExecutor;
 pub use recorder::{KernelEvent, Recorder, SerialEvent, SerialWork, ThreadInfo, Trace};
-pub use session::{TracedRun, expected_workers, run_traced, run_untraced};
+pub use session::{TracedRun, run_traced, run_untraced};
 
 /// What was traced: shown in titles and written to `trace.json`'s `otherData` and `meta.json`.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize)]

@@ -23,42 +23,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Instant;
 
-use crate::solver::Pass;
-
-/// What a kernel call computed: part of the neighbour search's rebuild (the grid's, which
-/// runs its per-particle parts on the executor), or one of the three passes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Phase {
-    /// The neighbour search's rebuild, before the density pass.
-    Rebuild,
-    /// A pass.
-    Pass(Pass),
-}
-
-impl Phase {
-    /// Every phase in step order.
-    pub const ALL: [Phase; 4] = [
-        Phase::Rebuild,
-        Phase::Pass(Pass::Density),
-        Phase::Pass(Pass::Forces),
-        Phase::Pass(Pass::Integrate),
-    ];
-
-    /// Name, as in trace.json, stats.csv and the timeline's legend: `grid rebuild` or the
-    /// pass's name.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Phase::Rebuild => "grid rebuild",
-            Phase::Pass(p) => p.as_str(),
-        }
-    }
-}
-
-impl From<Pass> for Phase {
-    fn from(p: Pass) -> Self {
-        Phase::Pass(p)
-    }
-}
+pub use crate::solver::Phase;
 
 /// One kernel call: which worker ran which chunk of which phase of which step, and when.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -367,6 +332,7 @@ impl Recorder {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solver::Pass;
 
     fn event(slot: &WorkerSlot, first: usize) -> KernelEvent {
         KernelEvent {

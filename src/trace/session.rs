@@ -1,22 +1,23 @@
-//! A traced run: the same step loop as [`crate::run::run_timed`], pass by pass, so that every
-//! kernel call is known to belong to one pass of one step.
+//! A traced run: the one step loop ([`crate::run`]) with hooks that run every phase of every
+//! step on a [`TracingExecutor`] and time the divergence check, so that every kernel call is
+//! known to belong to one pass of one step.
 //!
-//! Both traced and untraced runs here first **warm up** the strategy's threads: a few
-//! untimed, unrecorded steps on a copy of the initial state, on the same pool, right before
-//! the recorded steps. A freshly built pool's threads are still starting or asleep, and a
-//! first few steps of small chunks can then all run on the thread that started them; the
-//! committed `rayon-chunks` timeline once showed 405 kernel calls on one of two workers for
-//! that reason. The copy leaves the recorded steps exactly those of an untraced run from the
-//! same state.
+//! Both traced and untraced runs here first **warm up** the strategy's threads
+//! ([`crate::run::Steps::warmup`]): a few untimed, unrecorded steps on a copy of the initial
+//! state, on the same pool, right before the recorded steps. A freshly built pool's threads
+//! are still starting or asleep, and a first few steps of small chunks can then all run on the
+//! thread that started them; the committed `rayon-chunks` timeline once showed 405 kernel
+//! calls on one of two workers for that reason. The copy leaves the recorded steps exactly
+//! those of an untraced run from the same state.
 
-use sph_strategies::{Config, Executor, Session, StrategyName};
+use sph_strategies::{Config, Executor, KernelPanic, StrategyName};
 
 use super::executor::TracingExecutor;
 use super::recorder::{Phase, Recorder, SerialWork, Trace};
 use super::size::{MAX_EVENTS, Plan};
-use crate::clock::{Elapsed, Stopwatch};
-use crate::run::RunError;
-use crate::solver::{Pass, Simulation, StepError};
+use crate::clock::Elapsed;
+use crate::run::{RunError, run_timed_with};
+use crate::solver::{PhaseJob, Simulation, StepHooks};
 use crate::sph::neighbors::NeighborMode;
 
 /// What a traced run gives back.
@@ -26,15 +27,6 @@ pub struct TracedRun {
     pub elapsed: Elapsed,
     /// What was recorded.
     pub trace: Trace,
-}
-
-/// The number of worker tracks a strategy is expected to use: 1 for `seq`, `cores` otherwise.
-pub fn expected_workers(strategy: StrategyName, cores: usize) -> usize {
-    if strategy == StrategyName::Seq {
-        1
-    } else {
-        cores
-    }
 }
 
 /// The kernel calls one worker is expected to make (from [`Plan::kernel_calls`], counting the
@@ -52,7 +44,7 @@ fn capacity_hint(strategy: StrategyName, config: &Config, n: usize, steps: usize
     .kernel_calls();
     // Twice a fair share, so that a moderately unbalanced run never reallocates, but never
     // more than `MAX_EVENTS` preallocated over all workers (a buffer that fills grows).
-    let workers = expected_workers(strategy, config.cores);
+    let workers = strategy.info().effective_cores(config.cores);
     total
         .saturating_mul(2)
         .div_ceil(workers)
@@ -60,66 +52,42 @@ fn capacity_hint(strategy: StrategyName, config: &Config, n: usize, steps: usize
         .min(MAX_EVENTS / workers)
 }
 
-/// Runs `steps` steps of a copy of `sim` on `exec`, discarding the copy. A copy that diverges
-/// only ends the warm-up early (the recorded run reports its own divergence, if it reaches
-/// it); a kernel's panic is an error.
-fn warm_up<E: Executor>(exec: &E, sim: &Simulation, steps: usize) -> Result<(), StepError> {
-    if steps == 0 {
-        return Ok(());
-    }
-    let mut copy = sim.clone();
-    match copy.advance(exec, steps) {
-        Ok(()) | Err(StepError::Diverged { .. }) => Ok(()),
-        Err(e) => Err(e),
-    }
-}
-
-struct TracedSteps<'a> {
-    sim: &'a mut Simulation,
-    steps: usize,
-    warmup: usize,
+/// Step hooks that record: each phase runs on a [`TracingExecutor`], and the grid rebuild and
+/// the divergence check are timed as the calling thread's serial work. The recorded window
+/// runs from the first rebuild's start to the last check's end.
+struct Tracing<'a> {
     recorder: &'a Recorder,
+    window: Option<(u64, u64)>,
 }
 
-impl Session for TracedSteps<'_> {
-    type Output = Result<(Elapsed, u64, u64), StepError>;
-
-    fn run<E: Executor>(self, exec: &E) -> Self::Output {
-        let (sim, rec) = (self.sim, self.recorder);
-        warm_up(exec, sim, self.warmup)?;
-        let watch = Stopwatch::start();
-        let loop_start = rec.now_ns();
-        for _ in 0..self.steps {
-            let step = sim.steps_done + 1;
-            let kernel_failed = |source| StepError::Kernel { step, source };
-            let t = rec.now_ns();
-            sim.rebuild_neighbors_on(&TracingExecutor::new(exec, rec, Phase::Rebuild, step))
-                .map_err(kernel_failed)?;
+impl StepHooks for Tracing<'_> {
+    fn phase<E: Executor, J: PhaseJob>(
+        &mut self,
+        exec: &E,
+        phase: Phase,
+        step: usize,
+        job: J,
+    ) -> Result<(), KernelPanic> {
+        let rec = self.recorder;
+        let t = rec.now_ns();
+        self.window.get_or_insert((t, t));
+        job.run_on(&TracingExecutor::new(exec, rec, phase, step))?;
+        if phase == Phase::Rebuild {
             rec.record_serial(SerialWork::Rebuild, step, t, rec.now_ns());
-            for pass in Pass::ALL {
-                sim.run_pass(&TracingExecutor::new(exec, rec, pass, step), pass)
-                    .map_err(kernel_failed)?;
-            }
-            sim.steps_done = step;
-            // The same guard as `Simulation::advance`: velocities first, the full scan only
-            // to name the culprit.
-            let t = rec.now_ns();
-            let bad = if sim.state.velocities_finite() {
-                None
-            } else {
-                sim.state.first_non_finite()
-            };
-            rec.record_serial(SerialWork::Check, step, t, rec.now_ns());
-            if let Some((field, particle)) = bad {
-                return Err(StepError::Diverged {
-                    step,
-                    particle,
-                    field,
-                });
-            }
         }
-        let loop_end = rec.now_ns();
-        Ok((watch.stop(), loop_start, loop_end))
+        Ok(())
+    }
+
+    fn check<R>(&mut self, step: usize, check: impl FnOnce() -> R) -> R {
+        let rec = self.recorder;
+        let t = rec.now_ns();
+        let result = check();
+        let end = rec.now_ns();
+        rec.record_serial(SerialWork::Check, step, t, end);
+        if let Some(window) = &mut self.window {
+            window.1 = end;
+        }
+        result
     }
 }
 
@@ -137,39 +105,22 @@ pub fn run_traced(
     steps: usize,
     warmup: usize,
 ) -> Result<TracedRun, RunError> {
-    let workers = expected_workers(strategy, config.cores);
+    let workers = strategy.info().effective_cores(config.cores);
     let per_worker = capacity_hint(strategy, config, sim.state.len(), steps);
     let recorder = Recorder::new(workers, per_worker, 2 * steps);
-    let session = TracedSteps {
-        sim,
-        steps,
-        warmup,
+    let mut hooks = Tracing {
         recorder: &recorder,
+        window: None,
     };
-    let result = sph_strategies::run(strategy, config, session)
-        .map_err(|source| RunError::Build { strategy, source })?;
-    let (elapsed, start, end) = result?;
+    let elapsed = run_timed_with(sim, strategy, config, steps, warmup, &mut hooks)?;
+    let (start, end) = hooks.window.unwrap_or_else(|| {
+        let now = recorder.now_ns();
+        (now, now)
+    });
     Ok(TracedRun {
         elapsed,
         trace: recorder.finish(start, end, workers),
     })
-}
-
-struct UntracedSteps<'a> {
-    sim: &'a mut Simulation,
-    steps: usize,
-    warmup: usize,
-}
-
-impl Session for UntracedSteps<'_> {
-    type Output = Result<Elapsed, StepError>;
-
-    fn run<E: Executor>(self, exec: &E) -> Self::Output {
-        warm_up(exec, self.sim, self.warmup)?;
-        let watch = Stopwatch::start();
-        self.sim.advance(exec, self.steps)?;
-        Ok(watch.stop())
-    }
 }
 
 /// [`run_traced`] without the recording: the same warm-up, then `steps` timed steps. The
@@ -181,10 +132,7 @@ pub fn run_untraced(
     steps: usize,
     warmup: usize,
 ) -> Result<Elapsed, RunError> {
-    let session = UntracedSteps { sim, steps, warmup };
-    let result = sph_strategies::run(strategy, config, session)
-        .map_err(|source| RunError::Build { strategy, source })?;
-    Ok(result?)
+    run_timed_with(sim, strategy, config, steps, warmup, &mut ())
 }
 
 #[cfg(test)]
@@ -192,17 +140,10 @@ mod tests {
     use super::*;
     use crate::checksum::checksum_hex;
     use crate::run::run_timed;
-    use crate::scene::dam_break;
-    use crate::sph::params::Preset;
+    use crate::solver::StepError;
 
     fn sim(n: usize) -> Simulation {
-        let preset = Preset::Seed;
-        Simulation::new(
-            preset.params(),
-            dam_break::domain(preset, n),
-            dam_break::initial_state(preset, n, 7),
-            NeighborMode::Grid,
-        )
+        crate::run::test_simulation(n, 7)
     }
 
     #[test]
@@ -227,7 +168,7 @@ mod tests {
             assert_eq!(steps.iter().max(), Some(&3), "{strategy}");
             assert_eq!(run.trace.serial.len(), 2 * 3, "{strategy}");
             assert!(
-                run.trace.workers <= expected_workers(strategy, 2),
+                run.trace.workers <= strategy.info().effective_cores(2),
                 "{strategy}"
             );
             let last = run.trace.kernels.iter().map(|e| e.end_ns).max().unwrap();

@@ -3,7 +3,7 @@
 //! with the estimate and what to lower: without the cap, `rayon-spawn` at N = 20 000 for 50
 //! steps wrote an 824 MB `trace.json`.
 
-use sph_strategies::StrategyName;
+use sph_strategies::{Calls, Config, StrategyName};
 
 use crate::sph::neighbors::NeighborMode;
 
@@ -16,8 +16,8 @@ pub const MAX_EVENTS: usize = 1_000_000;
 /// refusal message.
 pub const JSON_BYTES_PER_EVENT: usize = 170;
 
-/// The leaves per worker that the estimate assumes for `rayon-iter`, whose splitting rayon
-/// decides at run time: a few per thread on an idle pool, more after steals (observed: 5 per
+/// The leaves per worker that the estimate assumes for `rayon-iter` (the one strategy whose
+/// splitting the runtime decides, [`Calls::Adaptive`]), which rayon decides at run time: a few per thread on an idle pool, more after steals (observed: 5 per
 /// core per pass at 2 cores, 100 to 165 at 8 cores on 2 hardware threads), never more than N.
 /// A run that records more than [`MAX_EVENTS`] anyway is refused before it writes
 /// ([`check_recorded`]).
@@ -83,31 +83,32 @@ pub fn check_recorded(strategy: StrategyName, events: usize) -> Result<(), Recor
     Ok(())
 }
 
-/// The options that shrink a trace of `strategy`.
-fn lower(strategy: StrategyName) -> &'static str {
-    match strategy {
-        StrategyName::Seq => "--steps",
-        StrategyName::RayonSpawn => {
-            "--steps or --n (rayon-spawn records one event per particle and pass)"
+/// The options that shrink a trace of `strategy`: those its kernel calls per pass grow with.
+fn lower(strategy: StrategyName) -> String {
+    match strategy.info().calls {
+        Calls::Whole => "--steps".to_owned(),
+        Calls::Elements => {
+            format!("--steps or --n ({strategy} records one event per particle and pass)")
         }
-        StrategyName::RayonChunks | StrategyName::CrossbeamPool => "--steps or --chunks",
-        StrategyName::StdStatic | StrategyName::RayonIter => "--steps or --cores",
+        Calls::Chunks => "--steps or --chunks".to_owned(),
+        Calls::Blocks | Calls::Adaptive => "--steps or --cores".to_owned(),
     }
 }
 
 impl Plan {
-    /// Kernel calls in one pass: one for `seq`, min(chunks, N) for the chunked strategies,
-    /// min(cores, N) for `std-static`, N for `rayon-spawn`, and for `rayon-iter`
+    /// Kernel calls in one pass: what the strategy's registry entry promises
+    /// ([`sph_strategies::Info::kernel_calls`]), and where the runtime decides (`rayon-iter`)
     /// min([`RAYON_ITER_LEAVES_PER_CORE`] × cores, N).
     pub fn calls_per_pass(&self) -> usize {
+        let config = Config {
+            cores: self.cores,
+            chunks: self.chunks,
+        };
         let n = self.n;
-        match self.strategy {
-            StrategyName::Seq => 1.min(n),
-            StrategyName::RayonSpawn => n,
-            StrategyName::RayonChunks | StrategyName::CrossbeamPool => self.chunks.min(n),
-            StrategyName::StdStatic => self.cores.min(n),
-            StrategyName::RayonIter => RAYON_ITER_LEAVES_PER_CORE.saturating_mul(self.cores).min(n),
-        }
+        self.strategy
+            .info()
+            .kernel_calls(n, &config)
+            .unwrap_or_else(|| RAYON_ITER_LEAVES_PER_CORE.saturating_mul(self.cores).min(n))
     }
 
     /// Passes that call kernels per step: the three passes, and the grid rebuild's two.

@@ -6,6 +6,7 @@
 //! needs no system package and a machine without a display gets a clear error.
 
 pub mod scene;
+mod stepper;
 
 use anyhow::Context;
 use minifb::{Key, KeyRepeat, ScaleMode, Window, WindowOptions};

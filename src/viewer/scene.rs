@@ -7,11 +7,12 @@ use crate::render::frame::{Caption, Painter};
 use crate::render::image::Image;
 use crate::render::scale::{ColorBy, Scale};
 use crate::render::text;
-use crate::run::run_timed;
 use crate::scene::dam_break;
 use crate::solver::Simulation;
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
+use crate::sph::state::State;
+use crate::viewer::stepper::Stepper;
 
 /// Fewest and most particles `+`/`-` reach.
 pub const N_RANGE: (usize, usize) = (10, 1_000_000);
@@ -59,7 +60,7 @@ pub enum Action {
 /// The running simulation and everything needed to draw it.
 pub struct Scene {
     settings: Settings,
-    sim: Simulation,
+    sim: Stepper,
     painter: Painter,
     paused: bool,
     /// Steps per second of the last advance, wall clock.
@@ -89,7 +90,7 @@ impl Scene {
 
     /// Steps completed since the last reset.
     pub fn steps_done(&self) -> usize {
-        self.sim.steps_done
+        self.sim.shown().1
     }
 
     /// Whether the simulation is paused (by the user or by a failure).
@@ -109,6 +110,7 @@ impl Scene {
                 let all = StrategyName::ALL;
                 let at = all.iter().position(|&x| x == s.strategy).unwrap_or(0);
                 s.strategy = all[(at + 1) % all.len()];
+                self.sim.switch_to(s.strategy);
                 return; // the simulation goes on with the new strategy
             }
             Action::NextColor => {
@@ -116,9 +118,7 @@ impl Scene {
                     ColorBy::Speed => ColorBy::Density,
                     ColorBy::Density => ColorBy::Speed,
                 };
-                let initial = dam_break::initial_state(s.preset, s.n, s.seed);
-                let scale = Scale::new(s.color, &s.preset.params(), &initial);
-                self.painter = Painter::new(self.sim.domain, self.sim.params.h, scale, s.width);
+                self.painter = painter(s, &dam_break::initial_state(s.preset, s.n, s.seed));
                 return;
             }
         }
@@ -134,22 +134,17 @@ impl Scene {
         if self.paused() {
             return;
         }
-        let s = &self.settings;
-        match run_timed(&mut self.sim, s.strategy, &s.config, s.every) {
-            Ok(elapsed) => self.rate = Some(s.every as f64 / elapsed.wall_s.max(1e-9)),
+        match self.sim.advance() {
+            Ok(wall_s) => self.rate = Some(self.settings.every as f64 / wall_s.max(1e-9)),
             Err(err) => self.failure = Some(format!("{err}: press r to reset")),
         }
     }
 
     /// The frame on screen: the rendered state with two status lines below it.
     pub fn draw(&self) -> Image {
-        let caption = Caption {
-            step: self.sim.steps_done,
-            time_s: self.sim.steps_done as f64 * self.sim.params.dt,
-            n: self.sim.state.len(),
-            preset: self.settings.preset,
-        };
-        let frame = self.painter.draw(&self.sim.state, &caption);
+        let (state, step) = self.sim.shown();
+        let caption = Caption::at(step, state.len(), self.settings.preset);
+        let frame = self.painter.draw(state, &caption);
         let em = self.painter.layout().font_px;
         let line = (1.5 * em).round() as u32;
         let mut img = Image::filled(frame.width, frame.height + 2 * line, [255; 3]);
@@ -162,11 +157,7 @@ impl Scene {
             (None, false, Some(rate)) => format!("{rate:.0} steps/s"),
             (None, false, None) => "starting".to_owned(),
         };
-        let cores = if s.strategy == StrategyName::Seq {
-            1
-        } else {
-            s.config.cores
-        };
+        let cores = s.strategy.info().effective_cores(s.config.cores);
         let plural = if cores == 1 { "" } else { "s" };
         let status = format!(
             "{} ({cores} core{plural}, {} neighbours) · {state}",
@@ -181,14 +172,20 @@ impl Scene {
     }
 }
 
-/// A fresh simulation and painter for `s`.
-fn build(s: &Settings) -> (Simulation, Painter) {
-    let params = s.preset.params();
+/// A fresh simulation, stepping on `s`'s strategy, and its painter.
+fn build(s: &Settings) -> (Stepper, Painter) {
     let state = dam_break::initial_state(s.preset, s.n, s.seed);
+    let painter = painter(s, &state);
     let domain = dam_break::domain(s.preset, s.n);
-    let scale = Scale::new(s.color, &params, &state);
-    let painter = Painter::new(domain, params.h, scale, s.width);
-    (Simulation::new(params, domain, state, s.neighbors), painter)
+    let sim = Simulation::new(s.preset.params(), domain, state, s.neighbors);
+    (Stepper::new(sim, s.strategy, s.config, s.every), painter)
+}
+
+/// The painter for `s`, whose colour scale is fixed by the `initial` state.
+fn painter(s: &Settings, initial: &State) -> Painter {
+    let params = s.preset.params();
+    let scale = Scale::new(s.color, &params, initial);
+    Painter::new(dam_break::domain(s.preset, s.n), params.h, scale, s.width)
 }
 
 #[cfg(test)]

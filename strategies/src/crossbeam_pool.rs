@@ -67,7 +67,7 @@ impl Strategy for CrossbeamPool {
         description: "a pool of --cores crossbeam threads kept for the whole run (the steps \
                       run on one of them); each pass's chunks are pulled dynamically from an \
                       atomic counter",
-        uses_chunks: true,
+        calls: crate::Calls::Chunks,
     };
 
     fn build(config: &Config) -> Result<Self, BuildError> {

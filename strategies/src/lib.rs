@@ -55,15 +55,67 @@ pub struct Config {
     pub chunks: usize,
 }
 
-/// Static facts about a strategy, shown by `bench-sph list` and used by the study runner.
+/// Static facts about a strategy, shown by `bench-sph list` and used by the study runner, the
+/// trace and the tests: everything above this crate asks [`Info`] rather than matching on a
+/// strategy's name, so that a new strategy is one file plus one registry line.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Info {
     /// The name used on the command line, in CSV files and in plots.
     pub name: &'static str,
     /// One line saying how the strategy schedules work.
     pub description: &'static str,
+    /// How the strategy cuts a pass into kernel calls.
+    pub calls: Calls,
+}
+
+/// How a strategy cuts a pass over `len` elements into kernel calls.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Calls {
+    /// One call for the whole output, on the calling thread: the strategy uses one core
+    /// whatever [`Config::cores`] says.
+    Whole,
+    /// `min(chunks, len)` balanced chunks: the only kind that [`Config::chunks`] changes.
+    Chunks,
+    /// `min(cores, len)` contiguous blocks, one per thread.
+    Blocks,
+    /// One call per element.
+    Elements,
+    /// The runtime decides, between one call and one per element: no exact count.
+    Adaptive,
+}
+
+impl Info {
     /// Whether `--chunks` changes what the strategy does.
-    pub uses_chunks: bool,
+    pub fn uses_chunks(&self) -> bool {
+        self.calls == Calls::Chunks
+    }
+
+    /// The chunks a run of the strategy uses when `requested` are asked for: `None` for a
+    /// strategy that ignores them (as reports show it: `n/a`, an empty CSV field).
+    pub fn effective_chunks(&self, requested: usize) -> Option<usize> {
+        self.uses_chunks().then_some(requested)
+    }
+
+    /// The worker threads a run of the strategy uses when `requested` are asked for: 1 for a
+    /// strategy that runs each pass as one call on the calling thread, `requested` otherwise.
+    pub fn effective_cores(&self, requested: usize) -> usize {
+        match self.calls {
+            Calls::Whole => 1,
+            _ => requested,
+        }
+    }
+
+    /// The kernel calls one pass over `len` elements makes with `config`, where the strategy
+    /// promises an exact number (every [`Calls`] but [`Calls::Adaptive`]).
+    pub fn kernel_calls(&self, len: usize, config: &Config) -> Option<usize> {
+        match self.calls {
+            Calls::Whole => Some(1.min(len)),
+            Calls::Chunks => Some(config.chunks.min(len)),
+            Calls::Blocks => Some(config.cores.min(len)),
+            Calls::Elements => Some(len),
+            Calls::Adaptive => None,
+        }
+    }
 }
 
 /// Why a strategy could not be built, or could not start the threads of a run.
@@ -132,7 +184,7 @@ pub trait Session: Send {
 
 /// A way of scheduling passes on threads.
 pub trait Strategy: Sized {
-    /// Name, description and whether chunks apply.
+    /// Name, description and how a pass is cut into kernel calls.
     const INFO: Info;
 
     /// Creates the strategy's long-lived resources for `config` (e.g. a thread pool with
@@ -145,4 +197,56 @@ pub trait Strategy: Sized {
     /// needs — before the session starts, or (`std-static`) during a pass, whose error then
     /// ends the session; the session's output is discarded. No thread is left behind.
     fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError>;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn info(calls: Calls) -> Info {
+        Info {
+            name: "x",
+            description: "x",
+            calls,
+        }
+    }
+
+    #[test]
+    fn each_kind_of_strategy_promises_its_kernel_calls_per_pass() {
+        let config = Config {
+            cores: 3,
+            chunks: 7,
+        };
+        let calls = |kind, len| info(kind).kernel_calls(len, &config);
+        assert_eq!(calls(Calls::Whole, 100), Some(1));
+        assert_eq!(calls(Calls::Whole, 0), Some(0));
+        assert_eq!(calls(Calls::Chunks, 100), Some(7));
+        assert_eq!(calls(Calls::Chunks, 5), Some(5));
+        assert_eq!(calls(Calls::Blocks, 100), Some(3));
+        assert_eq!(calls(Calls::Blocks, 2), Some(2));
+        assert_eq!(calls(Calls::Elements, 100), Some(100));
+        assert_eq!(calls(Calls::Adaptive, 100), None);
+    }
+
+    #[test]
+    fn only_a_whole_pass_strategy_runs_on_one_core_and_only_a_chunked_one_uses_chunks() {
+        for kind in [
+            Calls::Chunks,
+            Calls::Blocks,
+            Calls::Elements,
+            Calls::Adaptive,
+        ] {
+            assert_eq!(info(kind).effective_cores(4), 4, "{kind:?}");
+            let chunked = kind == Calls::Chunks;
+            assert_eq!(info(kind).uses_chunks(), chunked, "{kind:?}");
+            assert_eq!(
+                info(kind).effective_chunks(9),
+                chunked.then_some(9),
+                "{kind:?}"
+            );
+        }
+        assert_eq!(info(Calls::Whole).effective_cores(4), 1);
+        assert_eq!(info(Calls::Whole).effective_chunks(9), None);
+        assert_eq!(StrategyName::Seq.info().calls, Calls::Whole);
+    }
 }

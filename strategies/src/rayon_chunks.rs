@@ -33,7 +33,7 @@ impl Strategy for RayonChunks {
         name: "rayon-chunks",
         description: "min(--chunks, N) balanced chunks run as a rayon parallel iterator, one \
                       kernel call per chunk",
-        uses_chunks: true,
+        calls: crate::Calls::Chunks,
     };
 
     fn build(config: &Config) -> Result<Self, BuildError> {

@@ -29,7 +29,7 @@ impl Strategy for RayonIter {
         name: "rayon-iter",
         description: "rayon parallel iterator over the elements; rayon decides the splitting \
                       (ignores --chunks)",
-        uses_chunks: false,
+        calls: crate::Calls::Adaptive,
     };
 
     fn build(config: &Config) -> Result<Self, BuildError> {

@@ -28,7 +28,7 @@ impl Strategy for RayonSpawn {
     const INFO: Info = Info {
         name: "rayon-spawn",
         description: "one rayon task spawned per element in a scope (ignores --chunks)",
-        uses_chunks: false,
+        calls: crate::Calls::Elements,
     };
 
     fn build(config: &Config) -> Result<Self, BuildError> {

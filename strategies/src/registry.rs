@@ -24,7 +24,7 @@ macro_rules! registry {
             /// Every strategy, in registry order.
             pub const ALL: &'static [StrategyName] = &[$(StrategyName::$variant),*];
 
-            /// Name, description and whether chunks apply.
+            /// Name, description and how a pass is cut into kernel calls.
             pub fn info(self) -> Info {
                 match self {
                     $(StrategyName::$variant => <crate::$module::$ty as Strategy>::INFO,)*

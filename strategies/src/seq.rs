@@ -11,7 +11,7 @@ impl Strategy for Seq {
         name: "seq",
         description: "sequential baseline: each pass is one chunk on the calling thread \
                       (ignores --cores and --chunks)",
-        uses_chunks: false,
+        calls: crate::Calls::Whole,
     };
 
     fn build(config: &Config) -> Result<Self, BuildError> {

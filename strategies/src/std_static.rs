@@ -34,7 +34,7 @@ impl Strategy for StdStatic {
         name: "std-static",
         description: "std scoped threads started every pass, one contiguous block of N/cores \
                       elements each (ignores --chunks)",
-        uses_chunks: false,
+        calls: crate::Calls::Blocks,
     };
 
     fn build(config: &Config) -> Result<Self, BuildError> {

@@ -39,18 +39,10 @@ pub fn for_each_grid_point(mut f: impl FnMut(StrategyName, Config, usize)) {
 }
 
 /// How many kernel calls a pass over `len` elements makes, where the strategy promises an
-/// exact number; `None` where the strategy lets the runtime decide (`rayon-iter`) or a new
-/// strategy has not said.
+/// exact number (its registry [`Info`](sph_strategies::Info)); `None` where it lets the
+/// runtime decide (`rayon-iter`).
 pub fn promised_calls(name: StrategyName, config: Config, len: usize) -> Option<usize> {
-    if name.info().uses_chunks {
-        return Some(config.chunks.min(len));
-    }
-    match name.as_str() {
-        "seq" => Some(1.min(len)),
-        "std-static" => Some(config.cores.min(len)),
-        "rayon-spawn" => Some(len),
-        _ => None,
-    }
+    name.info().kernel_calls(len, &config)
 }
 
 /// Which outputs a [`Recorder`] hands to the strategy.
