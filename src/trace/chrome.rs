@@ -84,6 +84,44 @@ pub fn worker_track_name(w: &WorkerStats) -> String {
     format!("worker {} ({})", w.worker, w.thread_label())
 }
 
+impl<'a> Event<'a> {
+    /// A metadata event (`"ph": "M"`) about track `tid`.
+    fn metadata(name: &'static str, tid: usize, args: Args<'a>) -> Self {
+        Event {
+            name,
+            cat: None,
+            ph: "M",
+            ts: None,
+            dur: None,
+            s: None,
+            pid: PID,
+            tid,
+            args,
+        }
+    }
+
+    /// A complete event (`"ph": "X"`) from `start_ns` for `dur_ns` on track `tid`.
+    fn complete(
+        name: &'a str,
+        cat: &'static str,
+        (start_ns, dur_ns): (u64, u64),
+        tid: usize,
+        args: Args<'a>,
+    ) -> Self {
+        Event {
+            name,
+            cat: Some(cat),
+            ph: "X",
+            ts: Some(us(start_ns)),
+            dur: Some(us(dur_ns)),
+            s: None,
+            pid: PID,
+            tid,
+            args,
+        }
+    }
+}
+
 /// Writes `trace` as Chrome trace-event JSON to `out`. `workers` names the worker tracks
 /// (from [`super::stats::compute`]); `config` goes into `otherData`.
 pub fn write<W: Write>(
@@ -92,39 +130,51 @@ pub fn write<W: Write>(
     config: &TraceConfig,
     out: W,
 ) -> serde_json::Result<()> {
-    let caller_tid = trace.workers;
-    let meta = |name: &'static str, tid: usize, args: Args<'static>| Event {
-        name,
-        cat: None,
-        ph: "M",
-        ts: None,
-        dur: None,
-        s: None,
-        pid: PID,
-        tid,
-        args,
-    };
-    let mut events = Vec::with_capacity(trace.kernels.len() + trace.serial.len() + 16);
-    events.push(meta(
+    let step_names: Vec<String> = (0..=config.steps).map(|s| format!("step {s}")).collect();
+    let mut events = Vec::with_capacity(trace.kernels.len() + 2 * trace.serial.len() + 16);
+    events.extend(track_events(trace, workers, config));
+    events.extend(serial_events(trace, &step_names));
+    events.extend(kernel_events(trace));
+    serde_json::to_writer(
+        out,
+        &File {
+            trace_events: events,
+            display_time_unit: "ms",
+            other_data: config,
+        },
+    )
+}
+
+/// The process's name, then each track's name and sort index: the workers', then the
+/// caller's (`serial (between passes)`).
+fn track_events(
+    trace: &Trace,
+    workers: &[WorkerStats],
+    config: &TraceConfig,
+) -> Vec<Event<'static>> {
+    let process = format!("bench-sph trace: {}", config.title());
+    let mut events = vec![Event::metadata(
         "process_name",
         0,
-        Args::Name {
-            name: format!("bench-sph trace: {}", config.title()),
-        },
-    ));
+        Args::Name { name: process },
+    )];
     let tracks = workers
         .iter()
         .map(|w| (w.worker, worker_track_name(w)))
-        .chain([(caller_tid, "serial (between passes)".to_owned())]);
+        .chain([(trace.workers, "serial (between passes)".to_owned())]);
     for (tid, name) in tracks {
-        events.push(meta("thread_name", tid, Args::Name { name }));
-        events.push(meta(
-            "thread_sort_index",
-            tid,
-            Args::SortIndex { sort_index: tid },
-        ));
+        events.push(Event::metadata("thread_name", tid, Args::Name { name }));
+        let sort_index = Args::SortIndex { sort_index: tid };
+        events.push(Event::metadata("thread_sort_index", tid, sort_index));
     }
-    let step_names: Vec<String> = (0..=config.steps).map(|s| format!("step {s}")).collect();
+    events
+}
+
+/// The caller's serial work on its own track, with a global instant event `step k` at each
+/// step's start (its grid rebuild).
+fn serial_events<'a>(trace: &Trace, step_names: &'a [String]) -> Vec<Event<'a>> {
+    let caller = trace.workers;
+    let mut events = Vec::with_capacity(2 * trace.serial.len());
     for e in &trace.serial {
         if e.work == super::SerialWork::Rebuild {
             events.push(Event {
@@ -135,52 +185,40 @@ pub fn write<W: Write>(
                 dur: None,
                 s: Some("g"),
                 pid: PID,
-                tid: caller_tid,
+                tid: caller,
                 args: Args::None,
             });
         }
-        events.push(Event {
-            name: e.work.as_str(),
-            cat: Some("serial"),
-            ph: "X",
-            ts: Some(us(e.start_ns)),
-            dur: Some(us(e.end_ns - e.start_ns)),
-            s: None,
-            pid: PID,
-            tid: caller_tid,
-            args: Args::Serial { step: e.step },
-        });
+        let span = (e.start_ns, e.end_ns - e.start_ns);
+        let args = Args::Serial { step: e.step };
+        events.push(Event::complete(
+            e.work.as_str(),
+            "serial",
+            span,
+            caller,
+            args,
+        ));
     }
-    for e in &trace.kernels {
-        events.push(Event {
-            name: e.phase.as_str(),
-            cat: Some(match e.phase {
-                Phase::Rebuild => "rebuild",
-                Phase::Pass(_) => "pass",
-            }),
-            ph: "X",
-            ts: Some(us(e.start_ns)),
-            dur: Some(us(e.duration_ns())),
-            s: None,
-            pid: PID,
-            tid: e.worker,
-            args: Args::Kernel {
-                step: e.step,
-                first: e.first,
-                len: e.len,
-                worker: e.worker,
-                thread: trace.threads.get(e.thread).map_or("?", |t| t.name.as_str()),
-            },
-        });
-    }
-    serde_json::to_writer(
-        out,
-        &File {
-            trace_events: events,
-            display_time_unit: "ms",
-            other_data: config,
-        },
-    )
+    events
+}
+
+/// Every kernel call on its worker's track.
+fn kernel_events(trace: &Trace) -> impl Iterator<Item = Event<'_>> {
+    trace.kernels.iter().map(|e| {
+        let cat = match e.phase {
+            Phase::Rebuild => "rebuild",
+            Phase::Pass(_) => "pass",
+        };
+        let args = Args::Kernel {
+            step: e.step,
+            first: e.first,
+            len: e.len,
+            worker: e.worker,
+            thread: trace.threads.get(e.thread).map_or("?", |t| t.name.as_str()),
+        };
+        let span = (e.start_ns, e.duration_ns());
+        Event::complete(e.phase.as_str(), cat, span, e.worker, args)
+    })
 }
 
 #[cfg(test)]

@@ -16,6 +16,7 @@ use std::ops::RangeInclusive;
 
 use anyhow::Context;
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
@@ -191,23 +192,26 @@ struct Panel<'a> {
     steps: &'a RangeInclusive<usize>,
 }
 
+/// A panel's plot: milliseconds across, one row per track (worker 0 at the top).
+type Plot<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// The image, for text placed in pixels.
+type Root<'b> = DrawingArea<BitMapBackend<'b>, Shift>;
+
 impl Panel<'_> {
     /// Draws the rows over `(t0, t1)` ns into `area`; `title` above the plot; `outline` a span
     /// to outline in red. `root` is the whole image, for text placed in pixels.
     fn draw(
         &self,
-        root: &DrawingArea<BitMapBackend<'_>, Shift>,
-        area: &DrawingArea<BitMapBackend<'_>, Shift>,
+        root: &Root<'_>,
+        area: &Root<'_>,
         (t0, t1): (u64, u64),
         title: Option<&str>,
         outline: Option<(u64, u64)>,
     ) -> DrawResult {
-        let trace = self.trace;
-        let tracks = trace.workers + 1;
-        let centre = |row: usize| (tracks - row) as f64 - 0.5;
+        let tracks = self.trace.workers + 1;
         let (x0, x1) = (ms(t0), ms(t1).max(ms(t0) + 1e-6));
-        let visible =
-            |step: usize, s: u64, e: u64| self.steps.contains(&step) && e >= t0 && s <= t1;
         // Enough decimals that neighbouring tick labels differ.
         let decimals = ((-(x1 - x0).log10()).ceil() + 2.0).clamp(1.0, 6.0) as usize;
 
@@ -230,59 +234,99 @@ impl Panel<'_> {
             .bold_line_style(RGBColor(215, 215, 215))
             .draw()?;
 
-        // Row names, right-aligned beside the plot.
+        self.draw_labels(root, &chart, x0, title)?;
+        self.draw_bars(&mut chart, (t0, t1))?;
+        self.draw_step_starts(root, &mut chart, (t0, t1), title.is_none())?;
+        if let Some((lo, hi)) = outline {
+            chart.draw_series([Rectangle::new(
+                [(ms(lo), tracks as f64 - 0.02), (ms(hi), 0.02)],
+                RED.stroke_width(2),
+            )])?;
+        }
+        Ok(())
+    }
+
+    /// The y coordinate of the middle of `row`'s bars.
+    fn centre(&self, row: usize) -> f64 {
+        (self.trace.workers + 1 - row) as f64 - 0.5
+    }
+
+    /// Whether work of `step` over `s..e` ns shows in the panel's window `(t0, t1)`.
+    fn visible(&self, step: usize, (s, e): (u64, u64), (t0, t1): (u64, u64)) -> bool {
+        self.steps.contains(&step) && e >= t0 && s <= t1
+    }
+
+    /// Row names, right-aligned beside the plot, and `title` above it.
+    fn draw_labels(
+        &self,
+        root: &Root<'_>,
+        chart: &Plot<'_, '_>,
+        x0: f64,
+        title: Option<&str>,
+    ) -> DrawResult {
         let row_style = TextStyle::from((font::FAMILY, 16).into_font())
             .color(&BLACK)
             .pos(Pos::new(HPos::Right, VPos::Center));
         for (row, label) in self.labels.iter().enumerate() {
-            let (px, py) = chart.backend_coord(&(x0, centre(row)));
+            let (px, py) = chart.backend_coord(&(x0, self.centre(row)));
             root.draw(&Text::new(label.as_str(), (px - 12, py), row_style.clone()))?;
         }
         if let Some(title) = title {
+            let tracks = self.trace.workers + 1;
             let (px, py) = chart.backend_coord(&(x0, tracks as f64));
             let style = TextStyle::from((font::FAMILY, 17).into_font()).color(&BLACK);
             root.draw(&Text::new(title, (px, py - 30), style))?;
         }
+        Ok(())
+    }
 
-        // Kernel calls, alternating shades per worker (counted over the whole trace, so a
-        // call has the same shade in both panels).
+    /// One bar per kernel call on its worker's row, alternating shades per worker (counted
+    /// over the whole trace, so a call has the same shade in both panels); the caller's serial
+    /// work on the last row.
+    fn draw_bars(&self, chart: &mut Plot<'_, '_>, (t0, t1): (u64, u64)) -> DrawResult {
+        let trace = self.trace;
+        let bar = |row: usize, (s, e): (u64, u64), color: RGBColor| {
+            let y = self.centre(row);
+            Rectangle::new(
+                [
+                    (ms(s.max(t0)), y + BAR_HALF_HEIGHT),
+                    (ms(e.min(t1)), y - BAR_HALF_HEIGHT),
+                ],
+                color.filled(),
+            )
+        };
         let mut nth = vec![0usize; trace.workers];
         let mut bars = Vec::new();
         for e in &trace.kernels {
             let dark = nth[e.worker] % 2 == 1;
             nth[e.worker] += 1;
-            if !visible(e.step, e.start_ns, e.end_ns) {
-                continue;
+            let span = (e.start_ns, e.end_ns);
+            if self.visible(e.step, span, (t0, t1)) {
+                bars.push(bar(e.worker, span, phase_color(e.phase, dark)));
             }
-            let y = centre(e.worker);
-            bars.push(Rectangle::new(
-                [
-                    (ms(e.start_ns.max(t0)), y + BAR_HALF_HEIGHT),
-                    (ms(e.end_ns.min(t1)), y - BAR_HALF_HEIGHT),
-                ],
-                phase_color(e.phase, dark).filled(),
-            ));
         }
         chart.draw_series(bars)?;
-        let caller = centre(tracks - 1);
         let serial = trace
             .serial
             .iter()
-            .filter(|e| visible(e.step, e.start_ns, e.end_ns))
-            .map(|e| {
-                Rectangle::new(
-                    [
-                        (ms(e.start_ns.max(t0)), caller + BAR_HALF_HEIGHT),
-                        (ms(e.end_ns.min(t1)), caller - BAR_HALF_HEIGHT),
-                    ],
-                    serial_color(e.work).filled(),
-                )
-            });
+            .filter(|e| self.visible(e.step, (e.start_ns, e.end_ns), (t0, t1)))
+            .map(|e| bar(trace.workers, (e.start_ns, e.end_ns), serial_color(e.work)));
         chart.draw_series(serial)?;
+        Ok(())
+    }
 
-        // Step starts: a dashed line from the bottom to the top of the plot, labelled above.
+    /// Step starts: a dashed line from the bottom to the top of the plot, labelled above
+    /// when `labelled`.
+    fn draw_step_starts(
+        &self,
+        root: &Root<'_>,
+        chart: &mut Plot<'_, '_>,
+        (t0, t1): (u64, u64),
+        labelled: bool,
+    ) -> DrawResult {
+        let tracks = self.trace.workers + 1;
         let label_style = TextStyle::from((font::FAMILY, 15).into_font()).color(&BLACK);
-        let starts = trace.serial.iter().filter(|e| {
+        let starts = self.trace.serial.iter().filter(|e| {
             e.work == SerialWork::Rebuild
                 && self.steps.contains(&e.step)
                 && (t0..=t1).contains(&e.start_ns)
@@ -295,7 +339,7 @@ impl Panel<'_> {
                 4,
                 BLACK.stroke_width(1),
             ))?;
-            if title.is_none() {
+            if labelled {
                 let (px, py) = chart.backend_coord(&(x, tracks as f64));
                 root.draw(&Text::new(
                     format!("step {}", e.step),
@@ -303,13 +347,6 @@ impl Panel<'_> {
                     label_style.clone(),
                 ))?;
             }
-        }
-
-        if let Some((lo, hi)) = outline {
-            chart.draw_series([Rectangle::new(
-                [(ms(lo), tracks as f64 - 0.02), (ms(hi), 0.02)],
-                RED.stroke_width(2),
-            )])?;
         }
         Ok(())
     }
@@ -373,4 +410,106 @@ where
     x += 30 + tw as i32 + 36;
     area.draw(&Text::new("white: idle", (x, y), style))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sph::neighbors::NeighborMode;
+    use crate::sph::params::Preset;
+    use crate::trace::recorder::{KernelEvent, SerialEvent, ThreadInfo};
+
+    /// Two steps on two workers: per step a grid rebuild, then density, forces and integrate
+    /// calls of 100 µs each, with the caller's rebuild and check between them.
+    fn trace() -> Trace {
+        let mut kernels = Vec::new();
+        let mut serial = Vec::new();
+        for step in 1..=2u64 {
+            let t = (step - 1) * 1_000_000;
+            serial.push(SerialEvent {
+                work: SerialWork::Rebuild,
+                step: step as usize,
+                start_ns: t,
+                end_ns: t + 50_000,
+            });
+            for (k, phase) in Phase::ALL.into_iter().enumerate() {
+                for worker in 0..2 {
+                    let start_ns = t + 100_000 + k as u64 * 200_000 + worker as u64 * 20_000;
+                    kernels.push(KernelEvent {
+                        phase,
+                        step: step as usize,
+                        worker,
+                        thread: worker,
+                        first: worker * 5,
+                        len: 5,
+                        start_ns,
+                        end_ns: start_ns + 100_000,
+                    });
+                }
+            }
+            serial.push(SerialEvent {
+                work: SerialWork::Check,
+                step: step as usize,
+                start_ns: t + 900_000,
+                end_ns: t + 950_000,
+            });
+        }
+        Trace {
+            kernels,
+            serial,
+            threads: (0..2)
+                .map(|worker| ThreadInfo {
+                    name: format!("rayon-chunks-{worker}"),
+                    worker,
+                })
+                .collect(),
+            workers: 2,
+            wall_ns: 2_000_000,
+        }
+    }
+
+    fn config() -> TraceConfig {
+        TraceConfig {
+            strategy: "rayon-chunks".into(),
+            cores: 2,
+            chunks: Some(2),
+            n: 10,
+            steps: 2,
+            preset: Preset::Seed,
+            neighbors: NeighborMode::Grid,
+            seed: Some(2019),
+            init: None,
+        }
+    }
+
+    #[test]
+    fn a_timeline_shows_each_kernel_call_as_a_bar_of_its_pass_colour_on_its_worker_s_row() {
+        let trace = trace();
+        let stats = super::super::stats::compute(&trace);
+        font::ensure_registered().unwrap();
+        let (w, h) = image_size(3);
+        let mut pixels = vec![0u8; w as usize * h as usize * 3];
+        draw(&trace, &stats.workers, &config(), 1..=2, &mut pixels, (w, h)).unwrap();
+        let mut bytes = Vec::new();
+        write_png(&trace, &stats.workers, &config(), 1..=2, &mut bytes).unwrap();
+        assert_eq!(&bytes[..8], crate::trace::files::PNG_SIGNATURE);
+        if let Ok(path) = std::env::var("TIMELINE_PNG") {
+            std::fs::write(path, &bytes).unwrap();
+        }
+        let colour_count = |c: RGBColor| {
+            pixels
+                .chunks_exact(3)
+                .filter(|p| p == &[c.0, c.1, c.2])
+                .count()
+        };
+        // Every phase shows, in the shade its place in a worker's alternation gives it (4
+        // calls a step: the rebuild and forces light, density and integrate dark).
+        for (phase, dark) in Phase::ALL.into_iter().zip([false, true, false, true]) {
+            let n = colour_count(phase_color(phase, dark));
+            assert!(n > 100, "{phase:?} dark={dark}: {n} pixels");
+        }
+        for work in [SerialWork::Rebuild, SerialWork::Check] {
+            assert!(colour_count(serial_color(work)) > 100, "{work:?}");
+        }
+    }
 }
