@@ -1,17 +1,18 @@
 //! The `bench-sph` command line (clap derive): one module for the definitions, one per command.
 
 mod list;
+mod parallel;
 mod render;
 mod report;
 mod scene;
 mod simulate;
 mod sweep;
 mod trace;
+mod values;
 #[cfg(feature = "viewer")]
 mod view;
 
 use clap::{Parser, Subcommand};
-use sph_strategies::StrategyName;
 
 pub use render::RenderArgs;
 pub use report::ReportArgs;
@@ -160,11 +161,6 @@ fn warmup(s: &str) -> Result<usize, String> {
         .parse::<usize>()
         .map_err(|_| format!("'{s}' is not a whole number of at least 0"))?;
     crate::limits::check("warm-ups", v, 0, crate::limits::MAX_WARMUP).map_err(|e| e.to_string())
-}
-
-/// A strategy name from the registry.
-fn strategy(s: &str) -> Result<StrategyName, String> {
-    s.parse::<StrategyName>().map_err(|e| e.to_string())
 }
 
 /// The machine's hardware threads (1 when unknown).
