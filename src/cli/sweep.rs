@@ -88,6 +88,7 @@ pub struct SweepArgs {
     pub seed: u64,
     /// Results directory [default: results/<UTC timestamp>]. Must not exist or be empty,
     /// unless --force.
+    #[allow(rustdoc::invalid_html_tags)] // `--help` shows this text as it is: no markup
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Continue the sweep in DIR with the parameters of DIR/meta.json: finished cells are

@@ -1,6 +1,6 @@
 //! One step = three passes over all particles, each handed to a strategy's executor, plus the
 //! grid rebuild before them and the divergence check after them. How each pass is cut into
-//! kernel calls lives in [`schedule`].
+//! kernel calls lives in `schedule`.
 
 mod schedule;
 
