@@ -2,8 +2,23 @@
 //! the compiler's version (`BENCH_SPH_RUSTC`) and the git commit of the source tree
 //! (`BENCH_SPH_GIT_COMMIT`, with `-dirty` when tracked files had changes; "unknown" outside
 //! a git checkout or without git).
+//!
+//! Git runs with `--no-optional-locks`: a plain `git status` refreshes `.git/index`, which
+//! would make the next build run this script (and recompile bench-sph) again for nothing.
 
+use std::path::Path;
 use std::process::Command;
+
+/// The tracked paths that go into the build: a change to one of them marks the commit dirty
+/// (measured results and reports in `results/` and `report/` do not change the program).
+const BUILD_INPUTS: [&str; 6] = [
+    "Cargo.toml",
+    "Cargo.lock",
+    "build.rs",
+    "src",
+    "strategies",
+    "assets",
+];
 
 fn main() {
     let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".to_owned());
@@ -13,49 +28,39 @@ fn main() {
         rustc_version.as_deref().unwrap_or("unknown")
     );
     println!("cargo:rustc-env=BENCH_SPH_GIT_COMMIT={}", git_commit());
-    // Rerun when the commit or the tracked sources may have changed, including the
-    // `strategies` crate (a change there alone would otherwise leave a stale commit). A path
-    // that does not exist (no `.git`) makes Cargo rerun the script every build.
-    for path in [
-        ".git/HEAD",
-        ".git/index",
-        ".git/refs",
-        "Cargo.toml",
-        "build.rs",
-        "src",
-        "strategies",
-        "benches",
-        "tests",
-        "assets",
-    ] {
-        println!("cargo:rerun-if-changed={path}");
+    // Rerun when the commit may have moved (HEAD, the branch refs) or the build's inputs
+    // changed (dirty or clean). Git's files are located by git itself, so a worktree (where
+    // `.git` is a file) works; only existing paths are named, since a missing one makes Cargo
+    // rerun the script on every build.
+    let git_paths = ["HEAD", "refs", "packed-refs"].map(|p| git(&["rev-parse", "--git-path", p]));
+    for path in git_paths
+        .into_iter()
+        .flatten()
+        .chain(BUILD_INPUTS.map(str::to_owned))
+    {
+        if Path::new(&path).exists() {
+            println!("cargo:rerun-if-changed={path}");
+        }
     }
 }
 
-/// `git rev-parse HEAD`, plus `-dirty` when tracked files that go into the build differ from
-/// it (measured results and reports in `results/` and `report/` do not change the program).
+/// `git rev-parse HEAD`, plus `-dirty` when [`BUILD_INPUTS`] differ from it.
 fn git_commit() -> String {
-    let Some(commit) = output(Command::new("git").args(["rev-parse", "HEAD"])) else {
+    let Some(commit) = git(&["rev-parse", "HEAD"]) else {
         return "unknown".to_owned();
     };
-    let dirty = output(Command::new("git").args([
-        "status",
-        "--porcelain",
-        "--untracked-files=no",
-        "--",
-        "Cargo.toml",
-        "Cargo.lock",
-        "build.rs",
-        "src",
-        "strategies",
-        "assets",
-    ]))
-    .is_some_and(|s| !s.is_empty());
+    let status = ["status", "--porcelain", "--untracked-files=no", "--"];
+    let dirty = git(&[&status[..], &BUILD_INPUTS[..]].concat()).is_some_and(|s| !s.is_empty());
     if dirty {
         format!("{commit}-dirty")
     } else {
         commit
     }
+}
+
+/// The trimmed standard output of `git ARGS`, run without optional locks, if it succeeded.
+fn git(args: &[&str]) -> Option<String> {
+    output(Command::new("git").arg("--no-optional-locks").args(args))
 }
 
 /// The trimmed standard output of a command that succeeded.

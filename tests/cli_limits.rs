@@ -2,19 +2,14 @@
 //! line is parsed: a value beyond it is a clear error with a non-zero exit, before any thread
 //! is started or any memory allocated — never an abort, a panic or a hang.
 
-use std::process::Command;
+mod common;
+use common::fails_with_in;
 
+/// Runs `args` in an empty directory and expects a failure naming `needle`, with nothing
+/// written.
 fn refused(args: &[&str], needle: &str) {
     let tmp = tempfile::tempdir().unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
-        .args(args)
-        .current_dir(tmp.path())
-        .output()
-        .expect("binary runs");
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success(), "{args:?} succeeded");
-    assert!(err.contains(needle), "{args:?}: {err}");
-    assert!(!err.contains("panicked"), "{args:?}: {err}");
+    fails_with_in(tmp.path(), args, &[needle]);
     assert_eq!(
         std::fs::read_dir(tmp.path()).unwrap().count(),
         0,

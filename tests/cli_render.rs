@@ -3,47 +3,9 @@
 //! for each kind of bad input.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn bench_sph_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("binary runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Runs in `dir` and expects success.
-fn succeeds(dir: &Path, args: &[&str]) -> String {
-    let o = bench_sph_in(dir, args);
-    assert!(o.status.success(), "{args:?} failed:\n{}", stderr(&o));
-    stdout(&o)
-}
-
-/// Runs in `dir` and expects failure whose message contains every one of `needles`.
-fn fails_with(dir: &Path, args: &[&str], needles: &[&str]) {
-    let o = bench_sph_in(dir, args);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{args:?} succeeded: {}", stdout(&o));
-    for needle in needles {
-        assert!(
-            err.contains(needle),
-            "{args:?}: stderr lacks {needle:?}:\n{err}"
-        );
-    }
-    assert!(
-        !err.contains("panicked") && !err.contains("RUST_BACKTRACE"),
-        "{args:?} panicked:\n{err}"
-    );
-}
+mod common;
+use common::{bench_sph, fails_with_in, names, run_in, stderr, succeeds};
 
 /// The image size the render reports: "… of W × H px …".
 fn reported_size(out: &str) -> (u32, u32) {
@@ -197,7 +159,7 @@ fn a_diverging_run_is_an_error_and_keeps_the_frames_before_it() {
         "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n",
     )
     .unwrap();
-    fails_with(
+    fails_with_in(
         dir.path(),
         &[
             "render", "--init", "boom.csv", "--steps", "5", "--every", "1", "--out", "b.gif",
@@ -216,19 +178,19 @@ fn a_diverging_run_is_an_error_and_keeps_the_frames_before_it() {
 fn zero_counts_and_bad_sizes_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    fails_with(d, &["render", "--every", "0"], &["--every", "at least 1"]);
-    fails_with(d, &["render", "--steps", "0"], &["--steps", "at least 1"]);
-    fails_with(d, &["render", "--n", "0"], &["--n", "at least 1"]);
-    fails_with(d, &["render", "--width", "10"], &["--width"]);
-    fails_with(d, &["render", "--fps", "0"], &["--fps"]);
-    fails_with(d, &["render", "--color", "pressure"], &["--color"]);
+    fails_with_in(d, &["render", "--every", "0"], &["--every", "at least 1"]);
+    fails_with_in(d, &["render", "--steps", "0"], &["--steps", "at least 1"]);
+    fails_with_in(d, &["render", "--n", "0"], &["--n", "at least 1"]);
+    fails_with_in(d, &["render", "--width", "10"], &["--width"]);
+    fails_with_in(d, &["render", "--fps", "0"], &["--fps"]);
+    fails_with_in(d, &["render", "--color", "pressure"], &["--color"]);
     assert!(!d.join("dambreak.gif").exists());
 }
 
 #[test]
 fn out_and_frames_together_are_refused() {
     let dir = tempfile::tempdir().unwrap();
-    fails_with(
+    fails_with_in(
         dir.path(),
         &["render", "--out", "a.gif", "--frames", "f"],
         &["--out", "--frames", "cannot be used with"],
@@ -244,12 +206,12 @@ fn an_unwritable_output_fails_before_anything_is_simulated() {
     std::fs::write(d.join("plain-file"), "not a folder").unwrap();
     // A long render: were it simulated before the path is checked, this test would crawl.
     let long = ["--n", "1000", "--steps", "20000", "--every", "1"];
-    fails_with(
+    fails_with_in(
         d,
         &[&["render", "--out", "no/such/dir/a.gif"][..], &long].concat(),
         &["Error:", "cannot write 'no/such/dir/a.gif'"],
     );
-    fails_with(
+    fails_with_in(
         d,
         &[&["render", "--frames", "plain-file/frames"][..], &long].concat(),
         &["Error:", "cannot create directory 'plain-file/frames'"],
@@ -259,22 +221,12 @@ fn an_unwritable_output_fails_before_anything_is_simulated() {
 #[test]
 fn a_missing_init_file_is_one_clear_error() {
     let dir = tempfile::tempdir().unwrap();
-    fails_with(
+    fails_with_in(
         dir.path(),
         &["render", "--init", "nope.csv"],
         &["Error:", "cannot read init file 'nope.csv'"],
     );
     assert!(!dir.path().join("dambreak.gif").exists());
-}
-
-/// The names in `dir`, sorted.
-fn names(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .collect();
-    v.sort();
-    v
 }
 
 fn frames(count: usize) -> Vec<String> {
@@ -308,7 +260,7 @@ fn a_frames_folder_with_other_files_is_refused_and_force_writes_beside_them() {
     let args = [
         "render", "--n", "20", "--steps", "1", "--every", "1", "--frames", "f",
     ];
-    fails_with(
+    fails_with_in(
         dir.path(),
         &args,
         &[
@@ -327,14 +279,14 @@ fn a_frames_folder_with_other_files_is_refused_and_force_writes_beside_them() {
         std::fs::read_to_string(f.join("notes.txt")).unwrap(),
         "mine"
     );
-    fails_with(dir.path(), &["render", "--force"], &["--frames"]);
+    fails_with_in(dir.path(), &["render", "--force"], &["--frames"]);
 }
 
 #[test]
 fn an_interrupted_render_leaves_the_earlier_gif_untouched() {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("a.gif"), "earlier").unwrap();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+    let mut child = bench_sph()
         .args([
             "render", "--n", "400", "--steps", "1000000", "--every", "1", "--out", "a.gif",
         ])
@@ -367,7 +319,7 @@ fn an_interrupted_render_leaves_the_earlier_gif_untouched() {
 #[test]
 fn a_gif_that_cannot_be_written_is_one_error_line() {
     let dir = tempfile::tempdir().unwrap();
-    let o = bench_sph_in(
+    let o = run_in(
         dir.path(),
         &[
             "render",
@@ -395,7 +347,7 @@ fn a_gif_that_cannot_be_written_is_one_error_line() {
 #[test]
 fn a_render_larger_than_the_available_memory_is_refused_before_anything_is_written() {
     let dir = tempfile::tempdir().unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+    let o = bench_sph()
         .args(["render", "--n", "100000"])
         .current_dir(dir.path())
         .env("BENCH_SPH_FAKE_MEM_AVAILABLE", "1000000")

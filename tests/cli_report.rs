@@ -6,7 +6,10 @@
 //! No test asserts a duration.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
+
+mod common;
+use common::{run, text};
 
 const WIDTH: u32 = 1000;
 const HEIGHT: u32 = 650;
@@ -15,22 +18,11 @@ fn fixture() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/report-results")
 }
 
-fn bench_sph(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
 /// Runs `report` and expects success.
 fn report(args: &[&str]) -> Output {
     let mut all = vec!["report"];
     all.extend(args);
-    let o = bench_sph(&all);
+    let o = run(&all);
     assert!(
         o.status.success(),
         "{all:?}:\n{}\n{}",
@@ -44,7 +36,7 @@ fn report(args: &[&str]) -> Output {
 fn report_fails(args: &[&str], needle: &str) {
     let mut all = vec!["report"];
     all.extend(args);
-    let o = bench_sph(&all);
+    let o = run(&all);
     let err = text(&o.stderr);
     assert!(!o.status.success(), "{all:?} succeeded");
     assert_eq!(err.lines().count(), 1, "{err}");
@@ -246,7 +238,7 @@ fn a_missing_or_garbled_summary_or_meta_is_one_error_line_and_a_failure() {
 fn a_sweep_without_no_plots_writes_its_charts_and_report() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("sweep");
-    let o = bench_sph(&[
+    let o = run(&[
         "sweep",
         "--strategies",
         "rayon-chunks",

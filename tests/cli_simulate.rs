@@ -2,40 +2,11 @@
 //! `Error: ...` with a non-zero exit for each kind of bad input.
 
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-fn bench_sph(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Runs and expects failure whose message contains every one of `needles`.
-fn fails_with(args: &[&str], needles: &[&str]) {
-    let o = bench_sph(args);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{args:?} succeeded: {}", stdout(&o));
-    for needle in needles {
-        assert!(
-            err.contains(needle),
-            "{args:?}: stderr lacks {needle:?}:\n{err}"
-        );
-    }
-    assert!(
-        !err.contains("panicked") && !err.contains("RUST_BACKTRACE"),
-        "{args:?} panicked:\n{err}"
-    );
-}
+mod common;
+use common::{bench_sph, fails_with, names, run, stderr, stdout};
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
     let path = dir.join(name);
@@ -45,7 +16,7 @@ fn write(dir: &Path, name: &str, text: &str) -> String {
 
 #[test]
 fn json_output_carries_the_run_and_its_configuration() {
-    let o = bench_sph(&["simulate", "--n", "50", "--steps", "5", "--json"]);
+    let o = run(&["simulate", "--n", "50", "--steps", "5", "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("one JSON object");
     assert_eq!(v["n"], 50);
@@ -61,7 +32,7 @@ fn json_output_carries_the_run_and_its_configuration() {
 
 #[test]
 fn text_output_names_n_steps_wall_and_cpu_time() {
-    let o = bench_sph(&[
+    let o = run(&[
         "simulate",
         "--n",
         "40",
@@ -94,7 +65,7 @@ fn a_dump_loads_back_with_init_and_continues_exactly_as_an_unbroken_run() {
     let dump = dir.path().join("half.csv");
     let dump = dump.to_str().unwrap();
     let json = |args: &[&str]| -> serde_json::Value {
-        let o = bench_sph(args);
+        let o = run(args);
         assert!(o.status.success(), "{}", stderr(&o));
         serde_json::from_str(stdout(&o).trim()).unwrap()
     };
@@ -116,7 +87,7 @@ fn a_dump_loads_back_with_init_and_continues_exactly_as_an_unbroken_run() {
 fn init_accepts_any_column_order_and_ignores_extra_columns() {
     let dir = tempfile::tempdir().unwrap();
     let f = write(dir.path(), "s.csv", "note,y,x\na,100,200\nb,100.5,210\n");
-    let o = bench_sph(&["simulate", "--init", &f, "--steps", "2", "--json"]);
+    let o = run(&["simulate", "--init", &f, "--steps", "2", "--json"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("\"n\":2"));
 }
@@ -221,7 +192,7 @@ fn bad_numbers_and_names_are_refused_before_anything_runs() {
 
 #[test]
 fn an_unwritable_dump_path_fails_before_the_run() {
-    let o = bench_sph(&[
+    let o = run(&[
         "simulate",
         "--n",
         "10",
@@ -240,7 +211,7 @@ fn an_unwritable_dump_path_fails_before_the_run() {
 
 #[test]
 fn list_prints_one_strategy_per_line_name_first() {
-    let o = bench_sph(&["list"]);
+    let o = run(&["list"]);
     assert!(o.status.success());
     let out = stdout(&o);
     let names: Vec<&str> = out
@@ -254,22 +225,12 @@ fn list_prints_one_strategy_per_line_name_first() {
     );
 }
 
-/// The names in `dir`, sorted.
-fn names(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .collect();
-    v.sort();
-    v
-}
-
 #[test]
 fn a_failed_run_leaves_an_existing_dump_file_as_it_was() {
     let dir = tempfile::tempdir().unwrap();
     let dump = write(dir.path(), "final.csv", "earlier results\n");
     // A worker's panic made into an error of the run (its message says "panicked").
-    let o = bench_sph(&[
+    let o = run(&[
         "simulate",
         "--n",
         "50",
@@ -300,7 +261,7 @@ fn a_dump_of_one_preset_continues_only_with_that_preset_or_an_explicit_other() {
     let dir = tempfile::tempdir().unwrap();
     let dump = dir.path().join("cpp.csv");
     let dump = dump.to_str().unwrap();
-    let o = bench_sph(&[
+    let o = run(&[
         "simulate", "--preset", "cpp", "--n", "100", "--steps", "3", "--dump", dump,
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -312,7 +273,7 @@ fn a_dump_of_one_preset_continues_only_with_that_preset_or_an_explicit_other() {
         )],
     );
     for preset in ["cpp", "seed"] {
-        let o = bench_sph(&[
+        let o = run(&[
             "simulate", "--init", dump, "--steps", "1", "--preset", preset, "--json",
         ]);
         assert!(o.status.success(), "{preset}: {}", stderr(&o));
@@ -321,28 +282,19 @@ fn a_dump_of_one_preset_continues_only_with_that_preset_or_an_explicit_other() {
     // A dump from before the info line (no comment) loads with the default preset.
     let text = std::fs::read_to_string(dump).unwrap();
     let old = write(dir.path(), "old.csv", text.split_once('\n').unwrap().1);
-    let o = bench_sph(&["simulate", "--init", &old, "--steps", "1"]);
+    let o = run(&["simulate", "--init", &old, "--steps", "1"]);
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
 /// Runs `args` and returns its stderr, failing the test if it takes more than 30 s.
 fn stderr_within_30_s(args: &[&str]) -> String {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
-        .args(args)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let deadline = Instant::now() + Duration::from_secs(30);
-    while child.try_wait().unwrap().is_none() {
-        if Instant::now() > deadline {
-            child.kill().unwrap();
-            panic!("{args:?} did not end");
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let o = child.wait_with_output().unwrap();
-    assert!(!o.status.success());
+    let mut cmd = assert_cmd::Command::from_std(bench_sph());
+    let ended = cmd.args(args).timeout(Duration::from_secs(30)).assert();
+    let o = ended.failure().get_output().clone();
+    assert!(
+        o.status.code().is_some(),
+        "{args:?} did not end within 30 s"
+    );
     stderr(&o)
 }
 
@@ -374,7 +326,7 @@ fn an_init_line_over_4_kib_is_refused_with_its_number_and_a_directory_as_a_direc
 
 #[test]
 fn a_run_larger_than_the_available_memory_is_refused_before_allocating() {
-    let o = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+    let o = bench_sph()
         .args(["simulate", "--n", "100000000", "--neighbors", "grid"])
         .env("BENCH_SPH_FAKE_MEM_AVAILABLE", "21000000000")
         .output()
@@ -393,7 +345,7 @@ fn a_run_larger_than_the_available_memory_is_refused_before_allocating() {
 
 #[test]
 fn a_full_or_closed_stdout_is_one_error_line_not_a_panic() {
-    let o = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+    let o = bench_sph()
         .args(["simulate", "--n", "20", "--steps", "2"])
         .stdout(std::fs::File::create("/dev/full").unwrap())
         .output()
@@ -410,7 +362,7 @@ fn ctrl_c_during_a_dumping_run_keeps_the_earlier_file_and_leaves_no_temporary() 
     let tmp = tempfile::tempdir().unwrap();
     let dump = tmp.path().join("d.csv");
     std::fs::write(&dump, "keep").unwrap();
-    let child = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+    let child = bench_sph()
         .args(["simulate", "--n", "3000", "--steps", "1000000", "--dump"])
         .arg(&dump)
         .stdout(Stdio::null())

@@ -3,12 +3,13 @@
 //! interruption and `--resume`, and a clear `Error: ...` with a non-zero exit for bad input.
 //! No test asserts a duration.
 
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-type Row = HashMap<String, String>;
+mod common;
+use common::{Row, bench_sph, fails_with, rows, run, stderr, stdout};
 
 const TRIAL_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
     trial,wall_s,cpu_s,checksum,status,reason,foreign_cpu_s,steal_s,load1";
@@ -36,48 +37,18 @@ const TINY: &[&str] = &[
 ];
 const TINY_CELLS: usize = 15;
 
-fn bench_sph(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
 /// Runs the tiny sweep (plus `extra`) into `dir` and expects success.
 fn tiny_sweep(dir: &Path, extra: &[&str]) -> Output {
     let mut args = TINY.to_vec();
     args.extend(["--out", dir.to_str().unwrap()]);
     args.extend(extra);
-    let o = bench_sph(&args);
+    let o = run(&args);
     assert!(
         o.status.success(),
         "{args:?}:\n{}\n{}",
         stdout(&o),
         stderr(&o)
     );
-    o
-}
-
-/// Runs and expects failure whose standard error contains every one of `needles`.
-fn fails_with(args: &[&str], needles: &[&str]) -> Output {
-    let o = bench_sph(args);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{args:?} succeeded: {}", stdout(&o));
-    for needle in needles {
-        assert!(
-            err.contains(needle),
-            "{args:?}: stderr lacks {needle:?}:\n{err}"
-        );
-    }
-    assert!(!err.contains("panicked"), "{args:?} panicked:\n{err}");
     o
 }
 
@@ -88,27 +59,6 @@ fn header(path: &Path) -> String {
         .next()
         .unwrap_or_default()
         .to_owned()
-}
-
-fn rows(path: &Path) -> Vec<Row> {
-    let mut reader = csv::Reader::from_path(path).unwrap();
-    let names: Vec<String> = reader
-        .headers()
-        .unwrap()
-        .iter()
-        .map(str::to_owned)
-        .collect();
-    reader
-        .records()
-        .map(|r| {
-            let r = r.unwrap();
-            names
-                .iter()
-                .cloned()
-                .zip(r.iter().map(str::to_owned))
-                .collect()
-        })
-        .collect()
 }
 
 fn num(row: &Row, column: &str) -> f64 {
@@ -292,7 +242,7 @@ fn summary_statistics_agree_exactly_with_the_trial_rows_under_fake_timings() {
     let at = args.iter().position(|a| *a == "--trials").unwrap();
     args[at + 1] = "3";
     args.extend(["--fake-timings", fake, "--out", dir.to_str().unwrap()]);
-    let o = bench_sph(&args);
+    let o = run(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("--fake-timings"), "{}", stderr(&o));
 
@@ -395,7 +345,7 @@ fn a_sweep_stopped_midway_and_resumed_ends_with_exactly_one_row_per_trial() {
     ));
     std::fs::write(&trials_path, text).unwrap();
 
-    let o = bench_sph(&["sweep", "--resume", d, "--no-plots"]);
+    let o = run(&["sweep", "--resume", d, "--no-plots"]);
     assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
     assert!(
         stdout(&o).contains("4 finished cells kept"),
@@ -418,7 +368,7 @@ fn a_sweep_stopped_midway_and_resumed_ends_with_exactly_one_row_per_trial() {
     assert_eq!(meta["sessions"][1]["cells_run"], 11);
 
     // Resuming a finished sweep runs nothing and succeeds.
-    let o = bench_sph(&["sweep", "--resume", d, "--no-plots"]);
+    let o = run(&["sweep", "--resume", d, "--no-plots"]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_one_row_per_trial(&dir, 2, TINY_CELLS);
 }
@@ -445,7 +395,7 @@ const SLOW_CELLS: usize = 75;
 /// Starts a sweep big enough to still be running when the first cells are written, and
 /// returns it once `summary.csv` holds `cells` rows (or it has ended).
 fn spawn_until_cells(dir: &Path, cells: usize) -> std::process::Child {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
+    let mut child = bench_sph()
         .args(SLOW)
         .args(["--out", dir.to_str().unwrap()])
         .stdout(Stdio::null())
@@ -482,7 +432,7 @@ fn a_sweep_killed_outright_resumes_without_duplicating_rows() {
         eprintln!("killed after {kept} cells");
     }
     let d = dir.to_str().unwrap();
-    let o = bench_sph(&["sweep", "--resume", d, "--no-plots"]);
+    let o = run(&["sweep", "--resume", d, "--no-plots"]);
     assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
     assert_one_row_per_trial(&dir, 2, SLOW_CELLS);
 }
@@ -601,7 +551,7 @@ fn cells_with_more_cores_than_hardware_threads_are_marked_and_warned_about() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("r");
     let cores = format!("{hw}..{}", hw + 1);
-    let o = bench_sph(&[
+    let o = run(&[
         "sweep",
         "--n",
         "40",

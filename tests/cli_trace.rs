@@ -8,10 +8,13 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
 use sph_strategies::StrategyName;
+
+mod common;
+use common::{fails_with, names, run, stderr, stdout};
 
 const N: usize = 200;
 const STEPS: usize = 2;
@@ -19,21 +22,6 @@ const CORES: usize = 2;
 const CHUNKS: usize = 7;
 const PASSES: [&str; 3] = ["density", "forces", "integrate"];
 const STATS_HEADER: &str = "kind,name,threads,kernel_calls,busy_ms,span_ms,idle_pct,imbalance";
-
-fn bench_sph(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_bench-sph"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 fn trace(strategy: StrategyName, out: &Path, extra: &[&str]) -> Output {
     let (n, steps, cores, chunks) = (
@@ -58,7 +46,7 @@ fn trace(strategy: StrategyName, out: &Path, extra: &[&str]) -> Output {
         out.to_str().unwrap(),
     ];
     args.extend_from_slice(extra);
-    bench_sph(&args)
+    run(&args)
 }
 
 /// Kernel calls per pass, where the strategy fixes it (rayon-iter lets rayon decide).
@@ -265,7 +253,7 @@ fn a_traced_run_ends_in_the_same_state_as_simulate() {
     let meta: Value =
         serde_json::from_str(&std::fs::read_to_string(tmp.path().join("meta.json")).unwrap())
             .unwrap();
-    let s = bench_sph(&[
+    let s = run(&[
         "simulate",
         "--n",
         "200",
@@ -308,25 +296,13 @@ fn the_timeline_can_show_only_the_last_steps() {
     assert_eq!(meta["timeline_steps"], serde_json::json!([2, 2]));
 }
 
-/// Runs and expects failure whose message contains `needle`.
-fn fails_with(args: &[&str], needle: &str) {
-    let o = bench_sph(args);
-    let err = stderr(&o);
-    assert!(!o.status.success(), "{args:?} succeeded: {}", stdout(&o));
-    assert!(
-        err.contains(needle),
-        "{args:?}: stderr lacks {needle:?}:\n{err}"
-    );
-    assert!(!err.contains("panicked"), "{args:?} panicked:\n{err}");
-}
-
 #[test]
 fn an_unwritable_output_directory_is_an_error_before_anything_runs() {
     let tmp = tempfile::tempdir().unwrap();
     let file = tmp.path().join("a-file");
     std::fs::write(&file, "x").unwrap();
     let out = file.join("sub");
-    let o = bench_sph(&[
+    let o = run(&[
         "trace",
         "--strategy",
         "seq",
@@ -347,7 +323,7 @@ fn a_diverging_run_is_an_error_and_leaves_no_trace_files() {
     let init = tmp.path().join("boom.csv");
     std::fs::write(&init, "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n").unwrap();
     let out = tmp.path().join("t");
-    let o = bench_sph(&[
+    let o = run(&[
         "trace",
         "--strategy",
         "rayon-chunks",
@@ -372,25 +348,25 @@ fn bad_counts_and_names_are_rejected() {
     let base = ["trace", "--out", "unused-dir", "--strategy"];
     fails_with(
         &[&base[..], &["turbo"]].concat(),
-        "unknown strategy 'turbo'",
+        &["unknown strategy 'turbo'"],
     );
     fails_with(
         &[&base[..], &["seq", "--steps", "0"]].concat(),
-        "at least 1",
+        &["at least 1"],
     );
     fails_with(
         &[&base[..], &["seq", "--cores", "0"]].concat(),
-        "at least 1",
+        &["at least 1"],
     );
     fails_with(
         &[&base[..], &["seq", "--compare", "x"]].concat(),
-        "whole number",
+        &["whole number"],
     );
     fails_with(
         &[&base[..], &["seq", "--warmup", "1001"]].concat(),
-        "warm-ups must be between 0 and 1000, not 1001",
+        &["warm-ups must be between 0 and 1000, not 1001"],
     );
-    fails_with(&["trace", "--strategy", "seq"], "--out");
+    fails_with(&["trace", "--strategy", "seq"], &["--out"]);
     assert!(!Path::new("unused-dir").exists());
 }
 
@@ -401,16 +377,6 @@ fn one_error_line(o: &Output, needle: &str) -> String {
     assert!(err.starts_with("Error: ") && err.contains(needle), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     err
-}
-
-/// The names in `dir`, sorted.
-fn names(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 /// The bytes of every file in `dir`, by name.
@@ -509,7 +475,7 @@ fn a_failed_trace_leaves_an_earlier_trace_in_its_directory_as_it_was() {
     let before = contents(&out);
     let init = tmp.path().join("boom.csv");
     std::fs::write(&init, "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n").unwrap();
-    let o = bench_sph(&[
+    let o = run(&[
         "trace",
         "--strategy",
         "seq",
@@ -526,7 +492,7 @@ fn a_failed_trace_leaves_an_earlier_trace_in_its_directory_as_it_was() {
 fn a_trace_too_large_is_refused_before_it_runs_naming_the_estimate_and_what_to_lower() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("big");
-    let o = bench_sph(&[
+    let o = run(&[
         "trace",
         "--strategy",
         "rayon-spawn",
@@ -550,7 +516,7 @@ fn when_only_one_of_two_workers_ran_kernels_the_summary_says_so_plainly() {
     let tmp = tempfile::tempdir().unwrap();
     // One particle: std-static makes one block per pass, so one of its two workers never
     // gets one.
-    let o = bench_sph(&[
+    let o = run(&[
         "trace",
         "--strategy",
         "std-static",
@@ -582,7 +548,7 @@ fn real_trace(dir: &Path) {
 fn report(results: &Path, extra: &[&str]) -> Output {
     let mut args = vec!["report", results.to_str().unwrap()];
     args.extend_from_slice(extra);
-    bench_sph(&args)
+    run(&args)
 }
 
 #[test]

@@ -1,17 +1,20 @@
 //! The `bench-sph` command line (clap derive): one module for the definitions, one per command.
 
 mod list;
+mod parallel;
 mod render;
 mod report;
 mod scene;
 mod simulate;
 mod sweep;
 mod trace;
+mod values;
 #[cfg(feature = "viewer")]
 mod view;
 
 use clap::{Parser, Subcommand};
-use sph_strategies::StrategyName;
+
+use crate::limits;
 
 pub use render::RenderArgs;
 pub use report::ReportArgs;
@@ -124,47 +127,43 @@ fn positive(s: &str) -> Result<usize, String> {
     }
 }
 
-/// A worker-thread count: 1 ..= [`crate::limits::MAX_CORES`].
+/// A whole number from 1 to `max`; the error names the quantity `what`.
+fn count(s: &str, what: &'static str, max: usize) -> Result<usize, String> {
+    let v = positive(s)?;
+    limits::check(what, v, 1, max).map_err(|e| e.to_string())
+}
+
+/// A worker-thread count: 1 ..= [`limits::MAX_CORES`].
 fn cores(s: &str) -> Result<usize, String> {
-    let v = positive(s)?;
-    crate::limits::check("cores", v, 1, crate::limits::MAX_CORES).map_err(|e| e.to_string())
+    count(s, "cores", limits::MAX_CORES)
 }
 
-/// A chunk count: 1 ..= [`crate::limits::MAX_CHUNKS`].
+/// A chunk count: 1 ..= [`limits::MAX_CHUNKS`].
 fn chunks(s: &str) -> Result<usize, String> {
-    let v = positive(s)?;
-    crate::limits::check("chunks", v, 1, crate::limits::MAX_CHUNKS).map_err(|e| e.to_string())
+    count(s, "chunks", limits::MAX_CHUNKS)
 }
 
-/// A step count: 1 ..= [`crate::limits::MAX_STEPS`].
+/// A step count: 1 ..= [`limits::MAX_STEPS`].
 fn steps(s: &str) -> Result<usize, String> {
-    let v = positive(s)?;
-    crate::limits::check("steps", v, 1, crate::limits::MAX_STEPS).map_err(|e| e.to_string())
+    count(s, "steps", limits::MAX_STEPS)
 }
 
-/// A particle count: 1 ..= [`crate::limits::MAX_PARTICLES`].
+/// A particle count: 1 ..= [`limits::MAX_PARTICLES`].
 fn particles(s: &str) -> Result<usize, String> {
-    let v = positive(s)?;
-    crate::limits::check("particles", v, 1, crate::limits::MAX_PARTICLES).map_err(|e| e.to_string())
+    count(s, "particles", limits::MAX_PARTICLES)
 }
 
-/// Timed trials per cell: 1 ..= [`crate::limits::MAX_TRIALS`].
+/// Timed trials per cell: 1 ..= [`limits::MAX_TRIALS`].
 fn trials(s: &str) -> Result<usize, String> {
-    let v = positive(s)?;
-    crate::limits::check("trials", v, 1, crate::limits::MAX_TRIALS).map_err(|e| e.to_string())
+    count(s, "trials", limits::MAX_TRIALS)
 }
 
-/// Warm-up runs per cell: 0 ..= [`crate::limits::MAX_WARMUP`].
+/// Warm-up runs per cell: 0 ..= [`limits::MAX_WARMUP`].
 fn warmup(s: &str) -> Result<usize, String> {
     let v = s
         .parse::<usize>()
         .map_err(|_| format!("'{s}' is not a whole number of at least 0"))?;
-    crate::limits::check("warm-ups", v, 0, crate::limits::MAX_WARMUP).map_err(|e| e.to_string())
-}
-
-/// A strategy name from the registry.
-fn strategy(s: &str) -> Result<StrategyName, String> {
-    s.parse::<StrategyName>().map_err(|e| e.to_string())
+    limits::check("warm-ups", v, 0, limits::MAX_WARMUP).map_err(|e| e.to_string())
 }
 
 /// The machine's hardware threads (1 when unknown).

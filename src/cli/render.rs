@@ -10,7 +10,6 @@ use std::path::PathBuf;
 
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use sph_strategies::{Config, StrategyName};
 
 use super::simulate::say;
 use crate::clock::Elapsed;
@@ -29,6 +28,9 @@ const PROGRESS_FROM_PARTICLE_STEPS: usize = 1_000_000;
 
 /// Options of `render`.
 #[derive(Debug, Clone, Args)]
+#[command(mut_args(super::parallel::strategy_help(
+    "Parallel strategy (see `bench-sph list`); every strategy gives the same frames"
+)))]
 pub struct RenderArgs {
     /// The scene: preset, N, neighbour search, seed, initial state.
     #[command(flatten)]
@@ -39,17 +41,11 @@ pub struct RenderArgs {
     /// One frame every K steps.
     #[arg(long, value_name = "K", default_value_t = 10, value_parser = super::positive)]
     pub every: usize,
-    /// Parallel strategy (see `bench-sph list`); every strategy gives the same frames.
-    #[arg(long, default_value = "seq", value_parser = super::strategy)]
-    pub strategy: StrategyName,
-    /// Worker threads [default: the machine's hardware threads].
-    #[arg(long, value_parser = super::cores)]
-    pub cores: Option<usize>,
-    /// Chunks per pass, for strategies that use chunks.
-    #[arg(long, default_value_t = 10, value_parser = super::chunks)]
-    pub chunks: usize,
+    /// How the passes run: strategy, worker threads, chunks.
+    #[command(flatten)]
+    pub parallel: super::parallel::ParallelArgs,
     /// What the particles' colour shows (the range is fixed for the whole animation).
-    #[arg(long, value_enum, default_value_t = ColorBy::Speed)]
+    #[arg(long, default_value = "speed", value_parser = super::values::color())]
     pub color: ColorBy,
     /// Image width, px (the height follows the tank's aspect ratio).
     #[arg(long, default_value_t = 600,
@@ -84,10 +80,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
 
     let frames = args.steps / args.every + 1;
     let n = state.len();
-    let config = Config {
-        cores: args.cores.unwrap_or_else(super::hardware_threads),
-        chunks: args.chunks,
-    };
+    let config = args.parallel.config();
     let mut sim = Simulation::new(params, domain, state, args.scene.neighbors);
     let bar = progress_bar(frames, n * args.steps);
     let started = std::time::Instant::now();
@@ -109,7 +102,14 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         warmup: 0,
     };
     // All frames in one session: one thread pool for the whole animation.
-    let outcome = run_steps(&mut sim, args.strategy, &config, steps, &mut (), &mut drawn);
+    let outcome = run_steps(
+        &mut sim,
+        args.parallel.strategy,
+        &config,
+        steps,
+        &mut (),
+        &mut drawn,
+    );
     let (shown, simulating_s) = (drawn.shown, drawn.simulating_s);
     if let Some(err) = drawn.failed {
         return Err(err);

@@ -34,13 +34,13 @@ pub struct SceneArgs {
 #[derive(Debug, Clone, Args)]
 struct SceneOptions {
     /// Constants and integration order to reproduce.
-    #[arg(long, value_enum, default_value_t = Preset::Seed)]
+    #[arg(long, default_value = "seed", value_parser = super::values::preset())]
     preset: Preset,
     /// Number of particles [default: 1000, or the row count of --init].
     #[arg(long, value_parser = super::particles)]
     n: Option<usize>,
     /// Neighbour search.
-    #[arg(long, value_enum, default_value_t = NeighborMode::AllPairs)]
+    #[arg(long, default_value = "all-pairs", value_parser = super::values::neighbors())]
     neighbors: NeighborMode,
     /// Seed of the initial jitter.
     #[arg(long, default_value_t = 2019)]

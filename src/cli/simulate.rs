@@ -5,7 +5,6 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use serde::Serialize;
-use sph_strategies::{Config, StrategyName};
 
 use crate::checksum::checksum_hex;
 use crate::io::dump_csv::{self, DumpInfo};
@@ -26,15 +25,9 @@ pub struct SimulateArgs {
     /// Number of steps.
     #[arg(long, default_value_t = 1000, value_parser = super::steps)]
     pub steps: usize,
-    /// Parallel strategy (see `bench-sph list`).
-    #[arg(long, default_value = "seq", value_parser = super::strategy)]
-    pub strategy: StrategyName,
-    /// Worker threads [default: the machine's hardware threads].
-    #[arg(long, value_parser = super::cores)]
-    pub cores: Option<usize>,
-    /// Chunks per pass, for strategies that use chunks.
-    #[arg(long, default_value_t = 10, value_parser = super::chunks)]
-    pub chunks: usize,
+    /// How the passes run: strategy, worker threads, chunks.
+    #[command(flatten)]
+    pub parallel: super::parallel::ParallelArgs,
     /// Write the final state to CSV (i,x,y,vx,vy,fx,fy,rho,p; exact round-trip), replacing
     /// FILE only when the run ends.
     #[arg(long, value_name = "FILE.csv")]
@@ -74,11 +67,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     // temporary file and renamed over FILE at the end: a failed or interrupted run leaves
     // FILE as it was.
     let mut dump = args.dump.as_deref().map(Sink::create).transpose()?;
-    let cores = args.cores.unwrap_or_else(super::hardware_threads);
-    let config = Config {
-        cores,
-        chunks: args.chunks,
-    };
+    let config = args.parallel.config();
     let mut sim = Simulation::new(
         args.scene.preset.params(),
         domain,
@@ -86,10 +75,17 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         args.scene.neighbors,
     );
     let outcome = match args.inject_panic_at {
-        None => run_timed(&mut sim, args.strategy, &config, args.steps),
+        None => run_timed(&mut sim, args.parallel.strategy, &config, args.steps),
         Some(particle) => {
             let mut fault = PanicAt(particle);
-            run_timed_with(&mut sim, args.strategy, &config, args.steps, 0, &mut fault)
+            run_timed_with(
+                &mut sim,
+                args.parallel.strategy,
+                &config,
+                args.steps,
+                0,
+                &mut fault,
+            )
         }
     };
 
@@ -116,13 +112,13 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         Err(err) => return Err(err.into()),
     };
 
-    let info = args.strategy.info();
+    let info = args.parallel.strategy.info();
     let report = Report {
         preset: args.scene.preset,
         neighbors: args.scene.neighbors,
         strategy: info.name.to_owned(),
-        cores: info.effective_cores(cores),
-        chunks: info.effective_chunks(args.chunks),
+        cores: info.effective_cores(config.cores),
+        chunks: info.effective_chunks(args.parallel.chunks),
         seed: args.scene.init.is_none().then_some(args.scene.seed),
         init: args.scene.init.as_ref().map(|p| p.display().to_string()),
         n,

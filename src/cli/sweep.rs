@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::Context;
-use clap::Args;
+use clap::{Arg, Args};
 use sph_strategies::StrategyName;
 
 use crate::sph::neighbors::NeighborMode;
@@ -19,66 +19,77 @@ const QUICK_STEPS: usize = 300;
 /// See [`QUICK_CHUNKS`].
 const QUICK_TRIALS: usize = 3;
 
+/// The options that describe a new sweep: `--resume` takes its parameters from DIR/meta.json
+/// and cannot be used with any of them.
+///
+/// Not an `ArgGroup` that conflicts with `--resume`: clap's error for `--resume DIR --n 5`
+/// would then list every member of the group instead of naming `--n`.
+const NEW_SWEEP_ONLY: [&str; 15] = [
+    "cores",
+    "chunks",
+    "strategies",
+    "preset",
+    "neighbors",
+    "n",
+    "steps",
+    "trials",
+    "warmup",
+    "seed",
+    "out",
+    "force",
+    "quick",
+    "fake_timings",
+    "fake_contention",
+];
+
+/// Makes each of [`NEW_SWEEP_ONLY`] conflict with `--resume` (in place, keeping clap's order).
+fn not_with_resume(arg: Arg) -> Arg {
+    match NEW_SWEEP_ONLY.contains(&arg.get_id().as_str()) {
+        true => arg.conflicts_with("resume"),
+        false => arg,
+    }
+}
+
 /// Options of `sweep`.
 #[derive(Debug, Clone, Args)]
+#[command(mut_args(not_with_resume))]
 pub struct SweepArgs {
     /// Worker threads: N, A..B, A..B:S or a comma list [default: 1..the hardware threads].
-    #[arg(long, value_name = "RANGE", conflicts_with = "resume")]
+    #[arg(long, value_name = "RANGE")]
     pub cores: Option<String>,
     /// Chunks per pass, for strategies that use chunks: N, A..B (step 10), A..B:S, a comma
     /// list, or `paper` (2,4,8,12,16,20,25,35,45,60,75,100,150,200,250,333,400).
-    #[arg(
-        long,
-        value_name = "RANGE",
-        default_value = "paper",
-        conflicts_with = "resume"
-    )]
+    #[arg(long, value_name = "RANGE", default_value = "paper")]
     pub chunks: String,
     /// Strategies, comma-separated (see `bench-sph list`) [default: all]. seq at 1 core is
     /// measured in any case: it is the reference of speedup and checksum.
-    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = super::strategy, conflicts_with = "resume")]
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = super::values::strategy())]
     pub strategies: Vec<StrategyName>,
     /// Presets, comma-separated.
-    #[arg(
-        long,
-        value_enum,
-        value_delimiter = ',',
-        default_value = "seed",
-        conflicts_with = "resume"
-    )]
+    #[arg(long, value_delimiter = ',', default_value = "seed", value_parser = super::values::preset())]
     pub preset: Vec<Preset>,
     /// Neighbour searches, comma-separated.
-    #[arg(
-        long,
-        value_enum,
-        value_delimiter = ',',
-        default_value = "all-pairs",
-        conflicts_with = "resume"
-    )]
+    #[arg(long, value_delimiter = ',', default_value = "all-pairs", value_parser = super::values::neighbors())]
     pub neighbors: Vec<NeighborMode>,
     /// Particle counts: N, a comma list, or A..B:S.
-    #[arg(
-        long,
-        value_name = "LIST",
-        default_value = "1000",
-        conflicts_with = "resume"
-    )]
+    #[arg(long, value_name = "LIST", default_value = "1000")]
     pub n: String,
     /// Steps per run.
-    #[arg(long, default_value_t = 1000, value_parser = super::steps, conflicts_with = "resume")]
+    #[arg(long, default_value_t = 1000, value_parser = super::steps)]
     pub steps: usize,
     /// Timed runs per cell (1 ..= 1000).
-    #[arg(long, default_value_t = 5, value_parser = super::trials, conflicts_with = "resume")]
+    #[arg(long, default_value_t = 5, value_parser = super::trials)]
     pub trials: usize,
     /// Untimed runs before each cell's trials (0 ..= 1000).
-    #[arg(long, default_value_t = 1, value_parser = super::warmup, conflicts_with = "resume")]
+    #[arg(long, default_value_t = 1, value_parser = super::warmup)]
     pub warmup: usize,
     /// Seed of the initial jitter.
-    #[arg(long, default_value_t = 2019, conflicts_with = "resume")]
+    #[arg(long, default_value_t = 2019)]
     pub seed: u64,
     /// Results directory [default: results/<UTC timestamp>]. Must not exist or be empty,
     /// unless --force.
-    #[arg(long, value_name = "DIR", conflicts_with = "resume")]
+    #[allow(rustdoc::invalid_html_tags)] // `--help` shows this text as it is: no markup
+    #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Continue the sweep in DIR with the parameters of DIR/meta.json: finished cells are
     /// kept, unfinished ones run (again).
@@ -86,22 +97,22 @@ pub struct SweepArgs {
     pub resume: Option<PathBuf>,
     /// Replace the results files (trials.csv, summary.csv, meta.json) of an existing --out
     /// directory.
-    #[arg(long, conflicts_with = "resume")]
+    #[arg(long)]
     pub force: bool,
     /// Do not draw charts at the end.
     #[arg(long)]
     pub no_plots: bool,
     /// A small study that finishes in about a minute on 2 cores: the defaults, but 300 steps,
     /// chunks 10,45,90 and 3 trials per cell.
-    #[arg(long, conflicts_with_all = ["resume", "steps", "chunks", "trials"])]
+    #[arg(long, conflicts_with_all = ["steps", "chunks", "trials"])]
     pub quick: bool,
     /// Test only: record these times (WALL or WALL:CPU seconds, comma-separated, taken in
     /// turn) instead of the measured ones. The runs still happen and are checked.
-    #[arg(long, value_name = "LIST", hide = true, conflicts_with = "resume")]
+    #[arg(long, value_name = "LIST", hide = true)]
     pub fake_timings: Option<String>,
     /// Test only: record these shares (0 ..= 1, comma-separated, taken in turn) of the
     /// machine's capacity as taken by other work, instead of the measured foreign CPU.
-    #[arg(long, value_name = "LIST", hide = true, conflicts_with = "resume")]
+    #[arg(long, value_name = "LIST", hide = true)]
     pub fake_contention: Option<String>,
     /// Test only: stop as if Ctrl-C was pressed once this many cells are written.
     #[arg(long, value_name = "K", hide = true)]

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use serde::Serialize;
-use sph_strategies::{Config, StrategyName};
+use sph_strategies::Config;
 
 use crate::checksum::checksum_hex;
 use crate::output::atomic::AtomicFile;
@@ -21,19 +21,16 @@ use crate::trace::{TraceConfig, TracedRun, chrome, run_traced, run_untraced, tim
 
 /// Options of `trace`.
 #[derive(Debug, Clone, Args)]
+#[command(mut_args(super::parallel::strategy_required(
+    "Parallel strategy to trace (see `bench-sph list`)"
+)))]
 pub struct TraceArgs {
     /// The scene: preset, N, neighbour search, seed, initial state.
     #[command(flatten)]
     pub scene: super::scene::SceneArgs,
-    /// Parallel strategy to trace (see `bench-sph list`).
-    #[arg(long, value_parser = super::strategy)]
-    pub strategy: StrategyName,
-    /// Worker threads [default: the machine's hardware threads].
-    #[arg(long, value_parser = super::cores)]
-    pub cores: Option<usize>,
-    /// Chunks per pass, for strategies that use chunks.
-    #[arg(long, default_value_t = 10, value_parser = super::chunks)]
-    pub chunks: usize,
+    /// How the passes run: strategy, worker threads, chunks.
+    #[command(flatten)]
+    pub parallel: super::parallel::ParallelArgs,
     /// Number of steps to record.
     #[arg(long, default_value_t = 5, value_parser = super::steps)]
     pub steps: usize,
@@ -85,15 +82,12 @@ struct Comparison {
 /// removes trace's own stale files.
 pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
     let (state, domain) = args.scene.initial_state()?;
-    let cores = args.cores.unwrap_or_else(super::hardware_threads);
-    let strategy_config = Config {
-        cores,
-        chunks: args.chunks,
-    };
+    let strategy_config = args.parallel.config();
+    let cores = strategy_config.cores;
     Plan {
-        strategy: args.strategy,
+        strategy: args.parallel.strategy,
         n: state.len(),
-        chunks: args.chunks,
+        chunks: args.parallel.chunks,
         cores,
         steps: args.steps,
         neighbors: args.scene.neighbors,
@@ -114,11 +108,11 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
         path(files::META_JSON)?,
     ];
 
-    let info = args.strategy.info();
+    let info = args.parallel.strategy.info();
     let config = TraceConfig {
         strategy: info.name.to_owned(),
         cores: info.effective_cores(cores),
-        chunks: info.effective_chunks(args.chunks),
+        chunks: info.effective_chunks(args.parallel.chunks),
         n: state.len(),
         steps: args.steps,
         preset: args.scene.preset,
@@ -137,7 +131,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
     let (sim, run, comparison) = record(args, &strategy_config, fresh)?;
 
     size::check_recorded(
-        args.strategy,
+        args.parallel.strategy,
         run.trace.kernels.len() + run.trace.serial.len(),
     )?;
     let stats = stats::compute(&run.trace);
@@ -183,7 +177,7 @@ fn record(
     let traced = |sim: &mut Simulation| -> anyhow::Result<TracedRun> {
         Ok(run_traced(
             sim,
-            args.strategy,
+            args.parallel.strategy,
             config,
             args.steps,
             args.warmup,
@@ -196,7 +190,13 @@ fn record(
     let mut last = None;
     for _ in 0..args.compare.unwrap_or(0) {
         let mut plain = fresh();
-        let elapsed = run_untraced(&mut plain, args.strategy, config, args.steps, args.warmup)?;
+        let elapsed = run_untraced(
+            &mut plain,
+            args.parallel.strategy,
+            config,
+            args.steps,
+            args.warmup,
+        )?;
         comparison.untraced.push(elapsed.wall_s);
         let mut sim = fresh();
         let run = traced(&mut sim)?;

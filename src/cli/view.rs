@@ -1,7 +1,6 @@
 //! `bench-sph view` (cargo feature `viewer`): the dam break live in a window.
 
 use clap::Args;
-use sph_strategies::{Config, StrategyName};
 
 use crate::render::frame::{MAX_WIDTH, MIN_WIDTH};
 use crate::render::scale::ColorBy;
@@ -12,9 +11,12 @@ use crate::viewer::scene::Settings;
 
 /// Options of `view`.
 #[derive(Debug, Clone, Args)]
+#[command(mut_args(super::parallel::strategy_help(
+    "Parallel strategy at start (s moves to the next)"
+)))]
 pub struct ViewArgs {
     /// Constants and integration order to reproduce.
-    #[arg(long, value_enum, default_value_t = Preset::Seed)]
+    #[arg(long, default_value = "seed", value_parser = super::values::preset())]
     pub preset: Preset,
     /// Number of particles at start (+ and - double and halve it).
     #[arg(long, default_value_t = 1000, value_parser = super::particles)]
@@ -23,22 +25,16 @@ pub struct ViewArgs {
     #[arg(long, value_name = "K", default_value_t = 5, value_parser = super::positive)]
     pub every: usize,
     /// Neighbour search.
-    #[arg(long, value_enum, default_value_t = NeighborMode::Grid)]
+    #[arg(long, default_value = "grid", value_parser = super::values::neighbors())]
     pub neighbors: NeighborMode,
-    /// Parallel strategy at start (s moves to the next).
-    #[arg(long, default_value = "seq", value_parser = super::strategy)]
-    pub strategy: StrategyName,
-    /// Worker threads [default: the machine's hardware threads].
-    #[arg(long, value_parser = super::cores)]
-    pub cores: Option<usize>,
-    /// Chunks per pass, for strategies that use chunks.
-    #[arg(long, default_value_t = 10, value_parser = super::chunks)]
-    pub chunks: usize,
+    /// How the passes run: strategy, worker threads, chunks.
+    #[command(flatten)]
+    pub parallel: super::parallel::ParallelArgs,
     /// Seed of the initial jitter.
     #[arg(long, default_value_t = 2019)]
     pub seed: u64,
     /// What the particles' colour shows at start (c switches).
-    #[arg(long, value_enum, default_value_t = ColorBy::Speed)]
+    #[arg(long, default_value = "speed", value_parser = super::values::color())]
     pub color: ColorBy,
     /// Window width, px.
     #[arg(long, default_value_t = 800,
@@ -60,11 +56,8 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         n: args.n,
         seed: args.seed,
         neighbors: args.neighbors,
-        strategy: args.strategy,
-        config: Config {
-            cores: args.cores.unwrap_or_else(super::hardware_threads),
-            chunks: args.chunks,
-        },
+        strategy: args.parallel.strategy,
+        config: args.parallel.config(),
         every: args.every,
         color: args.color,
         width: args.width,

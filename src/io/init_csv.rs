@@ -10,6 +10,8 @@
 
 use std::path::Path;
 
+use serde::Deserialize;
+
 use crate::io::bounded::{BoundedLines, Overrun, overrun};
 use crate::io::dump_csv::DumpInfo;
 use crate::limits::MAX_PARTICLES;
@@ -118,6 +120,25 @@ pub struct InitRows {
     pub dumped: Option<DumpInfo>,
 }
 
+/// One row as the file writes it. Cells stay text until [`number`] parses them, so that a bad
+/// cell is reported with its column and as written, and its value keeps every bit
+/// (`str::parse::<f64>` rounds exactly). `vx`/`vy` are `None` only when the header lacks the
+/// column (then 0); an empty cell in a present column is an error like any non-number.
+#[derive(Debug, Deserialize)]
+struct Row {
+    x: String,
+    y: String,
+    #[serde(default, deserialize_with = "present")]
+    vx: Option<String>,
+    #[serde(default, deserialize_with = "present")]
+    vy: Option<String>,
+}
+
+/// A cell of a column the header has, even an empty one (csv reads an empty cell as `None`).
+fn present<'de, D: serde::Deserializer<'de>>(cell: D) -> Result<Option<String>, D::Error> {
+    String::deserialize(cell).map(Some)
+}
+
 /// Reads `path`. Checks numbers, not walls (the tank depends on N; see [`check_walls`]).
 pub fn read(path: &Path) -> Result<InitRows, InitError> {
     let shown = path.display().to_string();
@@ -135,62 +156,36 @@ pub fn read(path: &Path) -> Result<InitRows, InitError> {
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
         .from_reader(BoundedLines::new(file, MAX_LINES));
-    let malformed = |e: csv::Error, shown: &str| {
-        let (line, message) = (e.position().map_or(0, |p| p.line()), e.to_string());
-        match e.into_kind() {
-            csv::ErrorKind::Io(source) => match overrun(&source) {
-                Some(overrun) => InitError::Overrun {
-                    path: shown.to_owned(),
-                    overrun,
-                },
-                None => InitError::Io {
-                    path: shown.to_owned(),
-                    source,
-                },
-            },
-            _ => InitError::Malformed {
-                path: shown.to_owned(),
-                line,
-                message,
-            },
-        }
-    };
     let headers = reader.headers().map_err(|e| malformed(e, &shown))?.clone();
     if headers.is_empty() || headers.iter().all(str::is_empty) {
         return Err(InitError::Empty { path: shown });
     }
-    let column = |name: &'static str| headers.iter().position(|h| h == name);
-    let cx = column("x").ok_or(InitError::MissingColumn {
-        path: shown.clone(),
-        column: "x",
-    })?;
-    let cy = column("y").ok_or(InitError::MissingColumn {
-        path: shown.clone(),
-        column: "y",
-    })?;
-    let (cvx, cvy) = (column("vx"), column("vy"));
+    if let Some(column) = ["x", "y"]
+        .into_iter()
+        .find(|&c| !headers.iter().any(|h| h == c))
+    {
+        return Err(InitError::MissingColumn {
+            path: shown,
+            column,
+        });
+    }
 
     let (mut x, mut y, mut vx, mut vy, mut lines) = (vec![], vec![], vec![], vec![], vec![]);
     for record in reader.records() {
         let record = record.map_err(|e| malformed(e, &shown))?;
         let line = record.position().map_or(0, |p| p.line());
-        let cell = |idx: Option<usize>, name: &'static str| -> Result<f64, InitError> {
-            let Some(idx) = idx else { return Ok(0.0) };
-            let text = record.get(idx).unwrap_or("");
-            match text.parse::<f64>() {
-                Ok(v) if v.is_finite() => Ok(v),
-                _ => Err(InitError::BadNumber {
-                    path: shown.clone(),
-                    line,
-                    column: name,
-                    value: text.to_owned(),
-                }),
-            }
-        };
-        x.push(cell(Some(cx), "x")?);
-        y.push(cell(Some(cy), "y")?);
-        vx.push(cell(cvx, "vx")?);
-        vy.push(cell(cvy, "vy")?);
+        let row: Row = record
+            .deserialize(Some(&headers))
+            .map_err(|e| InitError::Malformed {
+                path: shown.clone(),
+                line,
+                message: e.to_string(),
+            })?;
+        let cell = |text: Option<&str>, column| number(text, column, &shown, line);
+        x.push(cell(Some(&row.x), "x")?);
+        y.push(cell(Some(&row.y), "y")?);
+        vx.push(cell(row.vx.as_deref(), "vx")?);
+        vy.push(cell(row.vy.as_deref(), "vy")?);
         lines.push(line);
     }
     if x.is_empty() {
@@ -212,6 +207,48 @@ pub fn read(path: &Path) -> Result<InitRows, InitError> {
     })
 }
 
+/// A cell's finite value (0 for a column the file does not have).
+fn number(
+    text: Option<&str>,
+    column: &'static str,
+    path: &str,
+    line: u64,
+) -> Result<f64, InitError> {
+    let Some(text) = text else { return Ok(0.0) };
+    match text.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(InitError::BadNumber {
+            path: path.to_owned(),
+            line,
+            column,
+            value: text.to_owned(),
+        }),
+    }
+}
+
+/// A CSV reader's error as the init file's: an over-long line or file, an I/O error, or a
+/// malformed row with its line.
+fn malformed(e: csv::Error, path: &str) -> InitError {
+    let (line, message) = (e.position().map_or(0, |p| p.line()), e.to_string());
+    match e.into_kind() {
+        csv::ErrorKind::Io(source) => match overrun(&source) {
+            Some(overrun) => InitError::Overrun {
+                path: path.to_owned(),
+                overrun,
+            },
+            None => InitError::Io {
+                path: path.to_owned(),
+                source,
+            },
+        },
+        _ => InitError::Malformed {
+            path: path.to_owned(),
+            line,
+            message,
+        },
+    }
+}
+
 /// Checks that every particle lies inside `domain`'s walls (0 ≤ x ≤ width, 0 ≤ y ≤ height).
 pub fn check_walls(path: &Path, rows: &InitRows, domain: Domain) -> Result<(), InitError> {
     let s = &rows.state;
@@ -229,5 +266,47 @@ pub fn check_walls(path: &Path, rows: &InitRows, domain: Domain) -> Result<(), I
             height: domain.height,
             n: s.len(),
         }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Reads an init file holding `text`.
+    fn read_text(text: &str) -> Result<InitRows, InitError> {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("init.csv");
+        std::fs::write(&path, text).unwrap();
+        read(&path)
+    }
+
+    #[test]
+    fn columns_are_found_by_name_in_any_order_and_missing_velocities_are_zero() {
+        let rows = read_text("# a comment\nid,y,x\n7,2.5,1.5\n8,4,3\n").unwrap();
+        assert_eq!(rows.state.x, [1.5, 3.0]);
+        assert_eq!(rows.state.y, [2.5, 4.0]);
+        assert_eq!(rows.state.vx, [0.0, 0.0]);
+        assert_eq!(rows.lines, [3, 4]);
+    }
+
+    #[test]
+    fn every_bit_of_a_written_value_is_read_back() {
+        let v: f64 = 0.1 + 0.2;
+        let rows = read_text(&format!("x,y,vx,vy\n{v:?},1,{:?},-0\n", -v / 3.0)).unwrap();
+        assert_eq!(rows.state.x[0].to_bits(), v.to_bits());
+        assert_eq!(rows.state.vx[0].to_bits(), (-v / 3.0).to_bits());
+        assert_eq!(rows.state.vy[0].to_bits(), (-0.0f64).to_bits());
+    }
+
+    #[test]
+    fn an_empty_cell_of_a_present_column_is_an_error_naming_its_line_and_column() {
+        let err = read_text("x,y,vx\n1,2,3\n1,2,\n").unwrap_err().to_string();
+        assert!(
+            err.ends_with("line 3, column 'vx': '' is not a finite number"),
+            "{err}"
+        );
+        let err = read_text("x,vx\n1,2\n").unwrap_err().to_string();
+        assert!(err.ends_with("line 1: missing column 'y' (the header must name x and y)"));
     }
 }

@@ -1,6 +1,6 @@
 //! Standard output that may be closed under us: `bench-sph sweep | head -2`, or `> /dev/full`.
 //!
-//! Rust's `println!` panics when standard output is gone. Commands print through [`line`]
+//! Rust's `println!` panics when standard output is gone. Commands print through [`line()`]
 //! instead: a failed write returns the error, and records that standard output is closed
 //! ([`closed`]) so that a long command (a sweep) can stop cleanly, as after Ctrl-C, keeping
 //! what it finished.

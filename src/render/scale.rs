@@ -16,13 +16,18 @@ use crate::sph::params::Params;
 use crate::sph::state::State;
 
 /// The quantity a particle's colour shows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum ColorBy {
     /// Speed `|v|`, px/s.
     Speed,
     /// Density ρ (as the solver defines it).
     Density,
+}
+
+impl ColorBy {
+    /// Every quantity, default first.
+    pub const ALL: [ColorBy; 2] = [ColorBy::Speed, ColorBy::Density];
 }
 
 /// A quantity and the range of it that spans the colour map.

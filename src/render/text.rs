@@ -9,9 +9,8 @@ use std::sync::OnceLock;
 
 use ab_glyph::{Font, FontRef, PxScale, ScaleFont, point};
 
+use crate::plot::font::BYTES as FONT_BYTES;
 use crate::render::image::Image;
-
-static FONT_BYTES: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// The bundled font, parsed once.
 fn font() -> &'static FontRef<'static> {
@@ -139,8 +138,15 @@ mod tests {
 
     #[test]
     fn text_off_the_image_is_clipped() {
-        let mut img = Image::filled(10, 10, WHITE);
-        draw(&mut img, "bench-sph", (-20.0, 5.0), 30.0, [0, 0, 0]);
-        draw(&mut img, "x", (8.0, 200.0), 30.0, [0, 0, 0]);
+        let blank = Image::filled(10, 10, WHITE);
+        // Starting left of the image and rising above it: the part inside is drawn.
+        let mut partly = Image::filled(10, 10, WHITE);
+        draw(&mut partly, "bench-sph", (-20.0, 5.0), 30.0, [0, 0, 0]);
+        assert_eq!(partly.pixels.len(), blank.pixels.len());
+        assert!(partly.pixels.chunks_exact(3).any(|p| p[0] < 128));
+        // Wholly below the image: nothing is drawn.
+        let mut below = Image::filled(10, 10, WHITE);
+        draw(&mut below, "x", (8.0, 200.0), 30.0, [0, 0, 0]);
+        assert_eq!(below.pixels, blank.pixels);
     }
 }

@@ -6,7 +6,7 @@ use serde::Serialize;
 use std::f64::consts::PI;
 
 /// Which source program's constants and integration order to reproduce.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Preset {
     /// The seed paper's Haskell program (`schuermannator/sph`), all f64.

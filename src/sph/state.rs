@@ -90,11 +90,6 @@ impl State {
         self.x.is_empty()
     }
 
-    /// Particle `i`'s position.
-    pub fn position(&self, i: usize) -> DVec2 {
-        DVec2::new(self.x[i], self.y[i])
-    }
-
     /// Particle `i`'s velocity.
     pub fn velocity(&self, i: usize) -> DVec2 {
         DVec2::new(self.vx[i], self.vy[i])

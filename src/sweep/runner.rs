@@ -224,7 +224,7 @@ const CALIBRATION_N_ALL_PAIRS: usize = 4000;
 const CALIBRATION_N_GRID: usize = 200_000;
 
 /// Seconds one `seq` run of `group` takes, estimated from a short timed run of at most
-/// [`CALIBRATION_N_ALL_PAIRS`] (all-pairs) or [`CALIBRATION_N_GRID`] (grid) particles,
+/// `CALIBRATION_N_ALL_PAIRS` (all-pairs) or `CALIBRATION_N_GRID` (grid) particles,
 /// scaled by (N / sample)² or N / sample: one step, then doubling the steps until a run
 /// takes 50 ms or covers all steps. NaN when the run fails (the sweep will then report the
 /// failure properly).

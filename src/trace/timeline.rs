@@ -489,7 +489,15 @@ mod tests {
         font::ensure_registered().unwrap();
         let (w, h) = image_size(3);
         let mut pixels = vec![0u8; w as usize * h as usize * 3];
-        draw(&trace, &stats.workers, &config(), 1..=2, &mut pixels, (w, h)).unwrap();
+        draw(
+            &trace,
+            &stats.workers,
+            &config(),
+            1..=2,
+            &mut pixels,
+            (w, h),
+        )
+        .unwrap();
         let mut bytes = Vec::new();
         write_png(&trace, &stats.workers, &config(), 1..=2, &mut bytes).unwrap();
         assert_eq!(&bytes[..8], crate::trace::files::PNG_SIGNATURE);

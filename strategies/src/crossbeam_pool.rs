@@ -1,4 +1,4 @@
-//! `crossbeam-pool`: a hand-rolled pool of `cores` threads that lives for the whole run, with
+//! `crossbeam-pool`: a pool of `cores` crossbeam threads that lives for the whole run, with
 //! chunks handed out dynamically.
 //!
 //! **Scheduling.** [`Strategy::run`] starts exactly `cores` worker threads in a
@@ -6,12 +6,22 @@
 //! first of them (the calling thread only waits for it). For each pass that thread cuts the
 //! output into `min(chunks, len)` balanced chunks, publishes one job on a job board, works on
 //! the job itself, and, once it finds no chunk left, waits for the workers still busy with one.
-//! Each thread in the job pulls chunk indices from a shared atomic counter until the chunks
-//! run out — so fast workers take more chunks — and takes the chunk out of its slot (a
-//! `Mutex<Option<_>>` per chunk, locked once, uncontended).
+//! The pass's chunks wait in a `crossbeam` `ArrayQueue` (lock-free, bounded, in index order);
+//! each thread in the job pops chunks until the queue is empty — so fast workers take more
+//! chunks.
+//!
+//! **What crossbeam does here, and what it does not.** Crossbeam provides the threads
+//! (`crossbeam::scope`), the chunk queue, the first, busy part of every wait (`Backoff`, see
+//! `spin_wait`) and the cache-line padding of the two atomics that waiting threads watch
+//! (`CachePadded`, in `erased_job`). The job board itself — publish a job, let the workers
+//! that show up join it, close the pass when no chunk is left and wait only for the workers
+//! already inside it, sleep after a short watch — is a mutex and two condition variables in
+//! `erased_job`, not a channel: a channel delivers each message to one receiver, while every
+//! worker must see the same job, and the pass's end must be a rendezvous with exactly the
+//! workers that joined it, on which the lifetime erasure's safety argument rests.
 //!
 //! **Cost.** No thread start-up per pass; per pass one publication and one completion
-//! rendezvous, per chunk one atomic `fetch_add` and one uncontended lock, nothing per element.
+//! rendezvous, per chunk one push and one pop (a compare-and-swap each), nothing per element.
 //! A waiting thread (a worker between passes, the session's thread at the end of a pass)
 //! watches an atomic hint for up to 200 µs before it sleeps on a condition variable, so
 //! back-to-back passes need no wake-up (waking a sleeping thread costs tens of microseconds,
@@ -48,10 +58,10 @@ use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Session, Split, Strategy, balanced_chunks,
     panic,
 };
+use crossbeam::queue::ArrayQueue;
 use std::cell::{Cell, RefCell};
 use std::marker::PhantomData;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Mutex, PoisonError};
+use std::sync::OnceLock;
 
 /// A pool of `cores` long-lived crossbeam scoped threads pulling chunks dynamically.
 #[derive(Debug, Clone, Copy)]
@@ -65,8 +75,8 @@ impl Strategy for CrossbeamPool {
     const INFO: Info = Info {
         name: "crossbeam-pool",
         description: "a pool of --cores crossbeam threads kept for the whole run (the steps \
-                      run on one of them); each pass's chunks are pulled dynamically from an \
-                      atomic counter",
+                      run on one of them); each pass's chunks are popped dynamically from a \
+                      crossbeam queue",
         calls: crate::Calls::Chunks,
     };
 
@@ -162,30 +172,22 @@ impl Executor for PoolExecutor<'_> {
         if out.is_empty() {
             return Ok(());
         }
-        let slots: Vec<Mutex<Option<(usize, O)>>> = balanced_chunks(out, self.chunks)
-            .into_iter()
-            .map(|chunk| Mutex::new(Some(chunk)))
-            .collect();
-        let next = AtomicUsize::new(0);
-        let first_panic: Mutex<Option<KernelPanic>> = Mutex::new(None);
+        let chunks = balanced_chunks(out, self.chunks);
+        // Not empty (`out` is not), so the capacity is at least 1 as `ArrayQueue` requires.
+        let queue = ArrayQueue::new(chunks.len());
+        for chunk in chunks {
+            if queue.push(chunk).is_err() {
+                unreachable!("the queue holds exactly the pass's chunks");
+            }
+        }
+        let first_panic: OnceLock<KernelPanic> = OnceLock::new();
 
-        // Run by every worker. No lock is held while a kernel runs, so a panicking kernel
-        // poisons nothing (poisoning is ignored all the same).
+        // Run by every worker: pop chunks (each one exactly once, in index order) until none
+        // is left. A panicking kernel is caught here; the first panic is kept.
         let job = || {
-            loop {
-                // Relaxed is enough: the counter only has to hand each index out once; the
-                // chunk itself travels through its slot's mutex.
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                let Some(slot) = slots.get(i) else { break };
-                let taken = slot.lock().unwrap_or_else(PoisonError::into_inner).take();
-                let Some((first, chunk)) = taken else {
-                    unreachable!("chunk {i} handed out twice")
-                };
+            while let Some((first, chunk)) = queue.pop() {
                 if let Err(p) = panic::catch(|| kernel(first, chunk)) {
-                    first_panic
-                        .lock()
-                        .unwrap_or_else(PoisonError::into_inner)
-                        .get_or_insert(p);
+                    let _ = first_panic.set(p); // a later panic: the first one is kept
                 }
             }
         };
@@ -201,10 +203,7 @@ impl Executor for PoolExecutor<'_> {
             escaped
         };
 
-        let caught = first_panic
-            .into_inner()
-            .unwrap_or_else(PoisonError::into_inner);
-        match caught {
+        match first_panic.into_inner() {
             Some(p) => Err(p),
             None => escaped,
         }

@@ -23,6 +23,8 @@ use std::ptr::NonNull;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
 
+use crossbeam::utils::CachePadded;
+
 use crate::{KernelPanic, panic, spin_wait};
 
 /// A `&(dyn Fn() + Sync)` whose lifetime has been erased. Only [`JobBoard`] creates and calls
@@ -104,10 +106,12 @@ struct Sleepers {
 /// after that. Every decision is taken under the mutex; a stale hint only costs a lock.
 pub(crate) struct JobBoard {
     state: Mutex<State>,
-    /// Hint: `State::epoch`, bumped again at shut-down.
-    epoch_hint: AtomicU64,
-    /// Hint: `State::running`.
-    running_hint: AtomicUsize,
+    /// Hint: `State::epoch`, bumped again at shut-down. Watched by idle workers; padded to a
+    /// cache line of its own, so that workers leaving a pass (which write `running_hint`) do
+    /// not disturb it.
+    epoch_hint: CachePadded<AtomicU64>,
+    /// Hint: `State::running`. Watched by the dispatcher at the end of a pass.
+    running_hint: CachePadded<AtomicUsize>,
     /// Wakes workers: a job was published, or the board shut down.
     to_workers: Condvar,
     /// Wakes dispatchers: the workers left a closed pass, or a `run` returned.
@@ -118,8 +122,8 @@ impl JobBoard {
     /// A board with no job yet.
     pub(crate) fn new() -> Self {
         JobBoard {
-            epoch_hint: AtomicU64::new(0),
-            running_hint: AtomicUsize::new(0),
+            epoch_hint: CachePadded::new(AtomicU64::new(0)),
+            running_hint: CachePadded::new(AtomicUsize::new(0)),
             state: Mutex::new(State {
                 job: None,
                 epoch: 0,

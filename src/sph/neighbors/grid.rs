@@ -62,7 +62,8 @@ impl Grid {
         }
     }
 
-    /// Bytes held by the grid's arrays (capacity), for memory reports.
+    /// Bytes held by the grid's arrays (capacity): what `scene::memory::estimate` must
+    /// predict (its test compares the two).
     pub fn heap_bytes(&self) -> usize {
         4 * (self.start.capacity() + self.order.capacity() + self.cell_of.capacity())
             + 8 * (self.sorted_x.capacity() + self.sorted_y.capacity())

@@ -38,7 +38,8 @@ impl NeighborLists {
         (count < SLOTS).then(|| &self.slots[i * SLOTS..i * SLOTS + count])
     }
 
-    /// Heap bytes held.
+    /// Heap bytes held (capacity): what `scene::memory::estimate` must predict (its test
+    /// compares the two).
     pub fn heap_bytes(&self) -> usize {
         4 * (self.count.capacity() + self.slots.capacity())
     }

@@ -18,7 +18,7 @@ use sph_strategies::{Executor, KernelPanic};
 use crate::sph::state::{Domain, Positions};
 
 /// How candidates are found.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, clap::ValueEnum)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum NeighborMode {
     /// Every particle against every particle, O(N²) per pass: the sources' loops.

@@ -1,0 +1,156 @@
+//! The command line's names for the domain's enums, in one place: `src/sph` and `src/render`
+//! know nothing of clap. Each CLI enum carries the help text of its values and maps onto its
+//! domain type; an option keeps the domain type, parsed by [`preset`], [`neighbors`], [`color`]
+//! or [`strategy`] (the strategies' names come from their registry).
+
+use std::ffi::OsStr;
+
+use clap::builder::{EnumValueParser, PossibleValue, TypedValueParser};
+use clap::{Arg, ValueEnum};
+use sph_strategies::StrategyName;
+
+use crate::render::scale::ColorBy;
+use crate::sph::neighbors::NeighborMode;
+use crate::sph::params::Preset;
+
+/// `--preset`'s values.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum PresetArg {
+    /// The seed paper's Haskell program (`schuermannator/sph`), all f64.
+    Seed,
+    /// The C++ original (`cerrno/mueller-sph` at e0821c49), evaluated in f64.
+    Cpp,
+}
+
+impl From<PresetArg> for Preset {
+    fn from(arg: PresetArg) -> Preset {
+        match arg {
+            PresetArg::Seed => Preset::Seed,
+            PresetArg::Cpp => Preset::Cpp,
+        }
+    }
+}
+
+/// `--neighbors`' values.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum NeighborsArg {
+    /// Every particle against every particle, O(N²) per pass: the sources' loops.
+    AllPairs,
+    /// A uniform cell list with cell size H, rebuilt every step by counting sort: O(N).
+    Grid,
+}
+
+impl From<NeighborsArg> for NeighborMode {
+    fn from(arg: NeighborsArg) -> NeighborMode {
+        match arg {
+            NeighborsArg::AllPairs => NeighborMode::AllPairs,
+            NeighborsArg::Grid => NeighborMode::Grid,
+        }
+    }
+}
+
+/// `--color`'s values.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum ColorArg {
+    /// Speed `|v|`, px/s.
+    Speed,
+    /// Density ρ (as the solver defines it).
+    Density,
+}
+
+impl From<ColorArg> for ColorBy {
+    fn from(arg: ColorArg) -> ColorBy {
+        match arg {
+            ColorArg::Speed => ColorBy::Speed,
+            ColorArg::Density => ColorBy::Density,
+        }
+    }
+}
+
+/// Parses a [`Preset`] by its command-line name, listing the presets in `--help`.
+pub(super) fn preset() -> impl TypedValueParser<Value = Preset> {
+    EnumValueParser::<PresetArg>::new().map(Preset::from)
+}
+
+/// Parses a [`NeighborMode`] by its command-line name, listing the modes in `--help`.
+pub(super) fn neighbors() -> impl TypedValueParser<Value = NeighborMode> {
+    EnumValueParser::<NeighborsArg>::new().map(NeighborMode::from)
+}
+
+/// Parses a [`ColorBy`] by its command-line name, listing the quantities in `--help`.
+pub(super) fn color() -> impl TypedValueParser<Value = ColorBy> {
+    EnumValueParser::<ColorArg>::new().map(ColorBy::from)
+}
+
+/// Parses a [`StrategyName`] from the registry, listing [`StrategyName::ALL`] in `--help`; an
+/// unknown name is an error that lists the known ones.
+pub(super) fn strategy() -> StrategyParser {
+    StrategyParser
+}
+
+/// See [`strategy`].
+#[derive(Debug, Clone, Copy)]
+pub(super) struct StrategyParser;
+
+impl TypedValueParser for StrategyParser {
+    type Value = StrategyName;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&Arg>,
+        value: &OsStr,
+    ) -> Result<StrategyName, clap::Error> {
+        let parse = |s: &str| s.parse::<StrategyName>().map_err(|e| e.to_string());
+        parse.parse_ref(cmd, arg, value)
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        Some(Box::new(
+            StrategyName::ALL
+                .iter()
+                .map(|s| PossibleValue::new(s.as_str())),
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde::Serialize;
+
+    /// Each value of `A` as the command line names it, beside its domain value's name in the
+    /// CSVs and meta.json.
+    fn names<A: ValueEnum + Copy, D: From<A> + Serialize>() -> Vec<(String, String)> {
+        A::value_variants()
+            .iter()
+            .map(|&a| {
+                let cli = a.to_possible_value().unwrap().get_name().to_owned();
+                let domain = serde_json::to_value(D::from(a)).unwrap();
+                (cli, domain.as_str().unwrap().to_owned())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_command_line_value_maps_to_the_domain_value_of_the_same_name() {
+        let all = [
+            names::<PresetArg, Preset>(),
+            names::<NeighborsArg, NeighborMode>(),
+            names::<ColorArg, ColorBy>(),
+        ];
+        for (cli, domain) in all.iter().flatten() {
+            assert_eq!(cli, domain);
+        }
+    }
+
+    #[test]
+    fn every_domain_value_has_a_command_line_value() {
+        assert_eq!(PresetArg::value_variants().len(), Preset::ALL.len());
+        assert_eq!(
+            NeighborsArg::value_variants().len(),
+            NeighborMode::ALL.len()
+        );
+        assert_eq!(ColorArg::value_variants().len(), ColorBy::ALL.len());
+    }
+}
