@@ -90,15 +90,8 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     };
 
     let diverged = matches!(outcome, Err(RunError::Step(StepError::Diverged { .. })));
-    if let Some(mut out) = dump.take().filter(|_| outcome.is_ok() || diverged) {
-        let info = DumpInfo {
-            preset: args.scene.preset,
-            n,
-            step: sim.steps_done,
-        };
-        dump_csv::write(&sim.state, &info, &mut out)
-            .with_context(|| format!("cannot write dump file '{}'", out.path().display()))?;
-        out.commit()?;
+    if let Some(out) = dump.take().filter(|_| outcome.is_ok() || diverged) {
+        write_dump(out, &sim, args.scene.preset)?;
     }
     let elapsed = match outcome {
         Ok(e) => e,
@@ -129,6 +122,18 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         checksum: checksum_hex(&sim.state),
     };
     print_report(&report, args.json)
+}
+
+/// Writes the state of `sim` (of `preset`) to the dump file and renames it into place.
+fn write_dump(mut out: Sink, sim: &Simulation, preset: Preset) -> anyhow::Result<()> {
+    let info = DumpInfo {
+        preset,
+        n: sim.state.len(),
+        step: sim.steps_done,
+    };
+    dump_csv::write(&sim.state, &info, &mut out)
+        .with_context(|| format!("cannot write dump file '{}'", out.path().display()))?;
+    out.commit()
 }
 
 /// Prints a line on standard output; a closed or full stdout is an error, not a panic.

@@ -93,33 +93,8 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
         neighbors: args.scene.neighbors,
     }
     .check()?;
-    let owner = Owner {
-        command: TOOL,
-        option: "--out",
-        owns: &files::owns,
-        tolerates: &claim::nothing,
-    };
-    let claimed = claim::claim(&args.out, &owner, args.force)?;
-    let path = |name| claimed.check_writable(name);
-    let paths = [
-        path(files::TRACE_JSON)?,
-        path(files::TIMELINE_PNG)?,
-        path(files::STATS_CSV)?,
-        path(files::META_JSON)?,
-    ];
-
-    let info = args.parallel.strategy.info();
-    let config = TraceConfig {
-        strategy: info.name.to_owned(),
-        cores: info.effective_cores(cores),
-        chunks: info.effective_chunks(args.parallel.chunks),
-        n: state.len(),
-        steps: args.steps,
-        preset: args.scene.preset,
-        neighbors: args.scene.neighbors,
-        seed: args.scene.init.is_none().then_some(args.scene.seed),
-        init: args.scene.init.as_ref().map(|p| p.display().to_string()),
-    };
+    let (claimed, paths) = claim_out(args)?;
+    let config = trace_config(args, state.len(), cores);
     let fresh = || {
         Simulation::new(
             args.scene.preset.params(),
@@ -136,7 +111,6 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
     )?;
     let stats = stats::compute(&run.trace);
     let shown = args.timeline_steps.unwrap_or(3).min(args.steps);
-    let window = [args.steps + 1 - shown, args.steps];
     let meta = Meta {
         tool: TOOL,
         config: &config,
@@ -147,7 +121,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
         worker_threads: stats.total.worker_threads,
         workers_used: stats.total.workers_used,
         checksum: checksum_hex(&sim.state),
-        timeline_steps: window,
+        timeline_steps: [args.steps + 1 - shown, args.steps],
     };
     write_files(&paths, &run, &stats, &meta)?;
     let removed = claimed.remove_stale(&paths)?;
@@ -165,6 +139,42 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
         ));
     }
     print(&lines, &claimed)
+}
+
+/// Claims `--out` for the trace and checks that its four files may be written there.
+fn claim_out(args: &TraceArgs) -> anyhow::Result<(Claimed, [PathBuf; 4])> {
+    let owner = Owner {
+        command: TOOL,
+        option: "--out",
+        owns: &files::owns,
+        tolerates: &claim::nothing,
+    };
+    let claimed = claim::claim(&args.out, &owner, args.force)?;
+    let path = |name| claimed.check_writable(name);
+    let paths = [
+        path(files::TRACE_JSON)?,
+        path(files::TIMELINE_PNG)?,
+        path(files::STATS_CSV)?,
+        path(files::META_JSON)?,
+    ];
+    Ok((claimed, paths))
+}
+
+/// What the trace ran, as meta.json and the titles state it: the threads and chunks the
+/// strategy really uses, not those asked for.
+fn trace_config(args: &TraceArgs, n: usize, cores: usize) -> TraceConfig {
+    let info = args.parallel.strategy.info();
+    TraceConfig {
+        strategy: info.name.to_owned(),
+        cores: info.effective_cores(cores),
+        chunks: info.effective_chunks(args.parallel.chunks),
+        n,
+        steps: args.steps,
+        preset: args.scene.preset,
+        neighbors: args.scene.neighbors,
+        seed: args.scene.init.is_none().then_some(args.scene.seed),
+        init: args.scene.init.as_ref().map(|p| p.display().to_string()),
+    }
 }
 
 /// The traced run whose files are written, after `--compare`'s alternating untraced and
@@ -304,6 +314,23 @@ fn summary(config: &TraceConfig, warmup: usize, stats: &Stats, wall_s: f64) -> V
             w.idle_pct
         ));
     }
+    lines.extend(pass_lines(stats));
+    let t = &stats.total;
+    lines.push(format!(
+        "TASKS: {} kernel calls over {} steps; worker threads that ran them: {}; \
+         workers idle {:.1} % of the step loop",
+        t.kernel_calls, config.steps, t.worker_threads, t.idle_pct
+    ));
+    lines.extend(stats::idle_workers_note(
+        t.workers_used,
+        stats.workers.len(),
+    ));
+    lines
+}
+
+/// The per-pass table: calls per step, busy and span time, idle share and imbalance.
+fn pass_lines(stats: &Stats) -> Vec<String> {
+    let mut lines = Vec::new();
     lines.push(format!(
         "{:<12} {:>12} {:>10} {:>10} {:>7} {:>10}",
         "pass", "calls/step", "busy ms", "span ms", "idle %", "imbalance"
@@ -328,16 +355,6 @@ fn summary(config: &TraceConfig, warmup: usize, stats: &Stats, wall_s: f64) -> V
             imbalance
         ));
     }
-    let t = &stats.total;
-    lines.push(format!(
-        "TASKS: {} kernel calls over {} steps; worker threads that ran them: {}; \
-         workers idle {:.1} % of the step loop",
-        t.kernel_calls, config.steps, t.worker_threads, t.idle_pct
-    ));
-    lines.extend(stats::idle_workers_note(
-        t.workers_used,
-        stats.workers.len(),
-    ));
     lines
 }
 
