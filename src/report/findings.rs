@@ -11,23 +11,24 @@
 
 use super::numbers::{interval, percent, secs, times};
 use super::paper;
-use super::series::{self, Best, GroupKey};
+use super::series::{self, Best, Group};
 use crate::sweep::rows::SummaryRow;
+use sph_strategies::StrategyName;
 
 /// The sentences for group `g` of `rows`.
-pub fn findings(rows: &[SummaryRow], g: &GroupKey) -> Vec<String> {
-    let strategies: Vec<String> = series::strategies(rows, g)
+pub fn findings(rows: &[SummaryRow], g: &Group) -> Vec<String> {
+    let strategies: Vec<StrategyName> = series::strategies(rows, g)
         .into_iter()
-        .filter(|s| s != "seq")
+        .filter(|&s| s != StrategyName::Seq)
         .collect();
-    let bests: Vec<(String, Vec<Best>)> = strategies
+    let bests: Vec<(StrategyName, Vec<Best>)> = strategies
         .iter()
-        .map(|s| (s.clone(), series::best_per_cores(rows, g, s)))
+        .map(|&s| (s, series::best_per_cores(rows, g, s)))
         .collect();
     // A contended reference makes every speedup doubtful: none enters a finding then.
     let seq_trusted = !rows
         .iter()
-        .any(|r| g.contains(r) && r.strategy == "seq" && r.contended == Some(true));
+        .any(|r| r.group() == *g && r.is_reference() && r.contended == Some(true));
     let mut out = Vec::new();
     if !seq_trusted {
         out.push(
@@ -168,9 +169,12 @@ fn one_core_noise(at: &[(&str, &Best)]) -> Vec<String> {
 }
 
 /// Where more chunks stop paying, per chunked strategy.
-fn chunking(rows: &[SummaryRow], g: &GroupKey, strategies: &[String]) -> Vec<String> {
+fn chunking(rows: &[SummaryRow], g: &Group, strategies: &[StrategyName]) -> Vec<String> {
     let mut out = Vec::new();
-    for s in strategies.iter().filter(|s| series::is_chunked(rows, g, s)) {
+    for &s in strategies
+        .iter()
+        .filter(|&&s| series::is_chunked(rows, g, s))
+    {
         let parts: Vec<String> = series::chunk_table(rows, g, s)
             .iter()
             .filter(|(_, v)| v.len() > 1)
@@ -192,7 +196,7 @@ fn chunking(rows: &[SummaryRow], g: &GroupKey, strategies: &[String]) -> Vec<Str
 
 /// The serial fraction of the fastest trusted cell at the most cores not oversubscribed,
 /// where it means something.
-fn karp_flatt(bests: &[(String, Vec<Best>)]) -> Option<String> {
+fn karp_flatt(bests: &[(StrategyName, Vec<Best>)]) -> Option<String> {
     let (s, b) = bests
         .iter()
         .flat_map(|(s, b)| b.iter().map(move |b| (s.as_str(), b)))
@@ -217,10 +221,10 @@ fn karp_flatt(bests: &[(String, Vec<Best>)]) -> Option<String> {
 /// The paper's published speedups beside ours, where comparable.
 fn against_paper(
     rows: &[SummaryRow],
-    g: &GroupKey,
-    bests: &[(String, Vec<Best>)],
+    g: &Group,
+    bests: &[(StrategyName, Vec<Best>)],
 ) -> Option<String> {
-    if !paper::comparable(&g.preset, &g.neighbors) {
+    if !paper::comparable(g) {
         return None;
     }
     let mut parts = Vec::new();
@@ -268,11 +272,11 @@ mod tests {
     #[test]
     fn overlapping_intervals_name_no_winner() {
         let rows = vec![
-            row("seq", 1, None, 4.0),
-            with_ci(row("rayon-chunks", 2, Some(10), 2.2), 2.0, 2.4),
-            with_ci(row("rayon-iter", 2, None, 2.3), 2.1, 2.5),
+            row(StrategyName::Seq, 1, None, 4.0),
+            with_ci(row(StrategyName::RayonChunks, 2, Some(10), 2.2), 2.0, 2.4),
+            with_ci(row(StrategyName::RayonIter, 2, None, 2.3), 2.1, 2.5),
         ];
-        let f = findings(&rows, &series::GroupKey::of(&rows[0]));
+        let f = findings(&rows, &rows[0].group());
         assert!(
             f[0].contains("indistinguishable within the trial spread") && !f[0].contains("fastest"),
             "{}",
@@ -283,11 +287,11 @@ mod tests {
     #[test]
     fn separate_intervals_name_the_fastest_with_its_margin() {
         let rows = vec![
-            row("seq", 1, None, 4.0),
-            with_ci(row("rayon-chunks", 2, Some(10), 2.2), 2.1, 2.3),
-            with_ci(row("rayon-iter", 2, None, 2.6), 2.5, 2.7),
+            row(StrategyName::Seq, 1, None, 4.0),
+            with_ci(row(StrategyName::RayonChunks, 2, Some(10), 2.2), 2.1, 2.3),
+            with_ci(row(StrategyName::RayonIter, 2, None, 2.6), 2.5, 2.7),
         ];
-        let f = findings(&rows, &series::GroupKey::of(&rows[0]));
+        let f = findings(&rows, &rows[0].group());
         assert!(
             f[0].starts_with(
                 "At 2 cores, **rayon-chunks with 10 chunks (2.20 s [2.10–2.30])** is fastest"
@@ -300,14 +304,14 @@ mod tests {
 
     #[test]
     fn contended_cells_enter_no_finding() {
-        let mut fast = with_ci(row("rayon-iter", 2, None, 1.0), 0.9, 1.1);
+        let mut fast = with_ci(row(StrategyName::RayonIter, 2, None, 1.0), 0.9, 1.1);
         fast.contended = Some(true);
         let rows = vec![
-            row("seq", 1, None, 4.0),
-            with_ci(row("rayon-chunks", 2, Some(10), 2.2), 2.1, 2.3),
+            row(StrategyName::Seq, 1, None, 4.0),
+            with_ci(row(StrategyName::RayonChunks, 2, Some(10), 2.2), 2.1, 2.3),
             fast,
         ];
-        let f = findings(&rows, &series::GroupKey::of(&rows[0]));
+        let f = findings(&rows, &rows[0].group());
         assert!(
             f[0].contains("only rayon-chunks") && f[0].contains("1 contended cell left out"),
             "{}",
@@ -318,11 +322,11 @@ mod tests {
     #[test]
     fn a_one_core_speedup_above_one_is_called_noise_and_karp_flatt_never_extrapolates() {
         let rows = vec![
-            row("seq", 1, None, 4.0),
-            row("rayon-chunks", 1, Some(10), 3.9),
-            row("rayon-chunks", 2, Some(10), 2.2),
+            row(StrategyName::Seq, 1, None, 4.0),
+            row(StrategyName::RayonChunks, 1, Some(10), 3.9),
+            row(StrategyName::RayonChunks, 2, Some(10), 2.2),
         ];
-        let f = findings(&rows, &series::GroupKey::of(&rows[0])).join("\n");
+        let f = findings(&rows, &rows[0].group()).join("\n");
         assert!(f.contains("at 1 core is noise in the seq reference"), "{f}");
         assert!(f.contains("e = 0.100"), "{f}");
         assert!(!f.contains("no number of cores"), "{f}");
@@ -330,10 +334,10 @@ mod tests {
 
     #[test]
     fn a_contended_reference_gives_no_speedup_finding() {
-        let mut seq = row("seq", 1, None, 4.0);
+        let mut seq = row(StrategyName::Seq, 1, None, 4.0);
         seq.contended = Some(true);
-        let rows = vec![seq, row("rayon-chunks", 2, Some(10), 2.2)];
-        let f = findings(&rows, &series::GroupKey::of(&rows[0])).join("\n");
+        let rows = vec![seq, row(StrategyName::RayonChunks, 2, Some(10), 2.2)];
+        let f = findings(&rows, &rows[0].group()).join("\n");
         assert!(f.contains("The seq reference was contended"), "{f}");
         assert!(!f.contains("Karp–Flatt") && !f.contains("over seq"), "{f}");
         assert!(!f.contains("paper's"), "{f}");
@@ -341,8 +345,11 @@ mod tests {
 
     #[test]
     fn no_karp_flatt_without_a_speedup_above_one() {
-        let rows = vec![row("seq", 1, None, 4.0), row("rayon-iter", 2, None, 5.0)];
-        let f = findings(&rows, &series::GroupKey::of(&rows[0])).join("\n");
+        let rows = vec![
+            row(StrategyName::Seq, 1, None, 4.0),
+            row(StrategyName::RayonIter, 2, None, 5.0),
+        ];
+        let f = findings(&rows, &rows[0].group()).join("\n");
         assert!(!f.contains("Karp–Flatt"), "{f}");
     }
 }

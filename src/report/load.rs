@@ -22,7 +22,7 @@ use crate::sweep::export::{
     LEGACY_SUMMARY_COLUMNS, LEGACY_TRIAL_COLUMNS, SUMMARY_COLUMNS, TRIAL_COLUMNS,
 };
 use crate::sweep::meta::Meta;
-use crate::sweep::plan::CellKey;
+use crate::sweep::plan::Cell;
 use crate::sweep::rows::{SummaryRow, TrialRow};
 use crate::sweep::validate;
 use crate::sweep::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
@@ -60,14 +60,14 @@ pub fn load_all(dirs: &[PathBuf]) -> anyhow::Result<Vec<Sweep>> {
         .iter()
         .map(|d| load(d))
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let mut owner: HashMap<CellKey, &Path> = HashMap::new();
+    let mut owner: HashMap<Cell, &Path> = HashMap::new();
     for s in &sweeps {
         for r in &s.rows {
             if let Some(first) = owner.insert(r.key(), &s.dir) {
                 bail!(
                     "the cell {} is in both '{}' and '{}': report them separately, or remove \
                      it from one (a cell must count once)",
-                    r.key().label(),
+                    r.key().label_with_group(),
                     first.display(),
                     s.dir.display()
                 );
@@ -100,7 +100,7 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
     } else {
         None
     };
-    let mut by_cell: HashMap<CellKey, Vec<TrialRow>> = HashMap::new();
+    let mut by_cell: HashMap<Cell, Vec<TrialRow>> = HashMap::new();
     for t in trials.iter().flatten() {
         by_cell.entry(t.key()).or_default().push(t.clone());
     }
@@ -118,7 +118,7 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
         };
         match checked {
             Ok(()) => rows.push(row),
-            Err(why) => dropped.push(format!("{}: {why}", row.key().label())),
+            Err(why) => dropped.push(format!("{}: {why}", row.key().label_with_group())),
         }
     }
     if rows.is_empty() {

@@ -6,15 +6,17 @@ use std::fmt::Write as _;
 use super::load::Sweep;
 use super::numbers::{interval, sig};
 use super::paper;
-use super::series::{self, Best, GroupKey};
+use super::series::{self, Best, Group};
 use super::traces::TraceDir;
+use crate::sweep::plan::LabelStyle;
 use crate::sweep::rows::{Status, SummaryRow};
+use sph_strategies::StrategyName;
 
 /// A chart as the report embeds it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChartRef {
     /// The group it belongs to (`None` for charts across groups).
-    pub group: Option<GroupKey>,
+    pub group: Option<Group>,
     /// File name, relative to the report.
     pub file: String,
     /// One-sentence caption.
@@ -25,7 +27,7 @@ pub struct ChartRef {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Skipped {
     /// The group (`None` for charts across groups).
-    pub group: Option<GroupKey>,
+    pub group: Option<Group>,
     /// E.g. `Chart 6 (all-pairs vs grid)`, and why it is not drawn.
     pub note: String,
 }
@@ -107,11 +109,12 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
         if s.meta.status == SweepStatus::Complete && measured >= s.meta.planned_cells {
             continue;
         }
-        let mut planned: Vec<&str> = vec!["seq"];
-        planned.extend(s.meta.params.strategies.iter().map(|x| x.as_str()));
+        let mut planned = vec![StrategyName::Seq];
+        planned.extend(&s.meta.params.strategies);
         let never: Vec<&str> = planned
             .into_iter()
-            .filter(|p| !s.rows.iter().any(|r| r.strategy == *p))
+            .filter(|&p| !s.rows.iter().any(|r| r.strategy == p))
+            .map(StrategyName::as_str)
             .collect();
         let _ = writeln!(
             md,
@@ -244,16 +247,16 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
     md.push('\n');
 }
 
-fn charts_of<'a>(input: &'a Input<'_>, g: Option<&GroupKey>) -> impl Iterator<Item = &'a ChartRef> {
+fn charts_of<'a>(input: &'a Input<'_>, g: Option<&Group>) -> impl Iterator<Item = &'a ChartRef> {
     let g = g.cloned();
     input.charts.iter().filter(move |c| c.group == g)
 }
 
-fn group(md: &mut String, rows: &[SummaryRow], g: &GroupKey, input: &Input<'_>) {
-    let _ = writeln!(md, "## {}\n", g.label());
+fn group(md: &mut String, rows: &[SummaryRow], g: &Group, input: &Input<'_>) {
+    let _ = writeln!(md, "## {}\n", g.label(LabelStyle::Report));
     if let Some(r) = rows
         .iter()
-        .find(|r| g.contains(r) && r.strategy == "seq" && series::usable(r))
+        .find(|r| r.group() == *g && r.is_reference() && r.is_usable())
     {
         let _ = writeln!(
             md,
@@ -274,7 +277,7 @@ fn group(md: &mut String, rows: &[SummaryRow], g: &GroupKey, input: &Input<'_>) 
             "No usable `seq` reference cell: speedups are undefined.\n"
         );
     }
-    let comparable = paper::comparable(&g.preset, &g.neighbors);
+    let comparable = paper::comparable(g);
     if comparable {
         let _ = writeln!(
             md,
@@ -296,7 +299,10 @@ fn group(md: &mut String, rows: &[SummaryRow], g: &GroupKey, input: &Input<'_>) 
         );
     }
     let _ = writeln!(md, "### Best cell per core count (Table 1 analogue)\n");
-    for s in series::strategies(rows, g).iter().filter(|s| *s != "seq") {
+    for s in series::strategies(rows, g)
+        .into_iter()
+        .filter(|&s| s != StrategyName::Seq)
+    {
         let best = series::best_per_cores(rows, g, s);
         if best.is_empty() {
             let _ = writeln!(md, "**{s}**: no successful cell.\n");
@@ -330,7 +336,7 @@ fn group(md: &mut String, rows: &[SummaryRow], g: &GroupKey, input: &Input<'_>) 
     }
 }
 
-fn table(md: &mut String, strategy: &str, best: &[Best], with_paper: bool) {
+fn table(md: &mut String, strategy: StrategyName, best: &[Best], with_paper: bool) {
     let _ = writeln!(md, "**{strategy}**\n");
     if with_paper {
         let _ = writeln!(
@@ -444,7 +450,7 @@ fn failed(md: &mut String, rows: &[SummaryRow]) {
         let _ = writeln!(
             md,
             "| {} | {} | {} | {} | {} |",
-            GroupKey::of(r).label(),
+            r.group().label(LabelStyle::Report),
             r.strategy,
             r.cores,
             r.chunks.map_or_else(|| "—".to_owned(), |k| k.to_string()),
@@ -462,12 +468,12 @@ mod tests {
     #[test]
     fn an_oversubscribed_best_cell_is_flagged_in_the_table() {
         let best = series::best_per_cores(
-            &[row("rayon-iter", 3, None, 2.0)],
-            &GroupKey::of(&row("seq", 1, None, 1.0)),
-            "rayon-iter",
+            &[row(StrategyName::RayonIter, 3, None, 2.0)],
+            &row(StrategyName::Seq, 1, None, 1.0).group(),
+            StrategyName::RayonIter,
         );
         let mut md = String::new();
-        table(&mut md, "rayon-iter", &best, false);
+        table(&mut md, StrategyName::RayonIter, &best, false);
         assert!(
             md.contains(
                 "| 3 ⚠ oversubscribed | — | 2.00 [1.96–2.04] | 2.00× [1.90–2.10] | 0.667 |"

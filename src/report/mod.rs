@@ -36,7 +36,8 @@ use std::path::{Path, PathBuf};
 use anyhow::bail;
 
 use markdown::{ChartRef, Skipped};
-use series::{GroupKey, Metric};
+use series::{Group, Metric};
+use sph_strategies::StrategyName;
 
 /// The report's file name.
 pub const REPORT_FILE: &str = "REPORT.md";
@@ -128,7 +129,7 @@ pub fn generate(
     let mut written = Vec::new();
     let mut refs = Vec::new();
     let mut skipped = Vec::new();
-    let mut chart = |file: String, group: Option<&GroupKey>, caption: String| {
+    let mut chart = |file: String, group: Option<&Group>, caption: String| {
         refs.push(ChartRef {
             group: group.cloned(),
             file: file.clone(),
@@ -138,15 +139,16 @@ pub fn generate(
     };
 
     for g in series::groups(&rows) {
-        let subtitle = g.label();
+        let subtitle = g.label(crate::sweep::plan::LabelStyle::Report);
         let skip = |note: String| Skipped {
-            group: Some(g.clone()),
+            group: Some(g),
             note,
         };
         let strategies = series::strategies(&rows, &g);
-        let chunked: Vec<&String> = strategies
+        let chunked: Vec<StrategyName> = strategies
             .iter()
-            .filter(|s| series::is_chunked(&rows, &g, s))
+            .copied()
+            .filter(|&s| series::is_chunked(&rows, &g, s))
             .collect();
         if chunked.is_empty() {
             skipped.push(skip(
@@ -201,19 +203,23 @@ pub fn generate(
         let seq = series::seq_mean(&rows, &g);
         match seq {
             Some(seq_s) if cores.len() > 1 => {
-                let comparable = paper::comparable(&g.preset, &g.neighbors);
-                for s in strategies.iter().filter(|s| *s != "seq") {
+                let comparable = paper::comparable(&g);
+                for s in strategies
+                    .iter()
+                    .copied()
+                    .filter(|&s| s != StrategyName::Seq)
+                {
                     let best = series::best_per_cores(&rows, &g, s);
                     if best.len() < 2 {
                         continue;
                     }
                     let speedup = series::speedup_lines(&rows, &g)
                         .into_iter()
-                        .find(|l| &l.label == s);
+                        .find(|l| l.label == s.as_str());
                     let Some(speedup) = speedup else { continue };
                     let data = charts::best::BestChart {
-                        strategy: s,
-                        runtime: series::runtime_line(&best, s),
+                        strategy: s.as_str(),
+                        runtime: series::runtime_line(&best, s.as_str()),
                         speedup,
                         seq_s,
                         paper: comparable,
@@ -290,7 +296,7 @@ pub fn generate(
     }
 
     for preset in series::presets(&rows) {
-        match series::neighbor_lines(&rows, &preset) {
+        match series::neighbor_lines(&rows, preset) {
             Some(lines) if !lines.is_empty() => {
                 let path = chart(
                     format!("{preset}-6-neighbors.png"),

@@ -43,7 +43,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use lock::DirLock;
 use meta::{Machine, Meta, Session, SweepStatus};
 use params::SweepParams;
-use plan::{CellKey, Group, Plan};
+use plan::{Cell, Group, LabelStyle, Plan};
 use range::{Axis, compact};
 use rows::{Status, SummaryRow, TrialRow};
 use runner::{Reference, Runner};
@@ -139,9 +139,9 @@ pub fn run(request: Request) -> anyhow::Result<()> {
         hz: crate::contention::ticks_per_second(),
     };
 
-    let done: HashSet<CellKey> = finished.iter().map(SummaryRow::key).collect();
+    let done: HashSet<Cell> = finished.iter().map(SummaryRow::key).collect();
     let todo: Vec<usize> = (0..plan.cells.len())
-        .filter(|&i| !done.contains(&plan.cells[i].key()))
+        .filter(|&i| !done.contains(&plan.cells[i]))
         .collect();
     let mut references = finished_references(&plan, &finished, &finished_trials);
 
@@ -275,9 +275,9 @@ fn finished_references(
 ) -> HashMap<Group, Reference> {
     finished
         .iter()
-        .filter(|r| r.strategy == sph_strategies::StrategyName::Seq.as_str())
+        .filter(|r| r.key().is_reference())
         .filter_map(|r| {
-            let cell = plan.cells.iter().find(|c| c.key() == r.key())?;
+            let cell = plan.cells.iter().find(|&&c| c == r.key())?;
             let walls = trials
                 .iter()
                 .filter(|t| t.key() == r.key())
@@ -302,7 +302,7 @@ fn check_memory(plan: &Plan) -> anyhow::Result<()> {
             g.n,
             available.map(|a| a.saturating_sub(copy)),
         )
-        .with_context(|| format!("the group {} cannot run here", g.label()))?;
+        .with_context(|| format!("the group {} cannot run here", g.label(LabelStyle::Sweep)))?;
     }
     Ok(())
 }
@@ -367,7 +367,7 @@ fn estimate(
         text.push_str(&format!(
             "  seq ≈ {} per run: {}\n",
             console::duration(seq_run_s[g]),
-            g.label()
+            g.label(LabelStyle::Sweep)
         ));
     }
     text.push_str(&format!(
@@ -458,7 +458,7 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
     })?;
     let plan = Plan::new(&meta.params);
     check_memory(&plan)?;
-    let planned: HashSet<CellKey> = plan.cells.iter().map(|c| c.key()).collect();
+    let planned: HashSet<Cell> = plan.cells.iter().copied().collect();
     let trials = meta.params.trials;
     let check = |row: &SummaryRow| -> Result<(), String> {
         if !planned.contains(&row.key()) {
@@ -534,7 +534,7 @@ fn print_plan(
 ) {
     let mut text = format!("bench-sph sweep → {}\n", dir.display());
     for group in &plan.groups {
-        text.push_str(&format!("  group: {}\n", group.label()));
+        text.push_str(&format!("  group: {}\n", group.label(LabelStyle::Sweep)));
     }
     let names: Vec<&str> = params.strategies.iter().map(|s| s.as_str()).collect();
     text.push_str(&format!(

@@ -133,12 +133,39 @@ pub fn by_name<T: Named>(name: &str) -> Option<T> {
     T::all().iter().copied().find(|v| v.name() == name)
 }
 
-/// Serde for a list of [`Named`] values as a list of their names.
-mod names {
-    use serde::de::Error;
+/// Looks `name` up among `T::all()`, or a serde error that lists the known names.
+fn lookup<T: Named, E: serde::de::Error>(name: &str) -> Result<T, E> {
+    by_name(name).ok_or_else(|| {
+        let known: Vec<&str> = T::all().iter().map(|v| v.name()).collect();
+        E::custom(format!(
+            "unknown name '{name}' (known: {})",
+            known.join(", ")
+        ))
+    })
+}
+
+/// Serde for one [`Named`] value as its name (the key columns of the results CSVs).
+pub mod name {
     use serde::{Deserialize, Deserializer, Serializer};
 
-    use super::{Named, by_name};
+    use super::{Named, lookup};
+
+    /// Writes the value's name.
+    pub fn serialize<T: Named, S: Serializer>(value: &T, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(value.name())
+    }
+
+    /// Reads a name; an unknown one is an error.
+    pub fn deserialize<'de, T: Named, D: Deserializer<'de>>(d: D) -> Result<T, D::Error> {
+        lookup(&String::deserialize(d)?)
+    }
+}
+
+/// Serde for a list of [`Named`] values as a list of their names.
+mod names {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    use super::{Named, lookup};
 
     pub fn serialize<T: Named, S: Serializer>(values: &[T], s: S) -> Result<S::Ok, S::Error> {
         s.collect_seq(values.iter().map(|v| v.name()))
@@ -147,15 +174,7 @@ mod names {
     pub fn deserialize<'de, T: Named, D: Deserializer<'de>>(d: D) -> Result<Vec<T>, D::Error> {
         Vec::<String>::deserialize(d)?
             .iter()
-            .map(|name| {
-                by_name(name).ok_or_else(|| {
-                    let known: Vec<&str> = T::all().iter().map(|v| v.name()).collect();
-                    D::Error::custom(format!(
-                        "unknown name '{name}' (known: {})",
-                        known.join(", ")
-                    ))
-                })
-            })
+            .map(|name| lookup(name))
             .collect()
     }
 }

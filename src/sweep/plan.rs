@@ -26,21 +26,43 @@ pub struct Group {
     pub steps: usize,
 }
 
+/// How a group is named in text: the sweep's console and the report word it differently, and
+/// each keeps its wording (both are compared byte for byte by users' scripts and the tests).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LabelStyle {
+    /// As the sweep prints it: `preset seed, all-pairs, N = 1000, 1000 steps`.
+    Sweep,
+    /// As the report prints it: `seed preset, all-pairs, N = 1000, 1000 steps`.
+    Report,
+}
+
 impl Group {
-    /// E.g. `preset seed, all-pairs, N = 1000, 1000 steps`.
-    pub fn label(&self) -> String {
+    /// The group in words, worded as `style` says (see [`LabelStyle`]).
+    pub fn label(&self, style: LabelStyle) -> String {
+        let preset = match style {
+            LabelStyle::Sweep => format!("preset {}", self.preset),
+            LabelStyle::Report => format!("{} preset", self.preset),
+        };
         format!(
-            "preset {}, {}, N = {}, {}",
-            self.preset,
+            "{preset}, {}, N = {}, {}",
             self.neighbors,
             self.n,
             super::console::plural(self.steps, "step", "steps")
         )
     }
+
+    /// A file-name part, e.g. `seed-all-pairs-n1000-s1000`.
+    pub fn slug(&self) -> String {
+        format!(
+            "{}-{}-n{}-s{}",
+            self.preset, self.neighbors, self.n, self.steps
+        )
+    }
 }
 
-/// One configuration to measure.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+/// One configuration to measure, and the key of its rows in the results CSVs: what
+/// `--resume` and the report match on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Cell {
     /// The group it belongs to.
     pub group: Group,
@@ -50,45 +72,6 @@ pub struct Cell {
     pub cores: usize,
     /// Requested chunks per pass; `None` for strategies without a chunks parameter.
     pub chunks: Option<usize>,
-}
-
-/// A cell as written in the CSVs' key columns: what `--resume` matches on.
-#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct CellKey {
-    /// Strategy name.
-    pub strategy: String,
-    /// Neighbour search name.
-    pub neighbors: String,
-    /// Preset name.
-    pub preset: String,
-    /// Particles.
-    pub n: usize,
-    /// Steps per run.
-    pub steps: usize,
-    /// Worker threads.
-    pub cores: usize,
-    /// Requested chunks, if the strategy uses them.
-    pub chunks: Option<usize>,
-}
-
-impl CellKey {
-    /// E.g. `rayon-chunks, 2 cores, 10 chunks (preset seed, all-pairs, N = 1000, 300 steps)`.
-    pub fn label(&self) -> String {
-        let cores = if self.cores == 1 { "core" } else { "cores" };
-        let chunks = self
-            .chunks
-            .map(|k| format!(", {k} chunks"))
-            .unwrap_or_default();
-        format!(
-            "{}, {} {cores}{chunks} (preset {}, {}, N = {}, {})",
-            self.strategy,
-            self.cores,
-            self.preset,
-            self.neighbors,
-            self.n,
-            super::console::plural(self.steps, "step", "steps")
-        )
-    }
 }
 
 impl Cell {
@@ -116,19 +99,6 @@ impl Cell {
         self.cores > hardware_threads
     }
 
-    /// The CSV key of the cell.
-    pub fn key(&self) -> CellKey {
-        CellKey {
-            strategy: self.strategy.as_str().to_owned(),
-            neighbors: self.group.neighbors.as_str().to_owned(),
-            preset: self.group.preset.as_str().to_owned(),
-            n: self.group.n,
-            steps: self.group.steps,
-            cores: self.cores,
-            chunks: self.chunks,
-        }
-    }
-
     /// The text that seeds the cell's bootstrap streams ([`super::bootstrap::rng_for`]): frozen,
     /// so that a display change never changes a results file (`rayon-chunks, 2 cores, 10
     /// chunks`, `seq, 1 core`).
@@ -144,6 +114,12 @@ impl Cell {
     /// [`stream_key`](Self::stream_key); a display change goes here, never there.
     pub fn label(&self) -> String {
         self.stream_key()
+    }
+
+    /// The cell and its group, e.g. `rayon-chunks, 2 cores, 10 chunks (preset seed,
+    /// all-pairs, N = 1000, 300 steps)`: how warnings name a cell.
+    pub fn label_with_group(&self) -> String {
+        format!("{} ({})", self.label(), self.group.label(LabelStyle::Sweep))
     }
 }
 

@@ -18,7 +18,7 @@ use std::path::Path;
 use anyhow::Context;
 
 use super::export::{SUMMARY_COLUMNS, TRIAL_COLUMNS, to_csv};
-use super::plan::CellKey;
+use super::plan::Cell;
 use super::rows::{SummaryRow, TrialRow};
 
 /// A results file whose header is not this version's.
@@ -77,7 +77,7 @@ pub fn repair(
             dropped_summary_rows += 1;
         }
     }
-    let mut by_cell: HashMap<CellKey, Vec<TrialRow>> = HashMap::new();
+    let mut by_cell: HashMap<Cell, Vec<TrialRow>> = HashMap::new();
     for row in trial_rows {
         let rows = by_cell.entry(row.key()).or_default();
         if rows.iter().any(|r| r.trial == row.trial) {
@@ -102,7 +102,7 @@ pub fn repair(
             Ok(())
         };
         if let Err(why) = &believed {
-            rejected.push(format!("{}: {why}", row.key().label()));
+            rejected.push(format!("{}: {why}", row.key().label_with_group()));
         }
         if complete && believed.is_ok() {
             kept.extend(trials);

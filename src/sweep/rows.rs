@@ -15,10 +15,13 @@
 use serde::{Deserialize, Serialize};
 
 use super::bootstrap::{self, Interval};
-use super::plan::{Cell, CellKey};
+use super::plan::{Cell, Group};
 use super::stats::{Stats, mean};
 use crate::clock::Elapsed;
 use crate::contention::Threshold;
+use crate::sph::neighbors::NeighborMode;
+use crate::sph::params::Preset;
+use sph_strategies::StrategyName;
 
 /// Whether a cell's numbers can be used.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -44,12 +47,15 @@ pub struct Measured {
 /// One row of `trials.csv`: one timed run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrialRow {
-    /// Strategy name.
-    pub strategy: String,
+    /// Strategy.
+    #[serde(with = "super::params::name")]
+    pub strategy: StrategyName,
     /// Neighbour search.
-    pub neighbors: String,
+    #[serde(with = "super::params::name")]
+    pub neighbors: NeighborMode,
     /// Preset.
-    pub preset: String,
+    #[serde(with = "super::params::name")]
+    pub preset: Preset,
     /// Particles.
     pub n: usize,
     /// Steps.
@@ -83,15 +89,19 @@ pub struct TrialRow {
     pub load1: Option<f64>,
 }
 
-/// One row of `summary.csv`: one cell.
+/// One row of `summary.csv`: one cell. Its first columns repeat [`TrialRow`]'s cell key on
+/// purpose: the csv crate cannot write a nested (`flatten`ed) key struct as flat columns.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SummaryRow {
-    /// Strategy name.
-    pub strategy: String,
+    /// Strategy.
+    #[serde(with = "super::params::name")]
+    pub strategy: StrategyName,
     /// Neighbour search.
-    pub neighbors: String,
+    #[serde(with = "super::params::name")]
+    pub neighbors: NeighborMode,
     /// Preset.
-    pub preset: String,
+    #[serde(with = "super::params::name")]
+    pub preset: Preset,
     /// Particles.
     pub n: usize,
     /// Steps.
@@ -150,50 +160,95 @@ pub struct SummaryRow {
     pub contended: Option<bool>,
 }
 
-impl TrialRow {
-    /// The row's cell.
-    pub fn key(&self) -> CellKey {
-        CellKey {
-            strategy: self.strategy.clone(),
-            neighbors: self.neighbors.clone(),
-            preset: self.preset.clone(),
-            n: self.n,
-            steps: self.steps,
-            cores: self.cores,
-            chunks: self.chunks,
+/// The columns that name a row's cell, shared by both files.
+macro_rules! keyed {
+    ($row:ty) => {
+        impl $row {
+            /// The row's group.
+            pub fn group(&self) -> Group {
+                Group {
+                    preset: self.preset,
+                    neighbors: self.neighbors,
+                    n: self.n,
+                    steps: self.steps,
+                }
+            }
+
+            /// The row's cell.
+            pub fn key(&self) -> Cell {
+                Cell {
+                    group: self.group(),
+                    strategy: self.strategy,
+                    cores: self.cores,
+                    chunks: self.chunks,
+                }
+            }
         }
+    };
+}
+keyed!(TrialRow);
+keyed!(SummaryRow);
+
+impl TrialRow {
+    /// Whether the row is a trial of its group's `seq` reference cell.
+    pub fn is_reference(&self) -> bool {
+        self.key().is_reference()
     }
 }
 
 impl SummaryRow {
-    /// The row's cell.
-    pub fn key(&self) -> CellKey {
-        CellKey {
-            strategy: self.strategy.clone(),
-            neighbors: self.neighbors.clone(),
-            preset: self.preset.clone(),
-            n: self.n,
-            steps: self.steps,
-            cores: self.cores,
-            chunks: self.chunks,
-        }
+    /// Whether the row is its group's `seq` reference cell.
+    pub fn is_reference(&self) -> bool {
+        self.key().is_reference()
     }
+
+    /// Whether the row's numbers may be used: status ok, with a mean.
+    pub fn is_usable(&self) -> bool {
+        self.status == Status::Ok && self.mean_s.is_some()
+    }
+}
+
+/// How [`fastest`] treats cells that other work disturbed (`contended = true`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Contended {
+    /// They compete like any other cell (the sweep's end-of-run table, which shows what was
+    /// measured).
+    Compete,
+    /// Only when every candidate is contended (the report, whose findings trust no
+    /// contended cell).
+    LastResort,
+}
+
+/// The one "best cell" rule: the usable row of `rows` with the lowest mean (the first of
+/// equals), contended rows treated as `contended` says.
+pub fn fastest<'a>(
+    rows: impl IntoIterator<Item = &'a SummaryRow>,
+    contended: Contended,
+) -> Option<&'a SummaryRow> {
+    let disturbed =
+        |r: &SummaryRow| contended == Contended::LastResort && r.contended == Some(true);
+    rows.into_iter().filter(|r| r.is_usable()).min_by(|a, b| {
+        disturbed(a).cmp(&disturbed(b)).then(
+            a.mean_s
+                .unwrap_or(f64::INFINITY)
+                .total_cmp(&b.mean_s.unwrap_or(f64::INFINITY)),
+        )
+    })
 }
 
 /// The trial rows of a cell: one per measured run, all with the cell's status and reason.
 pub fn trial_rows(cell: &Cell, measured: &[Measured], failure: Option<&str>) -> Vec<TrialRow> {
-    let key = cell.key();
     measured
         .iter()
         .enumerate()
         .map(|(i, m)| TrialRow {
-            strategy: key.strategy.clone(),
-            neighbors: key.neighbors.clone(),
-            preset: key.preset.clone(),
-            n: key.n,
-            steps: key.steps,
-            cores: key.cores,
-            chunks: key.chunks,
+            strategy: cell.strategy,
+            neighbors: cell.group.neighbors,
+            preset: cell.group.preset,
+            n: cell.group.n,
+            steps: cell.group.steps,
+            cores: cell.cores,
+            chunks: cell.chunks,
             particles_per_chunk: cell.particles_per_chunk(),
             trial: i + 1,
             wall_s: m.elapsed.wall_s,
@@ -232,7 +287,6 @@ pub fn summary_row(
     failure: Option<&str>,
     ctx: &CellContext<'_>,
 ) -> SummaryRow {
-    let key = cell.key();
     let walls: Vec<f64> = measured.iter().map(|m| m.elapsed.wall_s).collect();
     let cpus: Vec<f64> = measured.iter().map(|m| m.elapsed.cpu_s).collect();
     let stats = Stats::of(&walls).filter(|_| failure.is_none());
@@ -256,13 +310,13 @@ pub fn summary_row(
         .collect();
     let foreign = foreign.filter(|f| !f.is_empty());
     SummaryRow {
-        strategy: key.strategy,
-        neighbors: key.neighbors,
-        preset: key.preset,
-        n: key.n,
-        steps: key.steps,
-        cores: key.cores,
-        chunks: key.chunks,
+        strategy: cell.strategy,
+        neighbors: cell.group.neighbors,
+        preset: cell.group.preset,
+        n: cell.group.n,
+        steps: cell.group.steps,
+        cores: cell.cores,
+        chunks: cell.chunks,
         particles_per_chunk: cell.particles_per_chunk(),
         trials: measured.len(),
         mean_s: stats.map(|s| s.mean),
@@ -321,10 +375,6 @@ fn status_of(failure: Option<&str>) -> Status {
 mod tests {
     use super::*;
     use crate::contention::Foreign;
-    use crate::sph::neighbors::NeighborMode;
-    use crate::sph::params::Preset;
-    use crate::sweep::plan::Group;
-    use sph_strategies::StrategyName;
 
     fn cell(strategy: StrategyName, cores: usize, chunks: Option<usize>) -> Cell {
         Cell {
@@ -461,7 +511,7 @@ mod tests {
             (rows[0].trial, rows[0].wall_s, rows[0].cpu_s),
             (1, 0.5, 1.0)
         );
-        assert_eq!(rows[1].key(), c.key());
+        assert_eq!(rows[1].key(), c);
         assert_eq!(rows[1].particles_per_chunk, Some(12));
         assert_eq!(rows[0].status, Status::Ok);
     }

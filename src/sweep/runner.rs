@@ -373,7 +373,7 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
             }
             let mut text = String::new();
             if self.plan.groups.len() > 1 && shown_group != Some(cell.group) {
-                text = format!("{}:\n", cell.group.label());
+                text = format!("{}:\n", cell.group.label(super::plan::LabelStyle::Sweep));
                 shown_group = Some(cell.group);
             }
             text.push_str(&console::cell_line(
