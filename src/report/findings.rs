@@ -12,7 +12,7 @@
 use super::numbers::{interval, percent, secs, times};
 use super::paper;
 use super::series::{self, Best, Group};
-use crate::sweep::rows::SummaryRow;
+use crate::results::rows::SummaryRow;
 use sph_strategies::StrategyName;
 
 /// The sentences for group `g` of `rows`.

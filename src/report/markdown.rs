@@ -8,8 +8,8 @@ use super::numbers::{interval, sig};
 use super::paper;
 use super::series::{self, Best, Group};
 use super::traces::TraceDir;
-use crate::sweep::plan::LabelStyle;
-use crate::sweep::rows::{Status, SummaryRow};
+use crate::results::key::LabelStyle;
+use crate::results::rows::{Status, SummaryRow};
 use sph_strategies::StrategyName;
 
 /// A chart as the report embeds it.
@@ -68,9 +68,9 @@ pub fn render(input: &Input<'_>) -> String {
          resamples; with few trials it is, if anything, too narrow); speedup is the group's \
          `seq` mean over a cell's mean; efficiency is speedup / cores. Numbers show at most \
          three significant digits.\n",
-        crate::sweep::meta::GIT_COMMIT,
+        crate::results::meta::GIT_COMMIT,
         dirs.join(", "),
-        crate::sweep::console::plural(rows.len(), "cell", "cells"),
+        crate::output::console::plural(rows.len(), "cell", "cells"),
         series::groups(&rows).len(),
         if series::groups(&rows).len() == 1 {
             "group"
@@ -103,7 +103,7 @@ pub fn render(input: &Input<'_>) -> String {
 /// What a reader must know before any number: a partial study, contended cells, cells
 /// dropped as impossible.
 fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
-    use crate::sweep::meta::SweepStatus;
+    use crate::results::meta::SweepStatus;
     for s in sweeps {
         let measured = s.rows.len() + s.dropped.len();
         if s.meta.status == SweepStatus::Complete && measured >= s.meta.planned_cells {
@@ -140,7 +140,7 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
              measured, so {} not trustworthy. They are marked {CONTENDED} in the tables and \
              ringed in red in the charts, and left out of every finding. Measure again on a \
              quiet machine.\n",
-            crate::sweep::console::plural(contended.len(), "cell was", "cells were"),
+            crate::output::console::plural(contended.len(), "cell was", "cells were"),
             (crate::contention::CONTENDED_SHARE * 100.0).round(),
             if contended.len() == 1 {
                 "it was"
@@ -168,7 +168,7 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
             "> ⚠ **{} left out** as unreadable or impossible (a line cut off or garbled, \
              numbers not finite and positive, or statistics \
              that are not those of the trial rows):",
-            crate::sweep::console::plural(dropped.len(), "row", "rows")
+            crate::output::console::plural(dropped.len(), "row", "rows")
         );
         for d in dropped {
             let _ = writeln!(md, "> - {d}");

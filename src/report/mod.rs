@@ -24,7 +24,6 @@
 
 pub mod charts;
 pub mod findings;
-pub mod load;
 pub mod markdown;
 pub mod numbers;
 pub mod paper;
@@ -35,55 +34,17 @@ use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 
+use crate::results::load;
+pub use crate::results::{REPORT_FILE, is_report_file};
 use markdown::{ChartRef, Skipped};
 use series::{Group, Metric};
 use sph_strategies::StrategyName;
-
-/// The report's file name.
-pub const REPORT_FILE: &str = "REPORT.md";
-
-/// Whether a file is one `bench-sph report` writes, by name **and** contents, so that a
-/// user's file that merely has a similar name is never replaced or removed: a `REPORT.md`
-/// that starts with `# bench-sph report`, a chart (`<preset>-….png`, a PNG of the charts'
-/// size) or a copied timeline (`…-timeline.png`, a PNG of the timelines' width). A sweep
-/// that draws its report owns these too.
-pub fn is_own_file(path: &Path) -> bool {
-    use crate::sph::params::Preset;
-    let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
-        return false;
-    };
-    if name == REPORT_FILE {
-        return crate::trace::files::starts_with(path, b"# bench-sph report");
-    }
-    if !name.ends_with(".png") {
-        return false;
-    }
-    if name.ends_with("-timeline.png") {
-        return png_size(path).is_some_and(|(w, _)| w == crate::trace::timeline::WIDTH);
-    }
-    Preset::ALL
-        .iter()
-        .any(|p| name.starts_with(&format!("{}-", p.as_str())))
-        && png_size(path) == Some((charts::WIDTH, charts::HEIGHT))
-}
-
-/// Width and height from a PNG file's header, if it is one.
-fn png_size(path: &Path) -> Option<(u32, u32)> {
-    use std::io::Read;
-    let mut head = [0u8; 24];
-    std::fs::File::open(path).ok()?.read_exact(&mut head).ok()?;
-    if head[..8] != crate::trace::files::PNG_SIGNATURE || &head[12..16] != b"IHDR" {
-        return None;
-    }
-    let word = |i: usize| u32::from_be_bytes([head[i], head[i + 1], head[i + 2], head[i + 3]]);
-    Some((word(16), word(20)))
-}
 
 /// Whether an entry of a report's directory may stay beside the report: a sweep's own files
 /// (the report is often drawn into the sweep's directory) and any directory (traces; the
 /// report never writes into subdirectories).
 fn tolerated(path: &Path) -> bool {
-    use crate::sweep::{META_FILE, SUMMARY_FILE, TRIALS_FILE, lock::LOCK_FILE};
+    use crate::results::{LOCK_FILE, META_FILE, SUMMARY_FILE, TRIALS_FILE};
     path.is_dir()
         || path
             .file_name()
@@ -115,7 +76,7 @@ pub fn generate(
             ));
         }
     }
-    let owns = |p: &Path| p.is_file() && is_own_file(p);
+    let owns = |p: &Path| p.is_file() && is_report_file(p);
     let owner = crate::output::claim::Owner {
         command: "bench-sph report",
         option: "--out",
@@ -139,7 +100,7 @@ pub fn generate(
     };
 
     for g in series::groups(&rows) {
-        let subtitle = g.label(crate::sweep::plan::LabelStyle::Report);
+        let subtitle = g.label(crate::results::key::LabelStyle::Report);
         let skip = |note: String| Skipped {
             group: Some(g),
             note,

@@ -4,9 +4,9 @@
 //! Only the speedups compare with a bench-sph sweep; the absolute times are another program
 //! on another machine. The report shows them only beside `seed`/`all-pairs` groups.
 
+use crate::results::key::Group;
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
-use crate::sweep::plan::Group;
 
 /// The paper's machine, in words.
 pub const MACHINE: &str = "Intel i5-8600K, 6 cores at 5 GHz";

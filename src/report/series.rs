@@ -6,14 +6,14 @@
 
 use std::collections::BTreeSet;
 
-use crate::sweep::bootstrap::Interval;
+use crate::results::stats::Interval;
 
 use sph_strategies::StrategyName;
 
+pub use crate::results::key::Group;
+use crate::results::rows::{Contended, SummaryRow, fastest};
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
-pub use crate::sweep::plan::Group;
-use crate::sweep::rows::{Contended, SummaryRow, fastest};
 
 /// The groups of `rows`, in the order they first appear.
 pub fn groups(rows: &[SummaryRow]) -> Vec<Group> {
@@ -484,7 +484,7 @@ pub fn chunk_table(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::sweep::rows::Status;
+    use crate::results::rows::Status;
 
     /// A usable summary row for tests.
     pub(crate) fn row(

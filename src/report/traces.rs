@@ -3,7 +3,7 @@
 //! `--trace DIR`, and the report's "Traces" section ([`markdown`]).
 //!
 //! A directory holding `timeline.png` and `stats.csv` is a candidate; it is embedded only if
-//! it validates ([`check`]): `stats.csv` has the trace's columns, at least one worker row and
+//! it validates (`check`): `stats.csv` has the trace's columns, at least one worker row and
 //! a total row last whose kernel calls are the workers' sum, and only finite, non-negative
 //! numbers; `timeline.png` is a PNG; `meta.json` parses and says `"tool": "bench-sph trace"`
 //! (a trace written before that field existed is accepted when the rest validates). A
@@ -93,7 +93,7 @@ struct Checked {
     stats: Vec<StatsRow>,
 }
 
-/// Whether `dir` looks like a trace (holds `timeline.png` and `stats.csv`); [`check`] says
+/// Whether `dir` looks like a trace (holds `timeline.png` and `stats.csv`); `check` says
 /// whether it is a valid one.
 pub fn is_trace_dir(dir: &Path) -> bool {
     dir.join(TIMELINE).is_file() && dir.join(STATS).is_file()

@@ -5,7 +5,8 @@ use std::fmt::Write as _;
 
 use super::plan::{Cell, LabelStyle, Plan};
 use super::range::{Axis, compact};
-use super::rows::{Contended, Status, SummaryRow, fastest};
+use crate::output::console::plural;
+use crate::results::rows::{Contended, Status, SummaryRow, fastest};
 
 /// A duration for people: `0.25 ms`, `12 ms`, `4.2 s`, `42 s`, `3 min 20 s`, `1 h 05 min`.
 pub fn duration(seconds: f64) -> String {
@@ -35,11 +36,6 @@ pub fn places(seconds: f64) -> usize {
         return 4;
     }
     (3 - seconds.log10().floor() as i64).clamp(1, 9) as usize
-}
-
-/// `1 warm-up` / `3 warm-ups`, and so on.
-pub fn plural(count: usize, one: &str, many: &str) -> String {
-    format!("{count} {}", if count == 1 { one } else { many })
 }
 
 /// The cells of `plan` with more cores than `hardware_threads`, and their cores values.

@@ -7,7 +7,7 @@
 //! back without it, and the cell runs again. Failed cells are finished too: their failure is a
 //! result (delete their rows by hand to retry them).
 //!
-//! A finished cell is believed only if it passes [`super::validate::cell`] (finite positive
+//! A finished cell is believed only if it passes [`crate::results::validate::cell`] (finite positive
 //! times, statistics that are those of its trials) and the caller's own check (`--resume`:
 //! the cell is in the plan and has the sweep's number of trials); otherwise it is dropped,
 //! listed in [`Repaired::rejected`], and runs again.
@@ -17,15 +17,15 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::export::{SUMMARY_COLUMNS, TRIAL_COLUMNS, to_csv};
+use super::export::to_csv;
 use super::plan::Cell;
-use super::rows::{SummaryRow, TrialRow};
+use crate::results::rows::{SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow};
 
 /// A results file whose header is not this version's.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error(
     "{file} has the columns '{found}', not those bench-sph {} writes",
-    super::meta::VERSION
+    crate::results::meta::VERSION
 )]
 pub struct UnexpectedColumns {
     /// The file's name.
@@ -97,7 +97,7 @@ pub fn repair(
         let complete =
             trials.len() == row.trials && trials.iter().enumerate().all(|(i, t)| t.trial == i + 1);
         let believed = if complete {
-            super::validate::cell(&row, &trials).and_then(|()| check(&row))
+            crate::results::validate::cell(&row, &trials).and_then(|()| check(&row))
         } else {
             Ok(())
         };

@@ -1,37 +1,15 @@
-//! The rows of `trials.csv` and `summary.csv`, and how a cell's measurements become them.
-//!
-//! Field names are the column names. Times are seconds; an empty field means "not defined"
-//! (chunks of a strategy without chunks, the stddev of one trial, any statistic of a failed
-//! cell, anything unmeasurable on this OS). `status` is `ok` or `failed`; a failed cell's
-//! `reason` says why, and its summary carries no statistic, speedup or efficiency: a bug must
-//! never become a number.
-//!
-//! Columns added after the first release are appended at the end of each row (older readers
-//! keep working): per trial `foreign_cpu_s, steal_s, load1` ([`crate::contention`]); per cell
-//! the 95 % bootstrap intervals `mean_ci_low_s, mean_ci_high_s, speedup_ci_low,
-//! speedup_ci_high` ([`super::bootstrap`]), `foreign_cpu_mean_s` and `contended` (some trial
-//! saw more foreign CPU than [`Threshold::allowed_s`]).
+//! How a cell's measurements become its rows of `trials.csv` and `summary.csv`
+//! ([`crate::results::rows`]): the statistics, the speedup over the group's `seq`, the
+//! bootstrap intervals ([`super::bootstrap`]) and the contention flag (some trial saw more
+//! foreign CPU than [`Threshold::allowed_s`]). A failed cell's summary carries no statistic,
+//! speedup or efficiency: a bug must never become a number.
 
-use serde::{Deserialize, Serialize};
-
-use super::bootstrap::{self, Interval};
-use super::plan::{Cell, Group};
-use super::stats::{Stats, mean};
+use super::bootstrap;
 use crate::clock::Elapsed;
 use crate::contention::Threshold;
-use crate::sph::neighbors::NeighborMode;
-use crate::sph::params::Preset;
-use sph_strategies::StrategyName;
-
-/// Whether a cell's numbers can be used.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Status {
-    /// Every run finished and reproduced the group's `seq` checksum.
-    Ok,
-    /// A run failed or its checksum differed: see `reason`.
-    Failed,
-}
+use crate::results::key::Cell;
+use crate::results::rows::{Status, SummaryRow, TrialRow};
+use crate::results::stats::{Interval, Stats, mean};
 
 /// One timed run: its times and the checksum of its final state.
 #[derive(Debug, Clone, PartialEq)]
@@ -42,198 +20,6 @@ pub struct Measured {
     pub load1: Option<f64>,
     /// [`crate::checksum::checksum_hex`] of the final state.
     pub checksum: String,
-}
-
-/// One row of `trials.csv`: one timed run.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TrialRow {
-    /// Strategy.
-    #[serde(with = "super::params::name")]
-    pub strategy: StrategyName,
-    /// Neighbour search.
-    #[serde(with = "super::params::name")]
-    pub neighbors: NeighborMode,
-    /// Preset.
-    #[serde(with = "super::params::name")]
-    pub preset: Preset,
-    /// Particles.
-    pub n: usize,
-    /// Steps.
-    pub steps: usize,
-    /// Worker threads.
-    pub cores: usize,
-    /// Requested chunks (empty for strategies without chunks).
-    pub chunks: Option<usize>,
-    /// Particles in the largest chunk (empty for strategies without chunks).
-    pub particles_per_chunk: Option<usize>,
-    /// Trial number, from 1.
-    pub trial: usize,
-    /// Wall-clock seconds of the step loop.
-    pub wall_s: f64,
-    /// Process CPU seconds (user + system) over the same window.
-    pub cpu_s: f64,
-    /// Checksum of the final state (16 hex digits).
-    pub checksum: String,
-    /// The cell's status.
-    pub status: Status,
-    /// Why the cell failed (empty when ok).
-    pub reason: String,
-    /// Busy CPU seconds of the machine not spent by this process over the same window.
-    #[serde(default)]
-    pub foreign_cpu_s: Option<f64>,
-    /// Of those, seconds stolen by the hypervisor.
-    #[serde(default)]
-    pub steal_s: Option<f64>,
-    /// The 1-minute load average when the trial started.
-    #[serde(default)]
-    pub load1: Option<f64>,
-}
-
-/// One row of `summary.csv`: one cell. Its first columns repeat [`TrialRow`]'s cell key on
-/// purpose: the csv crate cannot write a nested (`flatten`ed) key struct as flat columns.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SummaryRow {
-    /// Strategy.
-    #[serde(with = "super::params::name")]
-    pub strategy: StrategyName,
-    /// Neighbour search.
-    #[serde(with = "super::params::name")]
-    pub neighbors: NeighborMode,
-    /// Preset.
-    #[serde(with = "super::params::name")]
-    pub preset: Preset,
-    /// Particles.
-    pub n: usize,
-    /// Steps.
-    pub steps: usize,
-    /// Worker threads.
-    pub cores: usize,
-    /// Requested chunks (empty for strategies without chunks).
-    pub chunks: Option<usize>,
-    /// Particles in the largest chunk (empty for strategies without chunks).
-    pub particles_per_chunk: Option<usize>,
-    /// Trials completed (the rows of this cell in `trials.csv`).
-    pub trials: usize,
-    /// Mean wall seconds.
-    pub mean_s: Option<f64>,
-    /// Sample standard deviation of the wall seconds (empty for one trial).
-    pub stddev_s: Option<f64>,
-    /// Fastest trial, wall seconds.
-    pub min_s: Option<f64>,
-    /// Median wall seconds.
-    pub median_s: Option<f64>,
-    /// Slowest trial, wall seconds.
-    pub max_s: Option<f64>,
-    /// Mean CPU seconds (user + system).
-    pub cpu_mean_s: Option<f64>,
-    /// The group's `seq` mean divided by this cell's mean.
-    pub speedup: Option<f64>,
-    /// Speedup divided by cores.
-    pub efficiency: Option<f64>,
-    /// Trials with |t − median| > 3 MAD.
-    pub outliers: Option<usize>,
-    /// Whether cores exceed the machine's hardware threads.
-    pub oversubscribed: bool,
-    /// The checksum every trial reproduced (empty for a failed cell).
-    pub checksum: String,
-    /// `ok` or `failed`.
-    pub status: Status,
-    /// Why the cell failed (empty when ok).
-    pub reason: String,
-    /// Lower end of the 95 % bootstrap interval of the mean wall seconds.
-    #[serde(default)]
-    pub mean_ci_low_s: Option<f64>,
-    /// Upper end of that interval.
-    #[serde(default)]
-    pub mean_ci_high_s: Option<f64>,
-    /// Lower end of the 95 % bootstrap interval of the speedup.
-    #[serde(default)]
-    pub speedup_ci_low: Option<f64>,
-    /// Upper end of that interval.
-    #[serde(default)]
-    pub speedup_ci_high: Option<f64>,
-    /// Mean foreign CPU seconds per trial.
-    #[serde(default)]
-    pub foreign_cpu_mean_s: Option<f64>,
-    /// Whether some trial saw more foreign CPU than the threshold (empty where unknown).
-    #[serde(default)]
-    pub contended: Option<bool>,
-}
-
-/// The columns that name a row's cell, shared by both files.
-macro_rules! keyed {
-    ($row:ty) => {
-        impl $row {
-            /// The row's group.
-            pub fn group(&self) -> Group {
-                Group {
-                    preset: self.preset,
-                    neighbors: self.neighbors,
-                    n: self.n,
-                    steps: self.steps,
-                }
-            }
-
-            /// The row's cell.
-            pub fn key(&self) -> Cell {
-                Cell {
-                    group: self.group(),
-                    strategy: self.strategy,
-                    cores: self.cores,
-                    chunks: self.chunks,
-                }
-            }
-        }
-    };
-}
-keyed!(TrialRow);
-keyed!(SummaryRow);
-
-impl TrialRow {
-    /// Whether the row is a trial of its group's `seq` reference cell.
-    pub fn is_reference(&self) -> bool {
-        self.key().is_reference()
-    }
-}
-
-impl SummaryRow {
-    /// Whether the row is its group's `seq` reference cell.
-    pub fn is_reference(&self) -> bool {
-        self.key().is_reference()
-    }
-
-    /// Whether the row's numbers may be used: status ok, with a mean.
-    pub fn is_usable(&self) -> bool {
-        self.status == Status::Ok && self.mean_s.is_some()
-    }
-}
-
-/// How [`fastest`] treats cells that other work disturbed (`contended = true`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Contended {
-    /// They compete like any other cell (the sweep's end-of-run table, which shows what was
-    /// measured).
-    Compete,
-    /// Only when every candidate is contended (the report, whose findings trust no
-    /// contended cell).
-    LastResort,
-}
-
-/// The one "best cell" rule: the usable row of `rows` with the lowest mean (the first of
-/// equals), contended rows treated as `contended` says.
-pub fn fastest<'a>(
-    rows: impl IntoIterator<Item = &'a SummaryRow>,
-    contended: Contended,
-) -> Option<&'a SummaryRow> {
-    let disturbed =
-        |r: &SummaryRow| contended == Contended::LastResort && r.contended == Some(true);
-    rows.into_iter().filter(|r| r.is_usable()).min_by(|a, b| {
-        disturbed(a).cmp(&disturbed(b)).then(
-            a.mean_s
-                .unwrap_or(f64::INFINITY)
-                .total_cmp(&b.mean_s.unwrap_or(f64::INFINITY)),
-        )
-    })
 }
 
 /// The trial rows of a cell: one per measured run, all with the cell's status and reason.
@@ -375,6 +161,10 @@ fn status_of(failure: Option<&str>) -> Status {
 mod tests {
     use super::*;
     use crate::contention::Foreign;
+    use crate::results::key::Group;
+    use crate::sph::neighbors::NeighborMode;
+    use crate::sph::params::Preset;
+    use sph_strategies::StrategyName;
 
     fn cell(strategy: StrategyName, cores: usize, chunks: Option<usize>) -> Cell {
         Cell {

@@ -23,10 +23,11 @@ use sph_strategies::StrategyName;
 use super::console;
 use super::export::Exporter;
 use super::plan::{Cell, Group, Plan};
-use super::rows::{CellContext, Measured, Status, SummaryRow, summary_row, trial_rows};
+use super::rows::{CellContext, Measured, summary_row, trial_rows};
 use super::timing::{Timing, Trial};
 use crate::checksum::checksum_hex;
 use crate::contention::Threshold;
+use crate::results::rows::{Status, SummaryRow};
 use crate::run::run_timed;
 use crate::scene::dam_break;
 use crate::solver::Simulation;
@@ -224,7 +225,7 @@ const CALIBRATION_N_ALL_PAIRS: usize = 4000;
 const CALIBRATION_N_GRID: usize = 200_000;
 
 /// Seconds one `seq` run of `group` takes, estimated from a short timed run of at most
-/// [`CALIBRATION_N_ALL_PAIRS`] (all-pairs) or [`CALIBRATION_N_GRID`] (grid) particles,
+/// 4000 (all-pairs, `CALIBRATION_N_ALL_PAIRS`) or 200 000 (grid, `CALIBRATION_N_GRID`) particles,
 /// scaled by (N / sample)² or N / sample: one step, then doubling the steps until a run
 /// takes 50 ms or covers all steps. NaN when the run fails (the sweep will then report the
 /// failure properly).

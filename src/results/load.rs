@@ -1,5 +1,5 @@
-//! Reading results directories: `meta.json`, `summary.csv` and `trials.csv` into the sweep's
-//! own types ([`Meta`], [`SummaryRow`], [`TrialRow`]), with errors that name the file and the
+//! Reading results directories leniently (`bench-sph report`): `meta.json`, `summary.csv` and
+//! `trials.csv` into the schema's types ([`Meta`], [`SummaryRow`], [`TrialRow`]), with errors that name the file and the
 //! line, and every cell checked before it can become a number in the report.
 //!
 //! - Files of this version and of the first release (before the contention and interval
@@ -18,14 +18,14 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
-use crate::sweep::export::{
-    LEGACY_SUMMARY_COLUMNS, LEGACY_TRIAL_COLUMNS, SUMMARY_COLUMNS, TRIAL_COLUMNS,
+use super::files::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
+use super::key::Cell;
+use super::meta::Meta;
+use super::rows::{
+    LEGACY_SUMMARY_COLUMNS, LEGACY_TRIAL_COLUMNS, SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS,
+    TrialRow,
 };
-use crate::sweep::meta::Meta;
-use crate::sweep::plan::Cell;
-use crate::sweep::rows::{SummaryRow, TrialRow};
-use crate::sweep::validate;
-use crate::sweep::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
+use super::validate;
 
 /// One sweep's results.
 #[derive(Debug, Clone)]

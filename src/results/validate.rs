@@ -179,9 +179,9 @@ fn show(v: Option<f64>) -> String {
 mod tests {
     use super::*;
     use crate::clock::Elapsed;
+    use crate::results::key::{Cell, Group};
     use crate::sph::neighbors::NeighborMode;
     use crate::sph::params::Preset;
-    use crate::sweep::plan::{Cell, Group};
     use crate::sweep::rows::{Measured, summary_row, test_context, trial_rows};
     use sph_strategies::StrategyName;
 
