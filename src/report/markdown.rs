@@ -6,22 +6,12 @@ use std::fmt::Write as _;
 use super::load::Sweep;
 use super::numbers::{interval, sig};
 use super::paper;
+use super::plan::ChartPlan;
 use super::series::{self, Best, Group};
 use super::traces::TraceDir;
 use crate::results::key::LabelStyle;
 use crate::results::rows::{Status, SummaryRow};
 use sph_strategies::StrategyName;
-
-/// A chart as the report embeds it.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ChartRef {
-    /// The group it belongs to (`None` for charts across groups).
-    pub group: Option<Group>,
-    /// File name, relative to the report.
-    pub file: String,
-    /// One-sentence caption.
-    pub caption: String,
-}
 
 /// A chart that does not apply, and why.
 #[derive(Debug, Clone, PartialEq)]
@@ -38,7 +28,7 @@ pub struct Input<'a> {
     /// The sweeps, in the order given.
     pub sweeps: &'a [Sweep],
     /// Charts drawn.
-    pub charts: &'a [ChartRef],
+    pub charts: &'a [ChartPlan],
     /// Charts not drawn.
     pub skipped: &'a [Skipped],
     /// Traces to embed.
@@ -247,7 +237,7 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
     md.push('\n');
 }
 
-fn charts_of<'a>(input: &'a Input<'_>, g: Option<&Group>) -> impl Iterator<Item = &'a ChartRef> {
+fn charts_of<'a>(input: &'a Input<'_>, g: Option<&Group>) -> impl Iterator<Item = &'a ChartPlan> {
     let g = g.cloned();
     input.charts.iter().filter(move |c| c.group == g)
 }
@@ -315,7 +305,7 @@ fn group(md: &mut String, rows: &[SummaryRow], g: &Group, input: &Input<'_>) {
         let _ = writeln!(md, "- {sentence}");
     }
     md.push('\n');
-    let charts: Vec<&ChartRef> = charts_of(input, Some(g)).collect();
+    let charts: Vec<&ChartPlan> = charts_of(input, Some(g)).collect();
     if !charts.is_empty() {
         let _ = writeln!(md, "### Charts\n");
         for c in charts {
@@ -410,7 +400,7 @@ fn alt(caption: &str) -> &str {
 }
 
 fn across_groups(md: &mut String, input: &Input<'_>) {
-    let charts: Vec<&ChartRef> = charts_of(input, None).collect();
+    let charts: Vec<&ChartPlan> = charts_of(input, None).collect();
     let skipped: Vec<&Skipped> = input.skipped.iter().filter(|s| s.group.is_none()).collect();
     if charts.is_empty() && skipped.is_empty() {
         return;

@@ -156,13 +156,7 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
         opened.fresh,
     )
     .context("cannot write the results")?;
-    let runs_per_cell = (params.warmup + params.trials) as u64;
-    let progress = progress_bar(
-        todo.iter()
-            .map(|&i| run_ms[i].saturating_mul(runs_per_cell))
-            .fold(0u64, u64::saturating_add),
-    );
-    let mut runner = Runner {
+    let runner = Runner {
         plan: &plan,
         warmup: params.warmup,
         trials: params.trials,
@@ -173,13 +167,29 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
         timing,
         stop_after_cells: request.stop_after_cells,
         exporter,
-        progress: progress.clone(),
+        progress: ProgressBar::hidden(),
         run_ms,
     };
-    let outcome = runner.run(&todo, &mut references);
-    progress.finish_and_clear();
-    let outcome = outcome?;
+    let outcome = measure(runner, &todo, &mut references)?;
     conclude(opened, plan, outcome.rows, outcome.interrupted)
+}
+
+/// Runs the cells `todo` under a progress bar measured in estimated milliseconds (see
+/// [`progress_bar`]), cleared when the runner stops.
+fn measure<T: std::io::Write, S: std::io::Write>(
+    mut runner: Runner<'_, T, S>,
+    todo: &[usize],
+    references: &mut HashMap<Group, Reference>,
+) -> anyhow::Result<runner::SessionOutcome> {
+    let runs_per_cell = (runner.warmup + runner.trials) as u64;
+    let total_ms = todo
+        .iter()
+        .map(|&i| runner.run_ms[i].saturating_mul(runs_per_cell))
+        .fold(0u64, u64::saturating_add);
+    runner.progress = progress_bar(total_ms);
+    let outcome = runner.run(todo, references);
+    runner.progress.finish_and_clear();
+    outcome
 }
 
 /// Estimated milliseconds of one run of each cell (at least 1), from [`estimate`]'s seconds.
