@@ -55,11 +55,67 @@ pub fn findings(rows: &[SummaryRow], g: &Group) -> Vec<String> {
     out
 }
 
-/// Who is fastest at `cores`, if anyone can be said to be.
-fn winner(cores: usize, at: &[(&str, &Best)], seq_trusted: bool) -> Option<String> {
+/// A strategy's best cell at one core count.
+type Entry<'a> = (&'a str, &'a Best);
+
+/// What can be said about the fastest strategy at one core count, from the cells measured
+/// without contention (fastest first).
+#[derive(Debug, Clone, PartialEq)]
+enum Verdict<'a> {
+    /// Only one cell.
+    Only(Entry<'a>),
+    /// Several, but some without confidence intervals: the lowest mean only.
+    NoIntervals(Entry<'a>),
+    /// The fastest cell's interval overlaps no other's.
+    Fastest {
+        /// The fastest.
+        winner: Entry<'a>,
+        /// The second fastest.
+        runner_up: Entry<'a>,
+    },
+    /// The fastest cell's interval overlaps these (the fastest first).
+    Tied {
+        /// The cells whose intervals overlap the fastest one's, and it.
+        tied: Vec<Entry<'a>>,
+        /// How many are slower beyond the overlap.
+        slower: usize,
+    },
+}
+
+/// The verdict on `trusted` (sorted fastest first); `None` when it is empty.
+fn verdict<'a>(trusted: &[Entry<'a>]) -> Option<Verdict<'a>> {
+    let &first = trusted.first()?;
+    if trusted.len() == 1 {
+        return Some(Verdict::Only(first));
+    }
+    if trusted.iter().any(|(_, b)| b.mean_ci.is_none()) {
+        return Some(Verdict::NoIntervals(first));
+    }
+    let mut tied = vec![first];
+    tied.extend(
+        trusted[1..]
+            .iter()
+            .copied()
+            .filter(|(_, b)| match (first.1.mean_ci, b.mean_ci) {
+                (Some(a), Some(o)) => a.overlaps(&o),
+                _ => true,
+            }),
+    );
+    Some(if tied.len() == 1 {
+        Verdict::Fastest {
+            winner: first,
+            runner_up: trusted[1],
+        }
+    } else {
+        let slower = trusted.len() - tied.len();
+        Verdict::Tied { tied, slower }
+    })
+}
+
+/// Who is fastest at `cores`, if anyone can be said to be, as a sentence.
+fn winner(cores: usize, at: &[Entry<'_>], seq_trusted: bool) -> Option<String> {
     let contended = at.iter().filter(|(_, b)| b.contended).count();
-    let mut trusted: Vec<(&str, &Best)> =
-        at.iter().copied().filter(|(_, b)| !b.contended).collect();
+    let mut trusted: Vec<Entry<'_>> = at.iter().copied().filter(|(_, b)| !b.contended).collect();
     trusted.sort_by(|a, b| a.1.mean_s.total_cmp(&b.1.mean_s));
     let left_out = match contended {
         0 => String::new(),
@@ -75,8 +131,7 @@ fn winner(cores: usize, at: &[(&str, &Best)], seq_trusted: bool) -> Option<Strin
             ""
         }
     );
-    let &(w, wb) = trusted.first()?;
-    let describe = |s: &str, b: &Best| {
+    let describe = |(s, b): Entry<'_>| {
         format!(
             "{s}{} ({} s{})",
             b.chunks
@@ -85,62 +140,48 @@ fn winner(cores: usize, at: &[(&str, &Best)], seq_trusted: bool) -> Option<Strin
             interval(b.mean_ci)
         )
     };
-    if trusted.len() == 1 {
-        let only = if contended > 0 {
-            "was measured without contention"
-        } else {
-            "was measured"
-        };
-        return Some(format!(
-            "{where_}, only {} {only}{left_out}.",
-            describe(w, wb)
-        ));
-    }
-    if trusted.iter().any(|(_, b)| b.mean_ci.is_none()) {
-        return Some(format!(
+    Some(match verdict(&trusted)? {
+        Verdict::Only(w) => {
+            let only = if contended > 0 {
+                "was measured without contention"
+            } else {
+                "was measured"
+            };
+            format!("{where_}, only {} {only}{left_out}.", describe(w))
+        }
+        Verdict::NoIntervals(w) => format!(
             "{where_}, the lowest mean is {}, but these cells have no confidence intervals (one \
              trial, or a sweep older than them), so no strategy can be called fastest{left_out}.",
-            describe(w, wb)
-        ));
-    }
-    let ties: Vec<(&str, &Best)> = trusted[1..]
-        .iter()
-        .copied()
-        .filter(|(_, b)| match (wb.mean_ci, b.mean_ci) {
-            (Some(a), Some(o)) => a.overlaps(&o),
-            _ => true,
-        })
-        .collect();
-    if ties.is_empty() {
-        let (r, rb) = trusted[1];
-        // At one core a speedup is the reference's noise (said separately), not a result.
-        let speed = wb
-            .speedup
-            .filter(|_| cores > 1 && seq_trusted)
-            .map_or_else(String::new, |s| {
-                format!(", {}{} over seq", times(s), interval(wb.speedup_ci))
-            });
-        return Some(format!(
-            "{where_}, **{}** is fastest{speed}; its 95 % interval does not overlap the \
-             runner-up {}, which takes {} more time{left_out}.",
-            describe(w, wb),
-            describe(r, rb),
-            percent((rb.mean_s - wb.mean_s) / wb.mean_s * 100.0)
-        ));
-    }
-    let mut names = vec![describe(w, wb)];
-    names.extend(ties.iter().map(|(s, b)| describe(s, b)));
-    let rest = trusted.len() - 1 - ties.len();
-    Some(format!(
-        "{where_}, {} are indistinguishable within the trial spread (their 95 % intervals \
-         overlap){}{left_out}.",
-        and_list(&names),
-        match rest {
-            0 => String::new(),
-            1 => "; the other strategy is slower".to_owned(),
-            _ => "; the others are slower".to_owned(),
+            describe(w)
+        ),
+        Verdict::Fastest { winner, runner_up } => {
+            let (wb, rb) = (winner.1, runner_up.1);
+            // At one core a speedup is the reference's noise (said separately), not a result.
+            let speed = wb
+                .speedup
+                .filter(|_| cores > 1 && seq_trusted)
+                .map_or_else(String::new, |s| {
+                    format!(", {}{} over seq", times(s), interval(wb.speedup_ci))
+                });
+            format!(
+                "{where_}, **{}** is fastest{speed}; its 95 % interval does not overlap the \
+                 runner-up {}, which takes {} more time{left_out}.",
+                describe(winner),
+                describe(runner_up),
+                percent((rb.mean_s - wb.mean_s) / wb.mean_s * 100.0)
+            )
         }
-    ))
+        Verdict::Tied { tied, slower } => format!(
+            "{where_}, {} are indistinguishable within the trial spread (their 95 % intervals \
+             overlap){}{left_out}.",
+            and_list(&tied.into_iter().map(describe).collect::<Vec<_>>()),
+            match slower {
+                0 => String::new(),
+                1 => "; the other strategy is slower".to_owned(),
+                _ => "; the others are slower".to_owned(),
+            }
+        ),
+    })
 }
 
 /// `a`, `a and b`, `a, b and c`.

@@ -242,8 +242,37 @@ fn charts_of<'a>(input: &'a Input<'_>, g: Option<&Group>) -> impl Iterator<Item 
     input.charts.iter().filter(move |c| c.group == g)
 }
 
+/// One group's section: its reference, the paper's context, the best-cell tables, the
+/// findings and the charts.
 fn group(md: &mut String, rows: &[SummaryRow], g: &Group, input: &Input<'_>) {
     let _ = writeln!(md, "## {}\n", g.label(LabelStyle::Report));
+    reference(md, rows, g);
+    let comparable = paper::comparable(g);
+    if comparable {
+        paper_context(md, g);
+    }
+    let _ = writeln!(md, "### Best cell per core count (Table 1 analogue)\n");
+    for s in series::strategies(rows, g)
+        .into_iter()
+        .filter(|&s| s != StrategyName::Seq)
+    {
+        let best = series::best_per_cores(rows, g, s);
+        if best.is_empty() {
+            let _ = writeln!(md, "**{s}**: no successful cell.\n");
+            continue;
+        }
+        table(md, s, &best, comparable && series::is_chunked(rows, g, s));
+    }
+    let _ = writeln!(md, "### Findings\n");
+    for sentence in super::findings::findings(rows, g) {
+        let _ = writeln!(md, "- {sentence}");
+    }
+    md.push('\n');
+    group_charts(md, g, input);
+}
+
+/// The group's `seq` reference, or that there is none.
+fn reference(md: &mut String, rows: &[SummaryRow], g: &Group) {
     if let Some(r) = rows
         .iter()
         .find(|r| r.group() == *g && r.is_reference() && r.is_usable())
@@ -267,44 +296,32 @@ fn group(md: &mut String, rows: &[SummaryRow], g: &Group, input: &Input<'_>) {
             "No usable `seq` reference cell: speedups are undefined.\n"
         );
     }
-    let comparable = paper::comparable(g);
-    if comparable {
-        let _ = writeln!(
-            md,
-            "Beside each table: the paper's Table 1 (the seed Haskell program with \
-             `parListChunk`, {}, N = {}, {} steps, all-pairs, serial {} s). **Speedups compare; \
-             absolute times do not** — another program on another machine{}.\n",
-            paper::MACHINE,
-            paper::N,
-            paper::STEPS,
-            sig(paper::SERIAL_S),
-            if g.n != paper::N || g.steps != paper::STEPS {
-                format!(
-                    ", and this group's N = {}, {} steps differ from the paper's",
-                    g.n, g.steps
-                )
-            } else {
-                String::new()
-            }
-        );
-    }
-    let _ = writeln!(md, "### Best cell per core count (Table 1 analogue)\n");
-    for s in series::strategies(rows, g)
-        .into_iter()
-        .filter(|&s| s != StrategyName::Seq)
-    {
-        let best = series::best_per_cores(rows, g, s);
-        if best.is_empty() {
-            let _ = writeln!(md, "**{s}**: no successful cell.\n");
-            continue;
+}
+
+/// What the paper measured, beside which the tables set this group's cells.
+fn paper_context(md: &mut String, g: &Group) {
+    let _ = writeln!(
+        md,
+        "Beside each table: the paper's Table 1 (the seed Haskell program with \
+         `parListChunk`, {}, N = {}, {} steps, all-pairs, serial {} s). **Speedups compare; \
+         absolute times do not** — another program on another machine{}.\n",
+        paper::MACHINE,
+        paper::N,
+        paper::STEPS,
+        sig(paper::SERIAL_S),
+        if g.n != paper::N || g.steps != paper::STEPS {
+            format!(
+                ", and this group's N = {}, {} steps differ from the paper's",
+                g.n, g.steps
+            )
+        } else {
+            String::new()
         }
-        table(md, s, &best, comparable && series::is_chunked(rows, g, s));
-    }
-    let _ = writeln!(md, "### Findings\n");
-    for sentence in super::findings::findings(rows, g) {
-        let _ = writeln!(md, "- {sentence}");
-    }
-    md.push('\n');
+    );
+}
+
+/// The group's charts with their captions, then the notes on those not drawn.
+fn group_charts(md: &mut String, g: &Group, input: &Input<'_>) {
     let charts: Vec<&ChartPlan> = charts_of(input, Some(g)).collect();
     if !charts.is_empty() {
         let _ = writeln!(md, "### Charts\n");

@@ -295,6 +295,32 @@ pub struct SessionOutcome {
     pub interrupted: bool,
 }
 
+/// What `cell` is measured against: the checksum its runs must reproduce and the group's
+/// `seq` walls (both `None` for the reference cell itself), or why it cannot run.
+type Against = (Option<String>, Option<String>, Option<Vec<f64>>);
+
+/// The group's reference as `cell` needs it (see [`Against`]): `(checksum, failure, walls)`.
+fn against(cell: &Cell, references: &HashMap<Group, Reference>) -> Against {
+    if cell.is_reference() {
+        return (None, None, None);
+    }
+    match references.get(&cell.group) {
+        Some(Reference::Ok { checksum, walls }) => {
+            (Some(checksum.clone()), None, Some(walls.clone()))
+        }
+        Some(Reference::Failed(why)) => (
+            None,
+            Some(format!("not run: the group's seq reference failed ({why})")),
+            None,
+        ),
+        None => (
+            None,
+            Some("not run: the group has no seq reference".to_owned()),
+            None,
+        ),
+    }
+}
+
 impl<T: Write, S: Write> Runner<'_, T, S> {
     /// Runs the cells at positions `todo` of the plan (ascending), measuring each against its
     /// group's entry in `references` (filled in as `seq` cells finish), and writes each
@@ -314,25 +340,7 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
                 break;
             }
             let cell = self.plan.cells[index];
-            let (measured, failure, seq_walls) = if cell.is_reference() {
-                (None, None, None)
-            } else {
-                match references.get(&cell.group) {
-                    Some(Reference::Ok { checksum, walls }) => {
-                        (Some(checksum.clone()), None, Some(walls.clone()))
-                    }
-                    Some(Reference::Failed(why)) => (
-                        None,
-                        Some(format!("not run: the group's seq reference failed ({why})")),
-                        None,
-                    ),
-                    None => (
-                        None,
-                        Some("not run: the group has no seq reference".to_owned()),
-                        None,
-                    ),
-                }
-            };
+            let (measured, failure, seq_walls) = against(&cell, references);
             let (measured, failure) = if let Some(failure) = failure {
                 self.progress
                     .inc(self.run_ms[index].saturating_mul((self.warmup + self.trials) as u64));
@@ -352,26 +360,7 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
                 }
             };
 
-            let seq_walls = if cell.is_reference() {
-                failure.is_none().then(|| walls(&measured))
-            } else {
-                seq_walls
-            };
-            let ctx = CellContext {
-                seq_walls: seq_walls.as_deref(),
-                hardware_threads: self.hardware_threads,
-                threshold: self.threshold,
-                seed: self.seed,
-                resamples: self.resamples,
-            };
-            let summary = summary_row(&cell, &measured, failure.as_deref(), &ctx);
-            let trials = trial_rows(&cell, &measured, failure.as_deref());
-            self.exporter
-                .write_cell(&trials, &summary)
-                .context("cannot write the results")?;
-            if cell.is_reference() {
-                references.insert(cell.group, Reference::from_row(&summary, walls(&measured)));
-            }
+            let summary = self.record(index, &measured, failure, seq_walls, references)?;
             let mut text = String::new();
             if self.plan.groups.len() > 1 && shown_group != Some(cell.group) {
                 text = format!("{}:\n", cell.group.label(super::plan::LabelStyle::Sweep));
@@ -391,6 +380,40 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
             outcome.rows.push(summary);
         }
         Ok(outcome)
+    }
+
+    /// Writes the cell at `index` of the plan (its trial rows and summary row, against the
+    /// group's `seq` walls), and records a reference cell in `references`.
+    fn record(
+        &mut self,
+        index: usize,
+        measured: &[Measured],
+        failure: Option<String>,
+        seq_walls: Option<Vec<f64>>,
+        references: &mut HashMap<Group, Reference>,
+    ) -> anyhow::Result<SummaryRow> {
+        let cell = self.plan.cells[index];
+        let seq_walls = if cell.is_reference() {
+            failure.is_none().then(|| walls(measured))
+        } else {
+            seq_walls
+        };
+        let ctx = CellContext {
+            seq_walls: seq_walls.as_deref(),
+            hardware_threads: self.hardware_threads,
+            threshold: self.threshold,
+            seed: self.seed,
+            resamples: self.resamples,
+        };
+        let summary = summary_row(&cell, measured, failure.as_deref(), &ctx);
+        let trials = trial_rows(&cell, measured, failure.as_deref());
+        self.exporter
+            .write_cell(&trials, &summary)
+            .context("cannot write the results")?;
+        if cell.is_reference() {
+            references.insert(cell.group, Reference::from_row(&summary, walls(measured)));
+        }
+        Ok(summary)
     }
 
     /// The runs of one cell, with the progress bar advanced after each.
