@@ -113,6 +113,7 @@ fn verdict<'a>(trusted: &[Entry<'a>]) -> Option<Verdict<'a>> {
 }
 
 /// Who is fastest at `cores`, if anyone can be said to be, as a sentence.
+// Over ~60 lines on purpose: one sentence per verdict ([`verdict`] decides; this only words it).
 fn winner(cores: usize, at: &[Entry<'_>], seq_trusted: bool) -> Option<String> {
     let contended = at.iter().filter(|(_, b)| b.contended).count();
     let mut trusted: Vec<Entry<'_>> = at.iter().copied().filter(|(_, b)| !b.contended).collect();

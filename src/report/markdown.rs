@@ -122,6 +122,12 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
             s.dir.display()
         );
     }
+    contended_banner(md, rows);
+    dropped_banner(md, sweeps);
+}
+
+/// The banner over a study with contended cells.
+fn contended_banner(md: &mut String, rows: &[SummaryRow]) {
     let contended: Vec<&SummaryRow> = rows.iter().filter(|r| r.contended == Some(true)).collect();
     if !contended.is_empty() {
         let _ = writeln!(
@@ -144,6 +150,10 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
             },
         );
     }
+}
+
+/// The banner listing rows left out as unreadable or impossible.
+fn dropped_banner(md: &mut String, sweeps: &[Sweep]) {
     let dropped: Vec<String> = sweeps
         .iter()
         .flat_map(|s| {
@@ -176,8 +186,22 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
         rule.push_str("---|");
     }
     let _ = writeln!(md, "{header}\n{rule}");
-    type Field = fn(&Sweep) -> String;
-    let fields: [(&str, Field); 12] = [
+    for (name, f) in machine_fields() {
+        let mut line = format!("| {name} |");
+        for s in sweeps {
+            let _ = write!(line, " {} |", f(s));
+        }
+        let _ = writeln!(md, "{line}");
+    }
+    md.push('\n');
+}
+
+/// A row of the machine table: its name and its value for one sweep.
+type Field = fn(&Sweep) -> String;
+
+/// The rows of the machine table, in order.
+fn machine_fields() -> [(&'static str, Field); 12] {
+    [
         ("CPU", |s| s.meta.machine.cpu_model.clone()),
         ("hardware threads", |s| {
             s.meta.machine.hardware_threads.to_string()
@@ -226,15 +250,7 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
             }
             format!("`{}`", c.replace('|', "\\|"))
         }),
-    ];
-    for (name, f) in fields {
-        let mut line = format!("| {name} |");
-        for s in sweeps {
-            let _ = write!(line, " {} |", f(s));
-        }
-        let _ = writeln!(md, "{line}");
-    }
-    md.push('\n');
+    ]
 }
 
 fn charts_of<'a>(input: &'a Input<'_>, g: Option<&Group>) -> impl Iterator<Item = &'a ChartPlan> {
@@ -343,6 +359,7 @@ fn group_charts(md: &mut String, g: &Group, input: &Input<'_>) {
     }
 }
 
+// Over ~60 lines on purpose: the table with and without the paper's columns, row by row; the two layouts share every row.
 fn table(md: &mut String, strategy: StrategyName, best: &[Best], with_paper: bool) {
     let _ = writeln!(md, "**{strategy}**\n");
     if with_paper {

@@ -109,6 +109,7 @@ const BUSY_CHECK: Duration = Duration::from_millis(300);
 /// Runs a sweep: plan, measure, write. Returns the finished sweep, whose
 /// [`outcome`](Finished::outcome) is the error to end with when it was interrupted or a cell
 /// failed; errors here are those that stop it before or while it measures.
+// Over ~60 lines on purpose: the sweep's steps in the order they print (open, plan, busy check, estimate, measure, conclude), each a call; what is left is handing values between them.
 pub fn run(request: Request) -> anyhow::Result<Finished> {
     // From the start: a Ctrl-C during the plan or the estimate also ends the sweep as
     // interrupted (after the estimate), never as a killed "running" one.
@@ -468,20 +469,7 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
         Ok(())
     };
     let repaired = resume::load_and_repair(dir, &check)?;
-    let (was, now) = (&meta.machine, &session.machine);
-    if was.cpu_model != now.cpu_model || was.hardware_threads != now.hardware_threads {
-        console_warn(&format!(
-            "warning: this sweep started on '{}' ({} hardware threads) and continues on '{}' \
-             ({}): times from the two machines are not comparable",
-            was.cpu_model, was.hardware_threads, now.cpu_model, now.hardware_threads
-        ));
-    }
-    if meta.git_commit != session.git_commit {
-        console_warn(&format!(
-            "warning: this sweep started with bench-sph {} and continues with {}",
-            meta.git_commit, session.git_commit
-        ));
-    }
+    warn_if_changed(&meta, &session);
     for why in &repaired.rejected {
         console_warn(&format!("warning: dropped, will run again: {why}"));
     }
@@ -506,6 +494,24 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
         fresh: false,
         lock,
     })
+}
+
+/// Warns when a resumed sweep continues on another machine or with another build.
+fn warn_if_changed(meta: &Meta, session: &Session) {
+    let (was, now) = (&meta.machine, &session.machine);
+    if was.cpu_model != now.cpu_model || was.hardware_threads != now.hardware_threads {
+        console_warn(&format!(
+            "warning: this sweep started on '{}' ({} hardware threads) and continues on '{}' \
+             ({}): times from the two machines are not comparable",
+            was.cpu_model, was.hardware_threads, now.cpu_model, now.hardware_threads
+        ));
+    }
+    if meta.git_commit != session.git_commit {
+        console_warn(&format!(
+            "warning: this sweep started with bench-sph {} and continues with {}",
+            meta.git_commit, session.git_commit
+        ));
+    }
 }
 
 /// Opens `path` for appending (creating it).

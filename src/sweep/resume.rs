@@ -57,6 +57,7 @@ pub struct Repaired {
 
 /// Repairs the contents of `trials.csv` and `summary.csv` (either may be empty: no file);
 /// `check` is the caller's own test of a finished cell (see the module docs).
+// Over ~60 lines on purpose: the repair is one pass over the rows whose steps (first row per cell, trials once per number, finished = complete and believed) are the module docs' list in order.
 pub fn repair(
     trials: &[u8],
     summary: &[u8],
