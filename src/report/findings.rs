@@ -303,7 +303,7 @@ fn against_paper(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::series::tests::row;
+    use crate::results::rows::tests::row;
 
     fn with_ci(mut r: SummaryRow, low: f64, high: f64) -> SummaryRow {
         r.mean_ci_low_s = Some(low);

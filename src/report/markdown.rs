@@ -487,7 +487,7 @@ fn failed(md: &mut String, rows: &[SummaryRow]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::series::tests::row;
+    use crate::results::rows::tests::row;
 
     #[test]
     fn an_oversubscribed_best_cell_is_flagged_in_the_table() {

@@ -281,7 +281,7 @@ fn neighbor_chart(rows: &[SummaryRow], preset: Preset, out: &mut ReportPlan) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::series::tests::row;
+    use crate::results::rows::tests::row;
     use crate::sph::neighbors::NeighborMode;
 
     fn files(p: &ReportPlan) -> Vec<&str> {

@@ -483,48 +483,10 @@ pub fn chunk_table(
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::*;
     use crate::results::rows::Status;
-
-    /// A usable summary row for tests.
-    pub(crate) fn row(
-        strategy: StrategyName,
-        cores: usize,
-        chunks: Option<usize>,
-        mean: f64,
-    ) -> SummaryRow {
-        SummaryRow {
-            strategy,
-            neighbors: NeighborMode::AllPairs,
-            preset: Preset::Seed,
-            n: 60,
-            steps: 3,
-            cores,
-            chunks,
-            particles_per_chunk: chunks.map(|k| 60usize.div_ceil(k)),
-            trials: 3,
-            mean_s: Some(mean),
-            stddev_s: Some(mean * 0.01),
-            min_s: Some(mean * 0.9),
-            median_s: Some(mean),
-            max_s: Some(mean * 1.1),
-            cpu_mean_s: Some(mean * cores as f64),
-            speedup: Some(4.0 / mean),
-            efficiency: Some(4.0 / mean / cores as f64),
-            outliers: Some(0),
-            oversubscribed: cores > 2,
-            checksum: "00000000000000aa".to_owned(),
-            status: Status::Ok,
-            reason: String::new(),
-            mean_ci_low_s: Some(mean * 0.98),
-            mean_ci_high_s: Some(mean * 1.02),
-            speedup_ci_low: Some(4.0 / mean * 0.95),
-            speedup_ci_high: Some(4.0 / mean * 1.05),
-            foreign_cpu_mean_s: Some(0.0),
-            contended: Some(false),
-        }
-    }
+    use crate::results::rows::tests::row;
 
     fn sample() -> Vec<SummaryRow> {
         let mut failed = row(StrategyName::RayonChunks, 2, Some(20), 0.1);

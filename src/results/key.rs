@@ -120,3 +120,38 @@ impl Cell {
         format!("{} ({})", self.label(), self.group.label(LabelStyle::Sweep))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_group_label_has_the_sweep_wording_and_the_report_wording() {
+        let g = Group {
+            preset: Preset::Seed,
+            neighbors: NeighborMode::AllPairs,
+            n: 1000,
+            steps: 1,
+        };
+        assert_eq!(
+            g.label(LabelStyle::Sweep),
+            "preset seed, all-pairs, N = 1000, 1 step"
+        );
+        assert_eq!(
+            g.label(LabelStyle::Report),
+            "seed preset, all-pairs, N = 1000, 1 step"
+        );
+        assert_eq!(g.slug(), "seed-all-pairs-n1000-s1");
+        let cell = Cell {
+            group: g,
+            strategy: StrategyName::RayonChunks,
+            cores: 2,
+            chunks: Some(10),
+        };
+        assert_eq!(
+            cell.label_with_group(),
+            "rayon-chunks, 2 cores, 10 chunks (preset seed, all-pairs, N = 1000, 1 step)"
+        );
+        assert!(!cell.is_reference());
+    }
+}

@@ -219,4 +219,21 @@ mod tests {
         assert_eq!(rows.len(), 1);
         assert_eq!((rows[0].mean_ci_low_s, rows[0].contended), (None, None));
     }
+
+    #[test]
+    fn a_row_naming_an_unknown_strategy_is_left_out_as_unreadable() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("summary.csv");
+        let header = SUMMARY_COLUMNS[..LEGACY_SUMMARY_COLUMNS].join(",");
+        let row = "all-pairs,seed,60,3,1,,,2,1.5,0.5,1.0,1.5,2.0,1.5,1.0,1.0,0,false,00000000000000aa,ok,";
+        std::fs::write(&path, format!("{header}\nseq,{row}\nturbo,{row}\n")).unwrap();
+        let (rows, bad) = read_summary(&path).unwrap();
+        assert_eq!(rows.len(), 1);
+        assert_eq!(rows[0].strategy, sph_strategies::StrategyName::Seq);
+        assert_eq!(bad.len(), 1);
+        assert!(
+            bad[0].contains("line 3: not a bench-sph summary row"),
+            "{bad:?}"
+        );
+    }
 }

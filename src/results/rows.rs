@@ -280,3 +280,83 @@ pub fn fastest<'a>(
         )
     })
 }
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// A usable summary row for tests.
+    pub(crate) fn row(
+        strategy: StrategyName,
+        cores: usize,
+        chunks: Option<usize>,
+        mean: f64,
+    ) -> SummaryRow {
+        SummaryRow {
+            strategy,
+            neighbors: NeighborMode::AllPairs,
+            preset: Preset::Seed,
+            n: 60,
+            steps: 3,
+            cores,
+            chunks,
+            particles_per_chunk: chunks.map(|k| 60usize.div_ceil(k)),
+            trials: 3,
+            mean_s: Some(mean),
+            stddev_s: Some(mean * 0.01),
+            min_s: Some(mean * 0.9),
+            median_s: Some(mean),
+            max_s: Some(mean * 1.1),
+            cpu_mean_s: Some(mean * cores as f64),
+            speedup: Some(4.0 / mean),
+            efficiency: Some(4.0 / mean / cores as f64),
+            outliers: Some(0),
+            oversubscribed: cores > 2,
+            checksum: "00000000000000aa".to_owned(),
+            status: Status::Ok,
+            reason: String::new(),
+            mean_ci_low_s: Some(mean * 0.98),
+            mean_ci_high_s: Some(mean * 1.02),
+            speedup_ci_low: Some(4.0 / mean * 0.95),
+            speedup_ci_high: Some(4.0 / mean * 1.05),
+            foreign_cpu_mean_s: Some(0.0),
+            contended: Some(false),
+        }
+    }
+
+    #[test]
+    fn the_fastest_cell_skips_failed_ones_and_takes_a_contended_one_only_as_a_last_resort() {
+        let mut contended = row(StrategyName::RayonIter, 2, None, 1.0);
+        contended.contended = Some(true);
+        let mut failed = row(StrategyName::RayonIter, 2, None, 0.5);
+        failed.status = Status::Failed;
+        let calm = row(StrategyName::RayonIter, 2, None, 2.0);
+        let rows = [contended, failed, calm];
+        assert_eq!(
+            fastest(&rows, Contended::Compete).unwrap().mean_s,
+            Some(1.0)
+        );
+        assert_eq!(
+            fastest(&rows, Contended::LastResort).unwrap().mean_s,
+            Some(2.0)
+        );
+        assert_eq!(
+            fastest(&rows[..1], Contended::LastResort).unwrap().mean_s,
+            Some(1.0)
+        );
+        assert!(fastest(&rows[1..2], Contended::Compete).is_none());
+    }
+
+    #[test]
+    fn rows_write_the_names_the_command_line_uses() {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.serialize(row(StrategyName::CrossbeamPool, 2, Some(4), 1.0))
+            .unwrap();
+        let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
+        let line = text.lines().nth(1).unwrap();
+        assert!(
+            line.starts_with("crossbeam-pool,all-pairs,seed,60,3,2,4,"),
+            "{line}"
+        );
+    }
+}
