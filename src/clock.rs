@@ -68,3 +68,29 @@ impl Stopwatch {
         }
     }
 }
+
+/// What other work used of the machine over a window of `window` while this process slept:
+/// (foreign CPU seconds, wall seconds); `None` without `/proc/stat`. Foreign seconds per wall
+/// second is how many hardware threads other work keeps busy.
+pub fn sample_now(window: Duration) -> Option<(f64, f64)> {
+    let watch = Stopwatch::start();
+    std::thread::sleep(window);
+    let elapsed = watch.stop();
+    Some((elapsed.foreign?.cpu_s, elapsed.wall_s))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn on_linux_a_window_reads_the_counters_and_elsewhere_gives_nothing() {
+        let busy = sample_now(Duration::from_millis(20));
+        if std::path::Path::new("/proc/stat").exists() {
+            let (foreign, wall) = busy.expect("Linux has /proc/stat");
+            assert!(foreign >= 0.0 && foreign.is_finite() && wall >= 0.02);
+        } else {
+            assert!(busy.is_none());
+        }
+    }
+}

@@ -11,7 +11,8 @@
 //! - [`plot`]: the bundled font shared by charts and animations;
 //! - [`render`]: animations of the dam break (GIF or PNG frames); `viewer` (cargo feature
 //!   `viewer`): the same, live in a window;
-//! - [`sweep`]: the cores × chunks study (`bench-sph sweep`) and its result files;
+//! - [`sweep`]: the cores × chunks study (`bench-sph sweep`); [`results`]: the schema of its
+//!   results directory, which the sweep writes and the report reads;
 //! - [`report`]: charts and REPORT.md from results directories (`bench-sph report`);
 //! - [`trace`]: per-worker timelines of a few steps (`bench-sph trace`);
 //! - [`cli`]: the `bench-sph` command line.
@@ -26,6 +27,7 @@ pub mod output;
 pub mod plot;
 pub mod render;
 pub mod report;
+pub mod results;
 pub mod run;
 pub mod scene;
 pub mod solver;

@@ -1,6 +1,6 @@
 //! `bench-sph sweep`: the cores × chunks study over every strategy.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::{Arg, Args};
@@ -175,7 +175,6 @@ impl SweepArgs {
         };
         Ok(Request {
             target,
-            no_plots: self.no_plots,
             stop_after_cells: self.stop_after_cells,
             command_line: std::env::args_os()
                 .map(|a| a.to_string_lossy().into_owned())
@@ -184,7 +183,50 @@ impl SweepArgs {
     }
 }
 
-/// Runs `sweep`.
+/// Runs `sweep`, then (when it is complete) `report` on its directory, and prints what it
+/// found, the charts and where everything is: cli → sweep → report, as hyperfine's
+/// cli → run → export.
 pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
-    crate::sweep::run(args.request()?)
+    let finished = crate::sweep::run(args.request()?)?;
+    let charts = if finished.is_complete() {
+        charts(finished.dir(), args.no_plots)
+    } else {
+        Ok(String::new())
+    };
+    // Standard output may be gone (`| head`): the sweep's files are complete by now, so
+    // printing failures are ignored and the sweep ends with its status.
+    let mut text = finished.best_text();
+    if let Ok(charts) = &charts {
+        text.push_str(charts);
+        text.push('\n');
+    }
+    text.push_str(&finished.paths_text());
+    let _ = crate::output::console::line(text.trim_end());
+    charts?;
+    finished.outcome()
+}
+
+/// The one place where a finished sweep's charts are made: `bench-sph report` on the sweep's
+/// directory, writing into it. A drawing failure is an error, but the CSVs and meta.json are
+/// already complete by then.
+fn charts(dir: &Path, no_plots: bool) -> anyhow::Result<String> {
+    if no_plots {
+        return Ok("Charts: skipped (--no-plots).".to_owned());
+    }
+    // The sweep has claimed its directory already (foreign files stay only where its own
+    // --force allowed them): the report writes beside them, never over them.
+    let written =
+        crate::report::generate(&[dir.to_path_buf()], dir, &[], true).with_context(|| {
+            format!(
+                "the charts and REPORT.md could not be made (the results in '{}' are complete; \
+             retry with `bench-sph report {}`)",
+                dir.display(),
+                dir.display()
+            )
+        })?;
+    let mut text = format!("Charts and report ({} files):", written.len());
+    for p in &written {
+        text.push_str(&format!("\n  {}", p.display()));
+    }
+    Ok(text)
 }

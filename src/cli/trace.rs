@@ -358,16 +358,10 @@ fn pass_lines(stats: &Stats) -> Vec<String> {
     lines
 }
 
+/// The smallest and the median of `v` (NaN for none).
 fn min_median(v: &[f64]) -> (f64, f64) {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    let mid = s.len() / 2;
-    let median = if s.len() % 2 == 1 {
-        s[mid]
-    } else {
-        (s[mid - 1] + s[mid]) / 2.0
-    };
-    (s[0], median)
+    let min = v.iter().copied().min_by(f64::total_cmp).unwrap_or(f64::NAN);
+    (min, crate::results::stats::median(v))
 }
 
 /// The measured comparison, and the estimate from the calibrated cost per kernel call

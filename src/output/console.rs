@@ -3,7 +3,7 @@
 //! Rust's `println!` panics when standard output is gone. Commands print through [`line()`]
 //! instead: a failed write returns the error, and records that standard output is closed
 //! ([`closed`]) so that a long command (a sweep) can stop cleanly, as after Ctrl-C, keeping
-//! what it finished.
+//! what it finished. [`plural`] words a count the one way every command's messages share.
 
 use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -30,4 +30,9 @@ pub fn closed() -> bool {
 /// a command).
 pub fn warn(text: &str) {
     let _ = writeln!(std::io::stderr().lock(), "{text}");
+}
+
+/// `1 warm-up` / `3 warm-ups`, and so on.
+pub fn plural(count: usize, one: &str, many: &str) -> String {
+    format!("{count} {}", if count == 1 { one } else { many })
 }

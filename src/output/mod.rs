@@ -6,8 +6,11 @@
 //! - [`claim`]: a command that writes into a directory first checks what the directory
 //!   holds, refuses one holding files it did not write (unless `--force`, and even then
 //!   replaces only its own), and removes its own stale files afterwards;
-//! - [`console`]: standard output that may be closed under us (`| head`, `> /dev/full`).
+//! - [`console`]: standard output that may be closed under us (`| head`, `> /dev/full`);
+//! - [`sniff`]: recognising a file by its first bytes, so that only a command's own files are
+//!   replaced.
 
 pub mod atomic;
 pub mod claim;
 pub mod console;
+pub mod sniff;

@@ -11,23 +11,24 @@
 
 use super::numbers::{interval, percent, secs, times};
 use super::paper;
-use super::series::{self, Best, GroupKey};
-use crate::sweep::rows::SummaryRow;
+use super::series::{self, Best, Group};
+use crate::results::rows::SummaryRow;
+use sph_strategies::StrategyName;
 
 /// The sentences for group `g` of `rows`.
-pub fn findings(rows: &[SummaryRow], g: &GroupKey) -> Vec<String> {
-    let strategies: Vec<String> = series::strategies(rows, g)
+pub fn findings(rows: &[SummaryRow], g: &Group) -> Vec<String> {
+    let strategies: Vec<StrategyName> = series::strategies(rows, g)
         .into_iter()
-        .filter(|s| s != "seq")
+        .filter(|&s| s != StrategyName::Seq)
         .collect();
-    let bests: Vec<(String, Vec<Best>)> = strategies
+    let bests: Vec<(StrategyName, Vec<Best>)> = strategies
         .iter()
-        .map(|s| (s.clone(), series::best_per_cores(rows, g, s)))
+        .map(|&s| (s, series::best_per_cores(rows, g, s)))
         .collect();
     // A contended reference makes every speedup doubtful: none enters a finding then.
     let seq_trusted = !rows
         .iter()
-        .any(|r| g.contains(r) && r.strategy == "seq" && r.contended == Some(true));
+        .any(|r| r.group() == *g && r.is_reference() && r.contended == Some(true));
     let mut out = Vec::new();
     if !seq_trusted {
         out.push(
@@ -54,11 +55,68 @@ pub fn findings(rows: &[SummaryRow], g: &GroupKey) -> Vec<String> {
     out
 }
 
-/// Who is fastest at `cores`, if anyone can be said to be.
-fn winner(cores: usize, at: &[(&str, &Best)], seq_trusted: bool) -> Option<String> {
+/// A strategy's best cell at one core count.
+type Entry<'a> = (&'a str, &'a Best);
+
+/// What can be said about the fastest strategy at one core count, from the cells measured
+/// without contention (fastest first).
+#[derive(Debug, Clone, PartialEq)]
+enum Verdict<'a> {
+    /// Only one cell.
+    Only(Entry<'a>),
+    /// Several, but some without confidence intervals: the lowest mean only.
+    NoIntervals(Entry<'a>),
+    /// The fastest cell's interval overlaps no other's.
+    Fastest {
+        /// The fastest.
+        winner: Entry<'a>,
+        /// The second fastest.
+        runner_up: Entry<'a>,
+    },
+    /// The fastest cell's interval overlaps these (the fastest first).
+    Tied {
+        /// The cells whose intervals overlap the fastest one's, and it.
+        tied: Vec<Entry<'a>>,
+        /// How many are slower beyond the overlap.
+        slower: usize,
+    },
+}
+
+/// The verdict on `trusted` (sorted fastest first); `None` when it is empty.
+fn verdict<'a>(trusted: &[Entry<'a>]) -> Option<Verdict<'a>> {
+    let &first = trusted.first()?;
+    if trusted.len() == 1 {
+        return Some(Verdict::Only(first));
+    }
+    if trusted.iter().any(|(_, b)| b.mean_ci.is_none()) {
+        return Some(Verdict::NoIntervals(first));
+    }
+    let mut tied = vec![first];
+    tied.extend(
+        trusted[1..]
+            .iter()
+            .copied()
+            .filter(|(_, b)| match (first.1.mean_ci, b.mean_ci) {
+                (Some(a), Some(o)) => a.overlaps(&o),
+                _ => true,
+            }),
+    );
+    Some(if tied.len() == 1 {
+        Verdict::Fastest {
+            winner: first,
+            runner_up: trusted[1],
+        }
+    } else {
+        let slower = trusted.len() - tied.len();
+        Verdict::Tied { tied, slower }
+    })
+}
+
+/// Who is fastest at `cores`, if anyone can be said to be, as a sentence.
+// Over ~60 lines on purpose: one sentence per verdict ([`verdict`] decides; this only words it).
+fn winner(cores: usize, at: &[Entry<'_>], seq_trusted: bool) -> Option<String> {
     let contended = at.iter().filter(|(_, b)| b.contended).count();
-    let mut trusted: Vec<(&str, &Best)> =
-        at.iter().copied().filter(|(_, b)| !b.contended).collect();
+    let mut trusted: Vec<Entry<'_>> = at.iter().copied().filter(|(_, b)| !b.contended).collect();
     trusted.sort_by(|a, b| a.1.mean_s.total_cmp(&b.1.mean_s));
     let left_out = match contended {
         0 => String::new(),
@@ -74,8 +132,7 @@ fn winner(cores: usize, at: &[(&str, &Best)], seq_trusted: bool) -> Option<Strin
             ""
         }
     );
-    let &(w, wb) = trusted.first()?;
-    let describe = |s: &str, b: &Best| {
+    let describe = |(s, b): Entry<'_>| {
         format!(
             "{s}{} ({} s{})",
             b.chunks
@@ -84,62 +141,48 @@ fn winner(cores: usize, at: &[(&str, &Best)], seq_trusted: bool) -> Option<Strin
             interval(b.mean_ci)
         )
     };
-    if trusted.len() == 1 {
-        let only = if contended > 0 {
-            "was measured without contention"
-        } else {
-            "was measured"
-        };
-        return Some(format!(
-            "{where_}, only {} {only}{left_out}.",
-            describe(w, wb)
-        ));
-    }
-    if trusted.iter().any(|(_, b)| b.mean_ci.is_none()) {
-        return Some(format!(
+    Some(match verdict(&trusted)? {
+        Verdict::Only(w) => {
+            let only = if contended > 0 {
+                "was measured without contention"
+            } else {
+                "was measured"
+            };
+            format!("{where_}, only {} {only}{left_out}.", describe(w))
+        }
+        Verdict::NoIntervals(w) => format!(
             "{where_}, the lowest mean is {}, but these cells have no confidence intervals (one \
              trial, or a sweep older than them), so no strategy can be called fastest{left_out}.",
-            describe(w, wb)
-        ));
-    }
-    let ties: Vec<(&str, &Best)> = trusted[1..]
-        .iter()
-        .copied()
-        .filter(|(_, b)| match (wb.mean_ci, b.mean_ci) {
-            (Some(a), Some(o)) => a.overlaps(&o),
-            _ => true,
-        })
-        .collect();
-    if ties.is_empty() {
-        let (r, rb) = trusted[1];
-        // At one core a speedup is the reference's noise (said separately), not a result.
-        let speed = wb
-            .speedup
-            .filter(|_| cores > 1 && seq_trusted)
-            .map_or_else(String::new, |s| {
-                format!(", {}{} over seq", times(s), interval(wb.speedup_ci))
-            });
-        return Some(format!(
-            "{where_}, **{}** is fastest{speed}; its 95 % interval does not overlap the \
-             runner-up {}, which takes {} more time{left_out}.",
-            describe(w, wb),
-            describe(r, rb),
-            percent((rb.mean_s - wb.mean_s) / wb.mean_s * 100.0)
-        ));
-    }
-    let mut names = vec![describe(w, wb)];
-    names.extend(ties.iter().map(|(s, b)| describe(s, b)));
-    let rest = trusted.len() - 1 - ties.len();
-    Some(format!(
-        "{where_}, {} are indistinguishable within the trial spread (their 95 % intervals \
-         overlap){}{left_out}.",
-        and_list(&names),
-        match rest {
-            0 => String::new(),
-            1 => "; the other strategy is slower".to_owned(),
-            _ => "; the others are slower".to_owned(),
+            describe(w)
+        ),
+        Verdict::Fastest { winner, runner_up } => {
+            let (wb, rb) = (winner.1, runner_up.1);
+            // At one core a speedup is the reference's noise (said separately), not a result.
+            let speed = wb
+                .speedup
+                .filter(|_| cores > 1 && seq_trusted)
+                .map_or_else(String::new, |s| {
+                    format!(", {}{} over seq", times(s), interval(wb.speedup_ci))
+                });
+            format!(
+                "{where_}, **{}** is fastest{speed}; its 95 % interval does not overlap the \
+                 runner-up {}, which takes {} more time{left_out}.",
+                describe(winner),
+                describe(runner_up),
+                percent((rb.mean_s - wb.mean_s) / wb.mean_s * 100.0)
+            )
         }
-    ))
+        Verdict::Tied { tied, slower } => format!(
+            "{where_}, {} are indistinguishable within the trial spread (their 95 % intervals \
+             overlap){}{left_out}.",
+            and_list(&tied.into_iter().map(describe).collect::<Vec<_>>()),
+            match slower {
+                0 => String::new(),
+                1 => "; the other strategy is slower".to_owned(),
+                _ => "; the others are slower".to_owned(),
+            }
+        ),
+    })
 }
 
 /// `a`, `a and b`, `a, b and c`.
@@ -168,9 +211,12 @@ fn one_core_noise(at: &[(&str, &Best)]) -> Vec<String> {
 }
 
 /// Where more chunks stop paying, per chunked strategy.
-fn chunking(rows: &[SummaryRow], g: &GroupKey, strategies: &[String]) -> Vec<String> {
+fn chunking(rows: &[SummaryRow], g: &Group, strategies: &[StrategyName]) -> Vec<String> {
     let mut out = Vec::new();
-    for s in strategies.iter().filter(|s| series::is_chunked(rows, g, s)) {
+    for &s in strategies
+        .iter()
+        .filter(|&&s| series::is_chunked(rows, g, s))
+    {
         let parts: Vec<String> = series::chunk_table(rows, g, s)
             .iter()
             .filter(|(_, v)| v.len() > 1)
@@ -192,7 +238,7 @@ fn chunking(rows: &[SummaryRow], g: &GroupKey, strategies: &[String]) -> Vec<Str
 
 /// The serial fraction of the fastest trusted cell at the most cores not oversubscribed,
 /// where it means something.
-fn karp_flatt(bests: &[(String, Vec<Best>)]) -> Option<String> {
+fn karp_flatt(bests: &[(StrategyName, Vec<Best>)]) -> Option<String> {
     let (s, b) = bests
         .iter()
         .flat_map(|(s, b)| b.iter().map(move |b| (s.as_str(), b)))
@@ -217,10 +263,10 @@ fn karp_flatt(bests: &[(String, Vec<Best>)]) -> Option<String> {
 /// The paper's published speedups beside ours, where comparable.
 fn against_paper(
     rows: &[SummaryRow],
-    g: &GroupKey,
-    bests: &[(String, Vec<Best>)],
+    g: &Group,
+    bests: &[(StrategyName, Vec<Best>)],
 ) -> Option<String> {
-    if !paper::comparable(&g.preset, &g.neighbors) {
+    if !paper::comparable(g) {
         return None;
     }
     let mut parts = Vec::new();
@@ -257,7 +303,7 @@ fn against_paper(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::series::tests::row;
+    use crate::results::rows::tests::row;
 
     fn with_ci(mut r: SummaryRow, low: f64, high: f64) -> SummaryRow {
         r.mean_ci_low_s = Some(low);
@@ -268,11 +314,11 @@ mod tests {
     #[test]
     fn overlapping_intervals_name_no_winner() {
         let rows = vec![
-            row("seq", 1, None, 4.0),
-            with_ci(row("rayon-chunks", 2, Some(10), 2.2), 2.0, 2.4),
-            with_ci(row("rayon-iter", 2, None, 2.3), 2.1, 2.5),
+            row(StrategyName::Seq, 1, None, 4.0),
+            with_ci(row(StrategyName::RayonChunks, 2, Some(10), 2.2), 2.0, 2.4),
+            with_ci(row(StrategyName::RayonIter, 2, None, 2.3), 2.1, 2.5),
         ];
-        let f = findings(&rows, &series::GroupKey::of(&rows[0]));
+        let f = findings(&rows, &rows[0].group());
         assert!(
             f[0].contains("indistinguishable within the trial spread") && !f[0].contains("fastest"),
             "{}",
@@ -283,11 +329,11 @@ mod tests {
     #[test]
     fn separate_intervals_name_the_fastest_with_its_margin() {
         let rows = vec![
-            row("seq", 1, None, 4.0),
-            with_ci(row("rayon-chunks", 2, Some(10), 2.2), 2.1, 2.3),
-            with_ci(row("rayon-iter", 2, None, 2.6), 2.5, 2.7),
+            row(StrategyName::Seq, 1, None, 4.0),
+            with_ci(row(StrategyName::RayonChunks, 2, Some(10), 2.2), 2.1, 2.3),
+            with_ci(row(StrategyName::RayonIter, 2, None, 2.6), 2.5, 2.7),
         ];
-        let f = findings(&rows, &series::GroupKey::of(&rows[0]));
+        let f = findings(&rows, &rows[0].group());
         assert!(
             f[0].starts_with(
                 "At 2 cores, **rayon-chunks with 10 chunks (2.20 s [2.10–2.30])** is fastest"
@@ -300,14 +346,14 @@ mod tests {
 
     #[test]
     fn contended_cells_enter_no_finding() {
-        let mut fast = with_ci(row("rayon-iter", 2, None, 1.0), 0.9, 1.1);
+        let mut fast = with_ci(row(StrategyName::RayonIter, 2, None, 1.0), 0.9, 1.1);
         fast.contended = Some(true);
         let rows = vec![
-            row("seq", 1, None, 4.0),
-            with_ci(row("rayon-chunks", 2, Some(10), 2.2), 2.1, 2.3),
+            row(StrategyName::Seq, 1, None, 4.0),
+            with_ci(row(StrategyName::RayonChunks, 2, Some(10), 2.2), 2.1, 2.3),
             fast,
         ];
-        let f = findings(&rows, &series::GroupKey::of(&rows[0]));
+        let f = findings(&rows, &rows[0].group());
         assert!(
             f[0].contains("only rayon-chunks") && f[0].contains("1 contended cell left out"),
             "{}",
@@ -318,11 +364,11 @@ mod tests {
     #[test]
     fn a_one_core_speedup_above_one_is_called_noise_and_karp_flatt_never_extrapolates() {
         let rows = vec![
-            row("seq", 1, None, 4.0),
-            row("rayon-chunks", 1, Some(10), 3.9),
-            row("rayon-chunks", 2, Some(10), 2.2),
+            row(StrategyName::Seq, 1, None, 4.0),
+            row(StrategyName::RayonChunks, 1, Some(10), 3.9),
+            row(StrategyName::RayonChunks, 2, Some(10), 2.2),
         ];
-        let f = findings(&rows, &series::GroupKey::of(&rows[0])).join("\n");
+        let f = findings(&rows, &rows[0].group()).join("\n");
         assert!(f.contains("at 1 core is noise in the seq reference"), "{f}");
         assert!(f.contains("e = 0.100"), "{f}");
         assert!(!f.contains("no number of cores"), "{f}");
@@ -330,10 +376,10 @@ mod tests {
 
     #[test]
     fn a_contended_reference_gives_no_speedup_finding() {
-        let mut seq = row("seq", 1, None, 4.0);
+        let mut seq = row(StrategyName::Seq, 1, None, 4.0);
         seq.contended = Some(true);
-        let rows = vec![seq, row("rayon-chunks", 2, Some(10), 2.2)];
-        let f = findings(&rows, &series::GroupKey::of(&rows[0])).join("\n");
+        let rows = vec![seq, row(StrategyName::RayonChunks, 2, Some(10), 2.2)];
+        let f = findings(&rows, &rows[0].group()).join("\n");
         assert!(f.contains("The seq reference was contended"), "{f}");
         assert!(!f.contains("Karp–Flatt") && !f.contains("over seq"), "{f}");
         assert!(!f.contains("paper's"), "{f}");
@@ -341,8 +387,11 @@ mod tests {
 
     #[test]
     fn no_karp_flatt_without_a_speedup_above_one() {
-        let rows = vec![row("seq", 1, None, 4.0), row("rayon-iter", 2, None, 5.0)];
-        let f = findings(&rows, &series::GroupKey::of(&rows[0])).join("\n");
+        let rows = vec![
+            row(StrategyName::Seq, 1, None, 4.0),
+            row(StrategyName::RayonIter, 2, None, 5.0),
+        ];
+        let f = findings(&rows, &rows[0].group()).join("\n");
         assert!(!f.contains("Karp–Flatt"), "{f}");
     }
 }

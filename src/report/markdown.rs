@@ -6,26 +6,18 @@ use std::fmt::Write as _;
 use super::load::Sweep;
 use super::numbers::{interval, sig};
 use super::paper;
-use super::series::{self, Best, GroupKey};
+use super::plan::ChartPlan;
+use super::series::{self, Best, Group};
 use super::traces::TraceDir;
-use crate::sweep::rows::{Status, SummaryRow};
-
-/// A chart as the report embeds it.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ChartRef {
-    /// The group it belongs to (`None` for charts across groups).
-    pub group: Option<GroupKey>,
-    /// File name, relative to the report.
-    pub file: String,
-    /// One-sentence caption.
-    pub caption: String,
-}
+use crate::results::key::LabelStyle;
+use crate::results::rows::{Status, SummaryRow};
+use sph_strategies::StrategyName;
 
 /// A chart that does not apply, and why.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Skipped {
     /// The group (`None` for charts across groups).
-    pub group: Option<GroupKey>,
+    pub group: Option<Group>,
     /// E.g. `Chart 6 (all-pairs vs grid)`, and why it is not drawn.
     pub note: String,
 }
@@ -36,7 +28,7 @@ pub struct Input<'a> {
     /// The sweeps, in the order given.
     pub sweeps: &'a [Sweep],
     /// Charts drawn.
-    pub charts: &'a [ChartRef],
+    pub charts: &'a [ChartPlan],
     /// Charts not drawn.
     pub skipped: &'a [Skipped],
     /// Traces to embed.
@@ -66,9 +58,9 @@ pub fn render(input: &Input<'_>) -> String {
          resamples; with few trials it is, if anything, too narrow); speedup is the group's \
          `seq` mean over a cell's mean; efficiency is speedup / cores. Numbers show at most \
          three significant digits.\n",
-        crate::sweep::meta::GIT_COMMIT,
+        crate::results::meta::GIT_COMMIT,
         dirs.join(", "),
-        crate::sweep::console::plural(rows.len(), "cell", "cells"),
+        crate::output::console::plural(rows.len(), "cell", "cells"),
         series::groups(&rows).len(),
         if series::groups(&rows).len() == 1 {
             "group"
@@ -101,17 +93,18 @@ pub fn render(input: &Input<'_>) -> String {
 /// What a reader must know before any number: a partial study, contended cells, cells
 /// dropped as impossible.
 fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
-    use crate::sweep::meta::SweepStatus;
+    use crate::results::meta::SweepStatus;
     for s in sweeps {
         let measured = s.rows.len() + s.dropped.len();
         if s.meta.status == SweepStatus::Complete && measured >= s.meta.planned_cells {
             continue;
         }
-        let mut planned: Vec<&str> = vec!["seq"];
-        planned.extend(s.meta.params.strategies.iter().map(|x| x.as_str()));
+        let mut planned = vec![StrategyName::Seq];
+        planned.extend(&s.meta.params.strategies);
         let never: Vec<&str> = planned
             .into_iter()
-            .filter(|p| !s.rows.iter().any(|r| r.strategy == *p))
+            .filter(|&p| !s.rows.iter().any(|r| r.strategy == p))
+            .map(StrategyName::as_str)
             .collect();
         let _ = writeln!(
             md,
@@ -129,6 +122,12 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
             s.dir.display()
         );
     }
+    contended_banner(md, rows);
+    dropped_banner(md, sweeps);
+}
+
+/// The banner over a study with contended cells.
+fn contended_banner(md: &mut String, rows: &[SummaryRow]) {
     let contended: Vec<&SummaryRow> = rows.iter().filter(|r| r.contended == Some(true)).collect();
     if !contended.is_empty() {
         let _ = writeln!(
@@ -137,7 +136,7 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
              measured, so {} not trustworthy. They are marked {CONTENDED} in the tables and \
              ringed in red in the charts, and left out of every finding. Measure again on a \
              quiet machine.\n",
-            crate::sweep::console::plural(contended.len(), "cell was", "cells were"),
+            crate::output::console::plural(contended.len(), "cell was", "cells were"),
             (crate::contention::CONTENDED_SHARE * 100.0).round(),
             if contended.len() == 1 {
                 "it was"
@@ -151,6 +150,10 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
             },
         );
     }
+}
+
+/// The banner listing rows left out as unreadable or impossible.
+fn dropped_banner(md: &mut String, sweeps: &[Sweep]) {
     let dropped: Vec<String> = sweeps
         .iter()
         .flat_map(|s| {
@@ -165,7 +168,7 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
             "> ⚠ **{} left out** as unreadable or impossible (a line cut off or garbled, \
              numbers not finite and positive, or statistics \
              that are not those of the trial rows):",
-            crate::sweep::console::plural(dropped.len(), "row", "rows")
+            crate::output::console::plural(dropped.len(), "row", "rows")
         );
         for d in dropped {
             let _ = writeln!(md, "> - {d}");
@@ -183,8 +186,22 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
         rule.push_str("---|");
     }
     let _ = writeln!(md, "{header}\n{rule}");
-    type Field = fn(&Sweep) -> String;
-    let fields: [(&str, Field); 12] = [
+    for (name, f) in machine_fields() {
+        let mut line = format!("| {name} |");
+        for s in sweeps {
+            let _ = write!(line, " {} |", f(s));
+        }
+        let _ = writeln!(md, "{line}");
+    }
+    md.push('\n');
+}
+
+/// A row of the machine table: its name and its value for one sweep.
+type Field = fn(&Sweep) -> String;
+
+/// The rows of the machine table, in order.
+fn machine_fields() -> [(&'static str, Field); 12] {
+    [
         ("CPU", |s| s.meta.machine.cpu_model.clone()),
         ("hardware threads", |s| {
             s.meta.machine.hardware_threads.to_string()
@@ -233,27 +250,48 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
             }
             format!("`{}`", c.replace('|', "\\|"))
         }),
-    ];
-    for (name, f) in fields {
-        let mut line = format!("| {name} |");
-        for s in sweeps {
-            let _ = write!(line, " {} |", f(s));
-        }
-        let _ = writeln!(md, "{line}");
-    }
-    md.push('\n');
+    ]
 }
 
-fn charts_of<'a>(input: &'a Input<'_>, g: Option<&GroupKey>) -> impl Iterator<Item = &'a ChartRef> {
+fn charts_of<'a>(input: &'a Input<'_>, g: Option<&Group>) -> impl Iterator<Item = &'a ChartPlan> {
     let g = g.cloned();
     input.charts.iter().filter(move |c| c.group == g)
 }
 
-fn group(md: &mut String, rows: &[SummaryRow], g: &GroupKey, input: &Input<'_>) {
-    let _ = writeln!(md, "## {}\n", g.label());
+/// One group's section: its reference, the paper's context, the best-cell tables, the
+/// findings and the charts.
+fn group(md: &mut String, rows: &[SummaryRow], g: &Group, input: &Input<'_>) {
+    let _ = writeln!(md, "## {}\n", g.label(LabelStyle::Report));
+    reference(md, rows, g);
+    let comparable = paper::comparable(g);
+    if comparable {
+        paper_context(md, g);
+    }
+    let _ = writeln!(md, "### Best cell per core count (Table 1 analogue)\n");
+    for s in series::strategies(rows, g)
+        .into_iter()
+        .filter(|&s| s != StrategyName::Seq)
+    {
+        let best = series::best_per_cores(rows, g, s);
+        if best.is_empty() {
+            let _ = writeln!(md, "**{s}**: no successful cell.\n");
+            continue;
+        }
+        table(md, s, &best, comparable && series::is_chunked(rows, g, s));
+    }
+    let _ = writeln!(md, "### Findings\n");
+    for sentence in super::findings::findings(rows, g) {
+        let _ = writeln!(md, "- {sentence}");
+    }
+    md.push('\n');
+    group_charts(md, g, input);
+}
+
+/// The group's `seq` reference, or that there is none.
+fn reference(md: &mut String, rows: &[SummaryRow], g: &Group) {
     if let Some(r) = rows
         .iter()
-        .find(|r| g.contains(r) && r.strategy == "seq" && series::usable(r))
+        .find(|r| r.group() == *g && r.is_reference() && r.is_usable())
     {
         let _ = writeln!(
             md,
@@ -274,42 +312,33 @@ fn group(md: &mut String, rows: &[SummaryRow], g: &GroupKey, input: &Input<'_>) 
             "No usable `seq` reference cell: speedups are undefined.\n"
         );
     }
-    let comparable = paper::comparable(&g.preset, &g.neighbors);
-    if comparable {
-        let _ = writeln!(
-            md,
-            "Beside each table: the paper's Table 1 (the seed Haskell program with \
-             `parListChunk`, {}, N = {}, {} steps, all-pairs, serial {} s). **Speedups compare; \
-             absolute times do not** — another program on another machine{}.\n",
-            paper::MACHINE,
-            paper::N,
-            paper::STEPS,
-            sig(paper::SERIAL_S),
-            if g.n != paper::N || g.steps != paper::STEPS {
-                format!(
-                    ", and this group's N = {}, {} steps differ from the paper's",
-                    g.n, g.steps
-                )
-            } else {
-                String::new()
-            }
-        );
-    }
-    let _ = writeln!(md, "### Best cell per core count (Table 1 analogue)\n");
-    for s in series::strategies(rows, g).iter().filter(|s| *s != "seq") {
-        let best = series::best_per_cores(rows, g, s);
-        if best.is_empty() {
-            let _ = writeln!(md, "**{s}**: no successful cell.\n");
-            continue;
+}
+
+/// What the paper measured, beside which the tables set this group's cells.
+fn paper_context(md: &mut String, g: &Group) {
+    let _ = writeln!(
+        md,
+        "Beside each table: the paper's Table 1 (the seed Haskell program with \
+         `parListChunk`, {}, N = {}, {} steps, all-pairs, serial {} s). **Speedups compare; \
+         absolute times do not** — another program on another machine{}.\n",
+        paper::MACHINE,
+        paper::N,
+        paper::STEPS,
+        sig(paper::SERIAL_S),
+        if g.n != paper::N || g.steps != paper::STEPS {
+            format!(
+                ", and this group's N = {}, {} steps differ from the paper's",
+                g.n, g.steps
+            )
+        } else {
+            String::new()
         }
-        table(md, s, &best, comparable && series::is_chunked(rows, g, s));
-    }
-    let _ = writeln!(md, "### Findings\n");
-    for sentence in super::findings::findings(rows, g) {
-        let _ = writeln!(md, "- {sentence}");
-    }
-    md.push('\n');
-    let charts: Vec<&ChartRef> = charts_of(input, Some(g)).collect();
+    );
+}
+
+/// The group's charts with their captions, then the notes on those not drawn.
+fn group_charts(md: &mut String, g: &Group, input: &Input<'_>) {
+    let charts: Vec<&ChartPlan> = charts_of(input, Some(g)).collect();
     if !charts.is_empty() {
         let _ = writeln!(md, "### Charts\n");
         for c in charts {
@@ -330,7 +359,8 @@ fn group(md: &mut String, rows: &[SummaryRow], g: &GroupKey, input: &Input<'_>) 
     }
 }
 
-fn table(md: &mut String, strategy: &str, best: &[Best], with_paper: bool) {
+// Over ~60 lines on purpose: the table with and without the paper's columns, row by row; the two layouts share every row.
+fn table(md: &mut String, strategy: StrategyName, best: &[Best], with_paper: bool) {
     let _ = writeln!(md, "**{strategy}**\n");
     if with_paper {
         let _ = writeln!(
@@ -404,7 +434,7 @@ fn alt(caption: &str) -> &str {
 }
 
 fn across_groups(md: &mut String, input: &Input<'_>) {
-    let charts: Vec<&ChartRef> = charts_of(input, None).collect();
+    let charts: Vec<&ChartPlan> = charts_of(input, None).collect();
     let skipped: Vec<&Skipped> = input.skipped.iter().filter(|s| s.group.is_none()).collect();
     if charts.is_empty() && skipped.is_empty() {
         return;
@@ -444,7 +474,7 @@ fn failed(md: &mut String, rows: &[SummaryRow]) {
         let _ = writeln!(
             md,
             "| {} | {} | {} | {} | {} |",
-            GroupKey::of(r).label(),
+            r.group().label(LabelStyle::Report),
             r.strategy,
             r.cores,
             r.chunks.map_or_else(|| "—".to_owned(), |k| k.to_string()),
@@ -457,17 +487,17 @@ fn failed(md: &mut String, rows: &[SummaryRow]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::series::tests::row;
+    use crate::results::rows::tests::row;
 
     #[test]
     fn an_oversubscribed_best_cell_is_flagged_in_the_table() {
         let best = series::best_per_cores(
-            &[row("rayon-iter", 3, None, 2.0)],
-            &GroupKey::of(&row("seq", 1, None, 1.0)),
-            "rayon-iter",
+            &[row(StrategyName::RayonIter, 3, None, 2.0)],
+            &row(StrategyName::Seq, 1, None, 1.0).group(),
+            StrategyName::RayonIter,
         );
         let mut md = String::new();
-        table(&mut md, "rayon-iter", &best, false);
+        table(&mut md, StrategyName::RayonIter, &best, false);
         assert!(
             md.contains(
                 "| 3 ⚠ oversubscribed | — | 2.00 [1.96–2.04] | 2.00× [1.90–2.10] | 0.667 |"

@@ -1,7 +1,8 @@
 //! `bench-sph report`: a results directory (or several) becomes PNG charts and `REPORT.md`.
 //!
-//! The pipeline: [`load`] reads `meta.json` and `summary.csv` into the sweep's own types;
-//! [`series`] turns rows into the series each chart and table needs (pure); [`charts`] draws
+//! The pipeline: [`crate::results::load`] reads `meta.json` and `summary.csv`;
+//! [`series`] turns rows into the series each chart and table needs and [`plan`] into the
+//! charts to draw, with their captions (both pure); [`charts`] draws
 //! them (one file per chart kind, [`charts::WIDTH`] × [`charts::HEIGHT`] PNGs in the bundled
 //! font); [`traces`] finds trace directories to embed; [`markdown`] writes the report's text
 //! (pure); [`paper`] holds the seed paper's published numbers.
@@ -24,10 +25,10 @@
 
 pub mod charts;
 pub mod findings;
-pub mod load;
 pub mod markdown;
 pub mod numbers;
 pub mod paper;
+pub mod plan;
 pub mod series;
 pub mod traces;
 
@@ -35,54 +36,15 @@ use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 
-use markdown::{ChartRef, Skipped};
-use series::{GroupKey, Metric};
-
-/// The report's file name.
-pub const REPORT_FILE: &str = "REPORT.md";
-
-/// Whether a file is one `bench-sph report` writes, by name **and** contents, so that a
-/// user's file that merely has a similar name is never replaced or removed: a `REPORT.md`
-/// that starts with `# bench-sph report`, a chart (`<preset>-….png`, a PNG of the charts'
-/// size) or a copied timeline (`…-timeline.png`, a PNG of the timelines' width). A sweep
-/// that draws its report owns these too.
-pub fn is_own_file(path: &Path) -> bool {
-    use crate::sph::params::Preset;
-    let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
-        return false;
-    };
-    if name == REPORT_FILE {
-        return crate::trace::files::starts_with(path, b"# bench-sph report");
-    }
-    if !name.ends_with(".png") {
-        return false;
-    }
-    if name.ends_with("-timeline.png") {
-        return png_size(path).is_some_and(|(w, _)| w == crate::trace::timeline::WIDTH);
-    }
-    Preset::ALL
-        .iter()
-        .any(|p| name.starts_with(&format!("{}-", p.as_str())))
-        && png_size(path) == Some((charts::WIDTH, charts::HEIGHT))
-}
-
-/// Width and height from a PNG file's header, if it is one.
-fn png_size(path: &Path) -> Option<(u32, u32)> {
-    use std::io::Read;
-    let mut head = [0u8; 24];
-    std::fs::File::open(path).ok()?.read_exact(&mut head).ok()?;
-    if head[..8] != crate::trace::files::PNG_SIGNATURE || &head[12..16] != b"IHDR" {
-        return None;
-    }
-    let word = |i: usize| u32::from_be_bytes([head[i], head[i + 1], head[i + 2], head[i + 3]]);
-    Some((word(16), word(20)))
-}
+use crate::results::load;
+pub use crate::results::{REPORT_FILE, is_report_file};
+use plan::ChartKind;
 
 /// Whether an entry of a report's directory may stay beside the report: a sweep's own files
 /// (the report is often drawn into the sweep's directory) and any directory (traces; the
 /// report never writes into subdirectories).
 fn tolerated(path: &Path) -> bool {
-    use crate::sweep::{META_FILE, SUMMARY_FILE, TRIALS_FILE, lock::LOCK_FILE};
+    use crate::results::{LOCK_FILE, META_FILE, SUMMARY_FILE, TRIALS_FILE};
     path.is_dir()
         || path
             .file_name()
@@ -114,7 +76,7 @@ pub fn generate(
             ));
         }
     }
-    let owns = |p: &Path| p.is_file() && is_own_file(p);
+    let owns = |p: &Path| p.is_file() && is_report_file(p);
     let owner = crate::output::claim::Owner {
         command: "bench-sph report",
         option: "--out",
@@ -125,201 +87,36 @@ pub fn generate(
     claimed.check_writable(REPORT_FILE)?;
     let rows: Vec<_> = sweeps.iter().flat_map(|s| s.rows.clone()).collect();
 
+    let planned = plan::plan(&rows);
     let mut written = Vec::new();
-    let mut refs = Vec::new();
-    let mut skipped = Vec::new();
-    let mut chart = |file: String, group: Option<&GroupKey>, caption: String| {
-        refs.push(ChartRef {
-            group: group.cloned(),
-            file: file.clone(),
-            caption,
-        });
-        claimed.check_writable(&file)
-    };
-
-    for g in series::groups(&rows) {
-        let subtitle = g.label();
-        let skip = |note: String| Skipped {
-            group: Some(g.clone()),
-            note,
-        };
-        let strategies = series::strategies(&rows, &g);
-        let chunked: Vec<&String> = strategies
-            .iter()
-            .filter(|s| series::is_chunked(&rows, &g, s))
-            .collect();
-        if chunked.is_empty() {
-            skipped.push(skip(
-                "Charts 1–2 (time against chunks) are not drawn: no strategy with chunks was \
-                 measured in this group."
-                    .to_owned(),
-            ));
-        }
-        for s in chunked {
-            for (metric, n, what, y_desc) in [
-                (Metric::Wall, 1, "runtime", "mean runtime (s)"),
-                (Metric::Cpu, 2, "cpu", "mean CPU time, user + sys (s)"),
-            ] {
-                let lines = series::chunk_lines(&rows, &g, s, metric);
-                if lines.is_empty() {
-                    continue;
-                }
-                let (title, caption) = match metric {
-                    Metric::Wall => (
-                        format!("Runtime against chunks: {s}"),
-                        format!(
-                            "Chart 1: {s}, mean runtime against chunks per pass, one line per core \
-                             count, each line's minimum crossed (the paper's Figure 7); {subtitle}."
-                        ),
-                    ),
-                    Metric::Cpu => (
-                        format!("CPU time against chunks: {s}"),
-                        format!(
-                            "Chart 2: {s}, mean CPU time (user + sys) against chunks per pass, \
-                             one line per core count (the paper's Figure 8); {subtitle}."
-                        ),
-                    ),
-                };
-                let path = chart(
-                    format!("{}-{n}-{what}-vs-chunks-{s}.png", g.slug()),
-                    Some(&g),
-                    caption,
-                )?;
-                charts::chunks::draw(
-                    &path,
-                    &title,
-                    &subtitle,
-                    y_desc,
-                    &lines,
-                    metric == Metric::Wall,
-                )?;
-                written.push(path);
-            }
-        }
-
-        let cores = series::cores(&rows, &g);
-        let seq = series::seq_mean(&rows, &g);
-        match seq {
-            Some(seq_s) if cores.len() > 1 => {
-                let comparable = paper::comparable(&g.preset, &g.neighbors);
-                for s in strategies.iter().filter(|s| *s != "seq") {
-                    let best = series::best_per_cores(&rows, &g, s);
-                    if best.len() < 2 {
-                        continue;
-                    }
-                    let speedup = series::speedup_lines(&rows, &g)
-                        .into_iter()
-                        .find(|l| &l.label == s);
-                    let Some(speedup) = speedup else { continue };
-                    let data = charts::best::BestChart {
-                        strategy: s,
-                        runtime: series::runtime_line(&best, s),
-                        speedup,
-                        seq_s,
-                        paper: comparable,
-                    };
-                    let caption = format!(
-                        "Chart 3: {s}, best runtime (above) and best speedup (below) against cores, \
-                         bars: 95 % confidence intervals{} (the paper's Figures 9 and 10); \
-                         {subtitle}.",
-                        if comparable {
-                            "; grey triangles: the paper's published speedups on its own machine, \
-                             at the core counts measured here"
-                        } else {
-                            ""
-                        }
-                    );
-                    let path = chart(format!("{}-3-best-{s}.png", g.slug()), Some(&g), caption)?;
-                    charts::best::draw(
-                        &path,
-                        &format!("Best runtime and speedup against cores: {s}"),
-                        &subtitle,
-                        &data,
-                    )?;
-                    written.push(path);
-                }
-                let lines = series::speedup_lines(&rows, &g);
-                let path = chart(
-                    format!("{}-4-speedup.png", g.slug()),
-                    Some(&g),
-                    format!(
-                        "Chart 4: every strategy's best speedup against cores, error bars the 95 % \
-                         bootstrap interval of the best cell's speedup; {subtitle}."
-                    ),
-                )?;
-                charts::speedup::draw(
-                    &path,
-                    "Speedup against cores, every strategy",
-                    &subtitle,
-                    &lines,
-                )?;
-                written.push(path);
-                let (eff, kf) = series::efficiency_lines(&rows, &g);
-                let path = chart(
-                    format!("{}-5-efficiency.png", g.slug()),
-                    Some(&g),
-                    format!(
-                        "Chart 5: parallel efficiency S/p (above) and the Karp–Flatt serial fraction \
-                         e = (1/S − 1/p)/(1 − 1/p) (below, only where S > 1 and p > 1) against \
-                         cores; {subtitle}."
-                    ),
-                )?;
-                charts::efficiency::draw(
-                    &path,
-                    "Efficiency and Karp–Flatt serial fraction against cores",
-                    &subtitle,
-                    &eff,
-                    &kf,
-                )?;
-                written.push(path);
-            }
-            Some(_) => skipped.push(skip(match cores.first() {
-                Some(&c) => format!(
-                    "Charts 3–5 (against cores) are not drawn: only {} was measured.",
-                    series::cores_label(c)
-                ),
-                None => "Charts 3–5 (against cores) are not drawn: no parallel strategy has a \
-                         usable cell."
-                    .to_owned(),
-            })),
-            None => skipped.push(skip(
-                "Charts 3–5 (against cores) are not drawn: there is no usable seq reference."
-                    .to_owned(),
-            )),
-        }
+    for chart in &planned.charts {
+        let path = claimed.check_writable(&chart.file)?;
+        draw(&path, chart)?;
+        written.push(path);
     }
 
-    for preset in series::presets(&rows) {
-        match series::neighbor_lines(&rows, &preset) {
-            Some(lines) if !lines.is_empty() => {
-                let path = chart(
-                    format!("{preset}-6-neighbors.png"),
-                    None,
-                    format!(
-                        "Chart 6: all-pairs against grid, seconds per step against N ({preset} \
-                         preset), for seq and for the fastest parallel cell, one line per step \
-                         count (runs of different lengths are never joined); bars: 95 % \
-                         confidence intervals."
-                    ),
-                )?;
-                charts::neighbors::draw(
-                    &path,
-                    "All-pairs against grid: time per step against N",
-                    &format!("{preset} preset; seq at 1 core and the fastest parallel cell"),
-                    &lines,
-                )?;
-                written.push(path);
-            }
-            _ => skipped.push(Skipped {
-                group: None,
-                note: format!(
-                    "Chart 6 (all-pairs against grid) is not drawn for the {preset} preset: the \
-                     results hold only one neighbour search."
-                ),
-            }),
-        }
-    }
+    let traces = embed_traces(results_dirs, out_dir, trace_dirs, &mut written)?;
+    let text = markdown::render(&markdown::Input {
+        sweeps: &sweeps,
+        charts: &planned.charts,
+        skipped: &planned.skipped,
+        traces: &traces,
+    });
+    let report = out_dir.join(REPORT_FILE);
+    crate::output::atomic::write(&report, text.as_bytes())?;
+    written.push(report);
+    claimed.remove_stale(&written)?;
+    Ok(written)
+}
 
+/// The traces found under the results directories and `out_dir` or named in `trace_dirs`;
+/// their timelines are copied into `out_dir` where needed (and added to `written`).
+fn embed_traces(
+    results_dirs: &[PathBuf],
+    out_dir: &Path,
+    trace_dirs: &[PathBuf],
+    written: &mut Vec<PathBuf>,
+) -> anyhow::Result<Vec<traces::TraceDir>> {
     let mut roots = results_dirs.to_vec();
     roots.push(out_dir.to_path_buf());
     let found = traces::find(&roots, trace_dirs)?;
@@ -333,16 +130,23 @@ pub fn generate(
             written.push(out_dir.join(&t.image));
         }
     }
+    Ok(traces)
+}
 
-    let text = markdown::render(&markdown::Input {
-        sweeps: &sweeps,
-        charts: &refs,
-        skipped: &skipped,
-        traces: &traces,
-    });
-    let report = out_dir.join(REPORT_FILE);
-    crate::output::atomic::write(&report, text.as_bytes())?;
-    written.push(report);
-    claimed.remove_stale(&written)?;
-    Ok(written)
+/// Draws one planned chart into `path`.
+fn draw(path: &Path, chart: &plan::ChartPlan) -> anyhow::Result<()> {
+    let (title, subtitle) = (chart.title.as_str(), chart.subtitle.as_str());
+    match &chart.kind {
+        ChartKind::Chunks {
+            y_desc,
+            lines,
+            mark_min,
+        } => charts::chunks::draw(path, title, subtitle, y_desc, lines, *mark_min),
+        ChartKind::Best(data) => charts::best::draw(path, title, subtitle, data),
+        ChartKind::Speedup(lines) => charts::speedup::draw(path, title, subtitle, lines),
+        ChartKind::Efficiency { efficiency, serial } => {
+            charts::efficiency::draw(path, title, subtitle, efficiency, serial)
+        }
+        ChartKind::Neighbors(lines) => charts::neighbors::draw(path, title, subtitle, lines),
+    }
 }

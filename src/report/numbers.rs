@@ -1,7 +1,7 @@
 //! How REPORT.md writes numbers: never more than three significant digits (a mean of five
 //! noisy trials does not know its fourth digit), intervals as `[low–high]`.
 
-use crate::sweep::bootstrap::Interval;
+use crate::results::stats::Interval;
 
 /// `v` to three significant digits, without exponent: `0.412`, `2.20`, `39.7`, `1230`.
 pub fn sig(v: f64) -> String {

@@ -4,6 +4,10 @@
 //! Only the speedups compare with a bench-sph sweep; the absolute times are another program
 //! on another machine. The report shows them only beside `seed`/`all-pairs` groups.
 
+use crate::results::key::Group;
+use crate::sph::neighbors::NeighborMode;
+use crate::sph::params::Preset;
+
 /// The paper's machine, in words.
 pub const MACHINE: &str = "Intel i5-8600K, 6 cores at 5 GHz";
 /// Particles in the paper's study.
@@ -62,8 +66,8 @@ pub const TABLE: [PaperRow; 5] = [
 
 /// Whether a group is comparable with the paper: the `seed` preset with all-pairs search
 /// (N and steps may differ; the report states the paper's).
-pub fn comparable(preset: &str, neighbors: &str) -> bool {
-    preset == "seed" && neighbors == "all-pairs"
+pub fn comparable(group: &Group) -> bool {
+    group.preset == Preset::Seed && group.neighbors == NeighborMode::AllPairs
 }
 
 /// The paper's row at `cores`, if it published one.
@@ -82,6 +86,14 @@ mod tests {
         }
         assert_eq!(at(6).map(|r| r.chunks), Some(150));
         assert!(at(1).is_none());
-        assert!(comparable("seed", "all-pairs") && !comparable("seed", "grid"));
+        let group = |preset, neighbors| Group {
+            preset,
+            neighbors,
+            n: 60,
+            steps: 3,
+        };
+        assert!(comparable(&group(Preset::Seed, NeighborMode::AllPairs)));
+        assert!(!comparable(&group(Preset::Seed, NeighborMode::Grid)));
+        assert!(!comparable(&group(Preset::Cpp, NeighborMode::AllPairs)));
     }
 }

@@ -6,67 +6,20 @@
 
 use std::collections::BTreeSet;
 
-use crate::sweep::bootstrap::Interval;
+use crate::results::stats::Interval;
 
-use crate::sweep::rows::{Status, SummaryRow};
+use sph_strategies::StrategyName;
 
-/// One (preset, neighbours, N, steps): cells that share an initial state and a `seq` reference.
-#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub struct GroupKey {
-    /// Preset name.
-    pub preset: String,
-    /// Neighbour search name.
-    pub neighbors: String,
-    /// Particles.
-    pub n: usize,
-    /// Steps per run.
-    pub steps: usize,
-}
-
-impl GroupKey {
-    /// The group of `row`.
-    pub fn of(row: &SummaryRow) -> GroupKey {
-        GroupKey {
-            preset: row.preset.clone(),
-            neighbors: row.neighbors.clone(),
-            n: row.n,
-            steps: row.steps,
-        }
-    }
-
-    /// E.g. `seed preset, all-pairs, N = 1000, 1000 steps`.
-    pub fn label(&self) -> String {
-        format!(
-            "{} preset, {}, N = {}, {}",
-            self.preset,
-            self.neighbors,
-            self.n,
-            crate::sweep::console::plural(self.steps, "step", "steps")
-        )
-    }
-
-    /// A file-name part, e.g. `seed-all-pairs-n1000-s1000`.
-    pub fn slug(&self) -> String {
-        format!(
-            "{}-{}-n{}-s{}",
-            self.preset, self.neighbors, self.n, self.steps
-        )
-    }
-
-    /// Whether `row` belongs to this group.
-    pub fn contains(&self, row: &SummaryRow) -> bool {
-        row.preset == self.preset
-            && row.neighbors == self.neighbors
-            && row.n == self.n
-            && row.steps == self.steps
-    }
-}
+pub use crate::results::key::Group;
+use crate::results::rows::{Contended, SummaryRow, fastest};
+use crate::sph::neighbors::NeighborMode;
+use crate::sph::params::Preset;
 
 /// The groups of `rows`, in the order they first appear.
-pub fn groups(rows: &[SummaryRow]) -> Vec<GroupKey> {
-    let mut out: Vec<GroupKey> = Vec::new();
+pub fn groups(rows: &[SummaryRow]) -> Vec<Group> {
+    let mut out: Vec<Group> = Vec::new();
     for r in rows {
-        let g = GroupKey::of(r);
+        let g = r.group();
         if !out.contains(&g) {
             out.push(g);
         }
@@ -74,50 +27,45 @@ pub fn groups(rows: &[SummaryRow]) -> Vec<GroupKey> {
     out
 }
 
-/// Whether a row's numbers may be used.
-pub fn usable(row: &SummaryRow) -> bool {
-    row.status == Status::Ok && row.mean_s.is_some()
-}
-
 /// The rows of `group` that may be used.
-pub fn ok_rows<'a>(rows: &'a [SummaryRow], group: &GroupKey) -> Vec<&'a SummaryRow> {
+pub fn ok_rows<'a>(rows: &'a [SummaryRow], group: &Group) -> Vec<&'a SummaryRow> {
     rows.iter()
-        .filter(|r| group.contains(r) && usable(r))
+        .filter(|r| r.group() == *group && r.is_usable())
         .collect()
 }
 
 /// The strategies of `group` in the order they first appear (the registry order of the plan).
-pub fn strategies(rows: &[SummaryRow], group: &GroupKey) -> Vec<String> {
-    let mut out: Vec<String> = Vec::new();
-    for r in rows.iter().filter(|r| group.contains(r)) {
+pub fn strategies(rows: &[SummaryRow], group: &Group) -> Vec<StrategyName> {
+    let mut out: Vec<StrategyName> = Vec::new();
+    for r in rows.iter().filter(|r| r.group() == *group) {
         if !out.contains(&r.strategy) {
-            out.push(r.strategy.clone());
+            out.push(r.strategy);
         }
     }
     out
 }
 
 /// Whether `strategy` has cells with a chunks value in `group`.
-pub fn is_chunked(rows: &[SummaryRow], group: &GroupKey, strategy: &str) -> bool {
+pub fn is_chunked(rows: &[SummaryRow], group: &Group, strategy: StrategyName) -> bool {
     rows.iter()
-        .any(|r| group.contains(r) && r.strategy == strategy && r.chunks.is_some())
+        .any(|r| r.group() == *group && r.strategy == strategy && r.chunks.is_some())
 }
 
 /// The distinct core counts of the usable cells of `group` (any strategy but `seq`).
-pub fn cores(rows: &[SummaryRow], group: &GroupKey) -> Vec<usize> {
+pub fn cores(rows: &[SummaryRow], group: &Group) -> Vec<usize> {
     let set: BTreeSet<usize> = ok_rows(rows, group)
         .iter()
-        .filter(|r| r.strategy != "seq")
+        .filter(|r| !r.is_reference())
         .map(|r| r.cores)
         .collect();
     set.into_iter().collect()
 }
 
 /// The group's reference: `seq`'s mean seconds.
-pub fn seq_mean(rows: &[SummaryRow], group: &GroupKey) -> Option<f64> {
+pub fn seq_mean(rows: &[SummaryRow], group: &Group) -> Option<f64> {
     ok_rows(rows, group)
         .iter()
-        .find(|r| r.strategy == "seq")
+        .find(|r| r.is_reference())
         .and_then(|r| r.mean_s)
 }
 
@@ -187,8 +135,8 @@ pub enum Metric {
 /// (Figures 7 and 8 of the paper).
 pub fn chunk_lines(
     rows: &[SummaryRow],
-    group: &GroupKey,
-    strategy: &str,
+    group: &Group,
+    strategy: StrategyName,
     metric: Metric,
 ) -> Vec<Line> {
     let ok = ok_rows(rows, group);
@@ -277,7 +225,7 @@ impl Best {
 }
 
 /// The fastest usable cell of `strategy` in `group` at each core count, by cores.
-pub fn best_per_cores(rows: &[SummaryRow], group: &GroupKey, strategy: &str) -> Vec<Best> {
+pub fn best_per_cores(rows: &[SummaryRow], group: &Group, strategy: StrategyName) -> Vec<Best> {
     let ok = ok_rows(rows, group);
     let mut set: BTreeSet<usize> = BTreeSet::new();
     for r in ok.iter().filter(|r| r.strategy == strategy) {
@@ -286,18 +234,12 @@ pub fn best_per_cores(rows: &[SummaryRow], group: &GroupKey, strategy: &str) -> 
     set.into_iter()
         .filter_map(|c| {
             // The fastest trustworthy cell; a contended one only when all of them are.
-            let r = ok
-                .iter()
-                .filter(|r| r.strategy == strategy && r.cores == c)
-                .min_by(|a, b| {
-                    (a.contended == Some(true))
-                        .cmp(&(b.contended == Some(true)))
-                        .then(
-                            a.mean_s
-                                .unwrap_or(f64::INFINITY)
-                                .total_cmp(&b.mean_s.unwrap_or(f64::INFINITY)),
-                        )
-                })?;
+            let r = fastest(
+                ok.iter()
+                    .copied()
+                    .filter(|r| r.strategy == strategy && r.cores == c),
+                Contended::LastResort,
+            )?;
             let mean_s = r.mean_s?;
             Some(Best {
                 cores: c,
@@ -337,15 +279,15 @@ pub fn karp_flatt(speedup: f64, p: usize) -> Option<f64> {
 
 /// Best lines per strategy for `group` (every strategy but `seq`): speedup against cores,
 /// with the best cell's 95 % interval of the speedup.
-pub fn speedup_lines(rows: &[SummaryRow], group: &GroupKey) -> Vec<Line> {
+pub fn speedup_lines(rows: &[SummaryRow], group: &Group) -> Vec<Line> {
     let Some(seq) = seq_mean(rows, group) else {
         return Vec::new();
     };
     strategies(rows, group)
         .into_iter()
-        .filter(|s| s != "seq")
+        .filter(|&s| s != StrategyName::Seq)
         .filter_map(|s| {
-            let points: Vec<Point> = best_per_cores(rows, group, &s)
+            let points: Vec<Point> = best_per_cores(rows, group, s)
                 .iter()
                 .map(|b| {
                     let y = seq / b.mean_s;
@@ -359,7 +301,10 @@ pub fn speedup_lines(rows: &[SummaryRow], group: &GroupKey) -> Vec<Line> {
                     }
                 })
                 .collect();
-            (!points.is_empty()).then_some(Line { label: s, points })
+            (!points.is_empty()).then_some(Line {
+                label: s.to_string(),
+                points,
+            })
         })
         .collect()
 }
@@ -384,7 +329,7 @@ pub fn runtime_line(best: &[Best], label: &str) -> Line {
 
 /// Per strategy, efficiency against cores (all core counts) and the Karp–Flatt fraction
 /// against cores (only where it means something: at least 2 cores and a speedup above 1).
-pub fn efficiency_lines(rows: &[SummaryRow], group: &GroupKey) -> (Vec<Line>, Vec<Line>) {
+pub fn efficiency_lines(rows: &[SummaryRow], group: &Group) -> (Vec<Line>, Vec<Line>) {
     let mut eff = Vec::new();
     let mut kf = Vec::new();
     for line in speedup_lines(rows, group) {
@@ -418,12 +363,13 @@ pub fn efficiency_lines(rows: &[SummaryRow], group: &GroupKey) -> (Vec<Line>, Ve
 
 /// For chart 6: per neighbour mode of `preset`, seconds per step against N for `seq` and for
 /// the fastest cell of any other strategy. `None` unless both modes are present.
-pub fn neighbor_lines(rows: &[SummaryRow], preset: &str) -> Option<Vec<Line>> {
-    let gs: Vec<GroupKey> = groups(rows)
+// Over ~60 lines on purpose: one pass per (mode, steps) pair builds both lines; split, the two would have to share the per-step point closure.
+pub fn neighbor_lines(rows: &[SummaryRow], preset: Preset) -> Option<Vec<Line>> {
+    let gs: Vec<Group> = groups(rows)
         .into_iter()
         .filter(|g| g.preset == preset)
         .collect();
-    let modes: BTreeSet<&str> = gs.iter().map(|g| g.neighbors.as_str()).collect();
+    let modes: BTreeSet<NeighborMode> = gs.iter().map(|g| g.neighbors).collect();
     if modes.len() < 2 {
         return None;
     }
@@ -454,17 +400,16 @@ pub fn neighbor_lines(rows: &[SummaryRow], preset: &str) -> Option<Vec<Line>> {
             };
             if let Some(p) = ok
                 .iter()
-                .find(|r| r.strategy == "seq")
+                .find(|r| r.is_reference())
                 .and_then(|r| per_step(r))
             {
                 seq_points.push(p);
             }
-            let best = ok.iter().filter(|r| r.strategy != "seq").min_by(|a, b| {
-                a.mean_s
-                    .unwrap_or(f64::INFINITY)
-                    .total_cmp(&b.mean_s.unwrap_or(f64::INFINITY))
-            });
-            if let Some(p) = best.and_then(|r| per_step(r)) {
+            let best = fastest(
+                ok.iter().copied().filter(|r| !r.is_reference()),
+                Contended::Compete,
+            );
+            if let Some(p) = best.and_then(per_step) {
                 best_points.push(p);
             }
         }
@@ -487,8 +432,8 @@ pub fn neighbor_lines(rows: &[SummaryRow], preset: &str) -> Option<Vec<Line>> {
 }
 
 /// The presets of `rows`, in order of appearance.
-pub fn presets(rows: &[SummaryRow]) -> Vec<String> {
-    let mut out: Vec<String> = Vec::new();
+pub fn presets(rows: &[SummaryRow]) -> Vec<Preset> {
+    let mut out: Vec<Preset> = Vec::new();
     for g in groups(rows) {
         if !out.contains(&g.preset) {
             out.push(g.preset);
@@ -517,8 +462,8 @@ pub fn chunking_stops_paying(line: &[ChunkCell]) -> Option<usize> {
 /// `(cores, [(chunks, mean, stddev)])`.
 pub fn chunk_table(
     rows: &[SummaryRow],
-    group: &GroupKey,
-    strategy: &str,
+    group: &Group,
+    strategy: StrategyName,
 ) -> Vec<(usize, Vec<ChunkCell>)> {
     let ok = ok_rows(rows, group);
     cores(rows, group)
@@ -538,61 +483,24 @@ pub fn chunk_table(
 }
 
 #[cfg(test)]
-pub(crate) mod tests {
+mod tests {
     use super::*;
-
-    /// A usable summary row for tests.
-    pub(crate) fn row(
-        strategy: &str,
-        cores: usize,
-        chunks: Option<usize>,
-        mean: f64,
-    ) -> SummaryRow {
-        SummaryRow {
-            strategy: strategy.to_owned(),
-            neighbors: "all-pairs".to_owned(),
-            preset: "seed".to_owned(),
-            n: 60,
-            steps: 3,
-            cores,
-            chunks,
-            particles_per_chunk: chunks.map(|k| 60usize.div_ceil(k)),
-            trials: 3,
-            mean_s: Some(mean),
-            stddev_s: Some(mean * 0.01),
-            min_s: Some(mean * 0.9),
-            median_s: Some(mean),
-            max_s: Some(mean * 1.1),
-            cpu_mean_s: Some(mean * cores as f64),
-            speedup: Some(4.0 / mean),
-            efficiency: Some(4.0 / mean / cores as f64),
-            outliers: Some(0),
-            oversubscribed: cores > 2,
-            checksum: "00000000000000aa".to_owned(),
-            status: Status::Ok,
-            reason: String::new(),
-            mean_ci_low_s: Some(mean * 0.98),
-            mean_ci_high_s: Some(mean * 1.02),
-            speedup_ci_low: Some(4.0 / mean * 0.95),
-            speedup_ci_high: Some(4.0 / mean * 1.05),
-            foreign_cpu_mean_s: Some(0.0),
-            contended: Some(false),
-        }
-    }
+    use crate::results::rows::Status;
+    use crate::results::rows::tests::row;
 
     fn sample() -> Vec<SummaryRow> {
-        let mut failed = row("rayon-chunks", 2, Some(20), 0.1);
+        let mut failed = row(StrategyName::RayonChunks, 2, Some(20), 0.1);
         failed.status = Status::Failed;
         failed.mean_s = None;
         vec![
-            row("seq", 1, None, 4.0),
-            row("rayon-chunks", 1, Some(10), 4.2),
-            row("rayon-chunks", 1, Some(5), 4.1),
-            row("rayon-chunks", 2, Some(5), 2.5),
-            row("rayon-chunks", 2, Some(10), 2.2),
+            row(StrategyName::Seq, 1, None, 4.0),
+            row(StrategyName::RayonChunks, 1, Some(10), 4.2),
+            row(StrategyName::RayonChunks, 1, Some(5), 4.1),
+            row(StrategyName::RayonChunks, 2, Some(5), 2.5),
+            row(StrategyName::RayonChunks, 2, Some(10), 2.2),
             failed,
-            row("rayon-iter", 2, None, 2.0),
-            row("rayon-iter", 3, None, 2.4),
+            row(StrategyName::RayonIter, 2, None, 2.0),
+            row(StrategyName::RayonIter, 3, None, 2.4),
         ]
     }
 
@@ -608,8 +516,8 @@ pub(crate) mod tests {
     #[test]
     fn the_best_cell_per_cores_is_the_fastest_usable_one() {
         let rows = sample();
-        let g = GroupKey::of(&rows[0]);
-        let best = best_per_cores(&rows, &g, "rayon-chunks");
+        let g = rows[0].group();
+        let best = best_per_cores(&rows, &g, StrategyName::RayonChunks);
         assert_eq!(best.len(), 2);
         assert_eq!(
             (best[0].cores, best[0].chunks, best[0].mean_s),
@@ -625,21 +533,21 @@ pub(crate) mod tests {
     #[test]
     fn chunk_lines_have_one_line_per_cores_sorted_by_chunks_with_their_minimum() {
         let rows = sample();
-        let g = GroupKey::of(&rows[0]);
-        let lines = chunk_lines(&rows, &g, "rayon-chunks", Metric::Wall);
+        let g = rows[0].group();
+        let lines = chunk_lines(&rows, &g, StrategyName::RayonChunks, Metric::Wall);
         assert_eq!(lines.len(), 2);
         assert_eq!(lines[0].label, "1 core");
         assert_eq!(lines[0].points[0].x, 5.0);
         assert_eq!(lines[0].min_index(), Some(0));
         assert_eq!(lines[1].min_index(), Some(1));
-        let cpu = chunk_lines(&rows, &g, "rayon-chunks", Metric::Cpu);
+        let cpu = chunk_lines(&rows, &g, StrategyName::RayonChunks, Metric::Cpu);
         assert_eq!(cpu[1].points[1].y, 4.4);
     }
 
     #[test]
     fn speedup_lines_skip_seq_and_carry_the_trial_spread_and_oversubscription() {
         let rows = sample();
-        let g = GroupKey::of(&rows[0]);
+        let g = rows[0].group();
         let lines = speedup_lines(&rows, &g);
         let labels: Vec<&str> = lines.iter().map(|l| l.label.as_str()).collect();
         assert_eq!(labels, ["rayon-chunks", "rayon-iter"]);
@@ -668,16 +576,16 @@ pub(crate) mod tests {
     #[test]
     fn chart_six_needs_both_neighbour_modes() {
         let rows = sample();
-        assert!(neighbor_lines(&rows, "seed").is_none());
+        assert!(neighbor_lines(&rows, Preset::Seed).is_none());
         let mut both = rows.clone();
         for r in rows {
             both.push(SummaryRow {
-                neighbors: "grid".to_owned(),
+                neighbors: NeighborMode::Grid,
                 n: 120,
                 ..r
             });
         }
-        let lines = neighbor_lines(&both, "seed").unwrap();
+        let lines = neighbor_lines(&both, Preset::Seed).unwrap();
         assert_eq!(lines.len(), 4);
         assert_eq!(lines[0].label, "all-pairs, seq (1 core)");
         assert_eq!(lines[0].points[0].y, 4.0 / 3.0);

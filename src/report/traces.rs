@@ -17,8 +17,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use serde::Deserialize;
 
+use crate::output::sniff::{self, PNG_SIGNATURE};
 use crate::output::{atomic, console};
-use crate::trace::files::{self, META_JSON, PNG_SIGNATURE};
+use crate::trace::files::{self, META_JSON};
 use crate::trace::stats::{CSV_HEADER, idle_workers_note};
 
 /// The files that make a directory a trace directory.
@@ -164,7 +165,7 @@ fn walk(dir: &Path, depth: usize, found: &mut BTreeSet<PathBuf>) {
 /// phrase that follows "not a valid trace: ".
 fn check(dir: &Path) -> anyhow::Result<Checked> {
     let stats = check_stats(&dir.join(STATS))?;
-    if !files::starts_with(&dir.join(TIMELINE), &PNG_SIGNATURE) {
+    if !sniff::starts_with(&dir.join(TIMELINE), &PNG_SIGNATURE) {
         bail!("{TIMELINE} is not a PNG image");
     }
     let title = check_meta(&dir.join(META_JSON))?;

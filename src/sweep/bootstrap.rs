@@ -20,31 +20,7 @@
 use crate::checksum::fingerprint;
 use crate::scene::splitmix::SplitMix64;
 
-/// Resamples per interval.
-pub const RESAMPLES: usize = 10_000;
-/// The intervals' confidence level.
-pub const CONFIDENCE: f64 = 0.95;
-
-/// A confidence interval.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Interval {
-    /// Lower end.
-    pub low: f64,
-    /// Upper end.
-    pub high: f64,
-}
-
-impl Interval {
-    /// Whether the two intervals share a point.
-    pub fn overlaps(&self, other: &Interval) -> bool {
-        self.low <= other.high && other.low <= self.high
-    }
-
-    /// Whether `x` lies inside.
-    pub fn contains(&self, x: f64) -> bool {
-        self.low <= x && x <= self.high
-    }
-}
+pub use crate::results::stats::{CONFIDENCE, Interval, RESAMPLES};
 
 /// The generator of one cell: `seed` mixed with the cell's key text, plus a `stream` number
 /// for the cell's separate intervals.

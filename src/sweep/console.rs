@@ -1,11 +1,12 @@
 //! What a sweep prints: pure functions from plan and rows to text.
 
-use std::collections::BTreeMap;
+use std::collections::HashMap;
 use std::fmt::Write as _;
 
-use super::plan::{Cell, CellKey, Plan};
+use super::plan::{Cell, LabelStyle, Plan};
 use super::range::{Axis, compact};
-use super::rows::{Status, SummaryRow};
+use crate::output::console::plural;
+use crate::results::rows::{Contended, Status, SummaryRow, fastest};
 
 /// A duration for people: `0.25 ms`, `12 ms`, `4.2 s`, `42 s`, `3 min 20 s`, `1 h 05 min`.
 pub fn duration(seconds: f64) -> String {
@@ -35,11 +36,6 @@ pub fn places(seconds: f64) -> usize {
         return 4;
     }
     (3 - seconds.log10().floor() as i64).clamp(1, 9) as usize
-}
-
-/// `1 warm-up` / `3 warm-ups`, and so on.
-pub fn plural(count: usize, one: &str, many: &str) -> String {
-    format!("{count} {}", if count == 1 { one } else { many })
 }
 
 /// The cells of `plan` with more cores than `hardware_threads`, and their cores values.
@@ -117,7 +113,7 @@ pub fn contended_cells(rows: &[SummaryRow]) -> Option<String> {
     let names: Vec<String> = rows
         .iter()
         .filter(|r| r.contended == Some(true))
-        .map(|r| r.key().label())
+        .map(|r| r.key().label_with_group())
         .collect();
     if names.is_empty() {
         return None;
@@ -136,10 +132,14 @@ pub fn contended_cells(rows: &[SummaryRow]) -> Option<String> {
 /// The fastest finished cell of each strategy in each group, as a table, groups in plan
 /// order and strategies in registry order. `rows` may hold any number of sessions' rows.
 pub fn best_cells(plan: &Plan, rows: &[SummaryRow]) -> String {
-    let by_key: BTreeMap<CellKey, &SummaryRow> = rows.iter().map(|r| (r.key(), r)).collect();
+    let by_key: HashMap<Cell, &SummaryRow> = rows.iter().map(|r| (r.key(), r)).collect();
     let mut text = String::new();
     for group in &plan.groups {
-        let _ = writeln!(text, "Fastest cell per strategy ({}):", group.label());
+        let _ = writeln!(
+            text,
+            "Fastest cell per strategy ({}):",
+            group.label(LabelStyle::Sweep)
+        );
         let _ = writeln!(
             text,
             "  {:<16} {:>5} {:>6} {:>10} {:>10} {:>8} {:>10}",
@@ -153,17 +153,13 @@ pub fn best_cells(plan: &Plan, rows: &[SummaryRow]) -> String {
             .collect();
         strategies.dedup();
         for strategy in strategies {
-            let best = plan
-                .cells
-                .iter()
-                .filter(|c| c.group == *group && c.strategy == strategy)
-                .filter_map(|c| by_key.get(&c.key()).copied())
-                .filter(|r| r.status == Status::Ok && r.mean_s.is_some())
-                .min_by(|a, b| {
-                    a.mean_s
-                        .unwrap_or(f64::NAN)
-                        .total_cmp(&b.mean_s.unwrap_or(f64::NAN))
-                });
+            let best = fastest(
+                plan.cells
+                    .iter()
+                    .filter(|c| c.group == *group && c.strategy == strategy)
+                    .filter_map(|c| by_key.get(c).copied()),
+                Contended::Compete,
+            );
             let num = |v: Option<f64>, prec: usize| {
                 v.map_or_else(|| "-".to_owned(), |v| format!("{v:.prec$}"))
             };

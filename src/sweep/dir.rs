@@ -15,9 +15,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 
 use super::lock::{self, DirLock, LOCK_FILE};
-use super::meta::Meta;
 use super::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
 use crate::output::claim::{self, Owner};
+use crate::results::meta::Meta;
 
 /// The default results directory: `results/<UTC timestamp>`, or with `-2`, `-3`, … when a
 /// sweep started in the same second took that name. Created here, exclusively.
@@ -25,7 +25,7 @@ pub fn new_default() -> anyhow::Result<PathBuf> {
     let parent = Path::new("results");
     std::fs::create_dir_all(parent)
         .with_context(|| format!("cannot create directory '{}'", parent.display()))?;
-    let stamp = super::meta::timestamp_dir_name();
+    let stamp = crate::results::meta::timestamp_dir_name();
     for k in 1..1000 {
         let name = if k == 1 {
             stamp.clone()
@@ -81,7 +81,7 @@ fn check_contents(dir: &Path, force: bool, remove: bool) -> anyhow::Result<()> {
         TRIALS_FILE,
         SUMMARY_FILE,
         META_FILE,
-        crate::report::REPORT_FILE,
+        crate::results::REPORT_FILE,
     ] {
         claimed.check_writable(name)?;
     }
@@ -147,11 +147,11 @@ fn owned(path: &Path) -> bool {
         // left by a sweep killed as it started, holds nothing to lose).
         TRIALS_FILE | SUMMARY_FILE => {
             std::fs::metadata(path).is_ok_and(|m| m.len() == 0)
-                || crate::trace::files::starts_with(path, b"strategy,neighbors,preset,n,steps,")
+                || crate::output::sniff::starts_with(path, b"strategy,neighbors,preset,n,steps,")
         }
         LOCK_FILE => true,
         META_FILE => Meta::is_sweep_meta(path),
-        _ => crate::report::is_own_file(path),
+        _ => crate::results::is_report_file(path),
     }
 }
 

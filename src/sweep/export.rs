@@ -7,66 +7,7 @@
 
 use std::io::Write;
 
-use super::rows::{SummaryRow, TrialRow};
-
-/// The columns of `trials.csv`, in order.
-pub const TRIAL_COLUMNS: [&str; 17] = [
-    "strategy",
-    "neighbors",
-    "preset",
-    "n",
-    "steps",
-    "cores",
-    "chunks",
-    "particles_per_chunk",
-    "trial",
-    "wall_s",
-    "cpu_s",
-    "checksum",
-    "status",
-    "reason",
-    "foreign_cpu_s",
-    "steal_s",
-    "load1",
-];
-
-/// The columns of `summary.csv`, in order.
-pub const SUMMARY_COLUMNS: [&str; 28] = [
-    "strategy",
-    "neighbors",
-    "preset",
-    "n",
-    "steps",
-    "cores",
-    "chunks",
-    "particles_per_chunk",
-    "trials",
-    "mean_s",
-    "stddev_s",
-    "min_s",
-    "median_s",
-    "max_s",
-    "cpu_mean_s",
-    "speedup",
-    "efficiency",
-    "outliers",
-    "oversubscribed",
-    "checksum",
-    "status",
-    "reason",
-    "mean_ci_low_s",
-    "mean_ci_high_s",
-    "speedup_ci_low",
-    "speedup_ci_high",
-    "foreign_cpu_mean_s",
-    "contended",
-];
-
-/// How many leading columns of each file bench-sph 0.1.0 wrote before the contention and
-/// confidence-interval columns were appended: a file with exactly those is an older sweep.
-pub const LEGACY_TRIAL_COLUMNS: usize = 14;
-/// See [`LEGACY_TRIAL_COLUMNS`].
-pub const LEGACY_SUMMARY_COLUMNS: usize = 22;
+use crate::results::rows::{SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow};
 
 /// Writes cells to the two CSV streams.
 #[derive(Debug)]

@@ -12,8 +12,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
-/// The lock file's name.
-pub const LOCK_FILE: &str = "sweep.lock";
+pub use crate::results::LOCK_FILE;
 
 /// Held for as long as the sweep runs; dropping it releases the lock.
 #[derive(Debug)]

@@ -3,33 +3,26 @@
 //! The pipeline, one module per step: the command line ([`crate::cli`]) becomes
 //! [`params::SweepParams`] (lists expanded by [`range`]); [`plan`] turns them into groups of
 //! cells; [`runner`] measures each cell (warm-ups, timed trials, the checksum guard, progress,
-//! Ctrl-C); [`rows`] and [`stats`] turn measurements into rows; [`export`] writes them to
-//! `trials.csv` and `summary.csv` after every cell; [`meta`] writes `meta.json`; [`resume`]
-//! continues an interrupted sweep; [`console`] formats what is printed.
+//! Ctrl-C); [`rows`] turns measurements into rows (statistics from
+//! [`crate::results::stats`], intervals from [`bootstrap`]); [`export`] writes them to
+//! `trials.csv` and `summary.csv` after every cell, and `meta.json` records the sessions;
+//! [`resume`] continues an interrupted sweep; [`console`] formats what is printed. The CLI
+//! then draws the report into the directory (`crate::cli::sweep::run`).
 //!
-//! A results directory holds:
-//! - `trials.csv`: one row per timed trial (columns [`export::TRIAL_COLUMNS`]);
-//! - `summary.csv`: one row per cell (columns [`export::SUMMARY_COLUMNS`]): mean, sample
-//!   stddev, min, median, max of the wall seconds, mean CPU seconds, speedup over the group's
-//!   `seq` mean, efficiency = speedup / cores, outliers (|t − median| > 3 MAD),
-//!   oversubscribed, the common checksum, status and reason;
-//! - `meta.json`: machine, build, times, command lines and every parameter.
+//! What a results directory holds, and how it is read back, is [`crate::results`].
 
 pub mod bootstrap;
 pub mod console;
 pub mod dir;
 pub mod export;
 pub mod lock;
-pub mod meta;
 pub mod params;
 pub mod plan;
 pub mod range;
 pub mod resume;
 pub mod rows;
 pub mod runner;
-pub mod stats;
 pub mod timing;
-pub mod validate;
 
 use std::collections::{HashMap, HashSet};
 use std::fs::{File, OpenOptions};
@@ -40,23 +33,19 @@ use std::time::Duration;
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use crate::output::console::plural;
+use crate::results::meta::{Machine, Meta, Session, SweepStatus};
+use crate::results::rows::{Status, SummaryRow, TrialRow};
 use lock::DirLock;
-use meta::{Machine, Meta, Session, SweepStatus};
 use params::SweepParams;
-use plan::{CellKey, Group, Plan};
+use plan::{Cell, Group, LabelStyle, Plan};
 use range::{Axis, compact};
-use rows::{Status, SummaryRow, TrialRow};
 use runner::{Reference, Runner};
 use timing::Timing;
 
 use crate::contention::Threshold;
 
-/// The per-trial file.
-pub const TRIALS_FILE: &str = "trials.csv";
-/// The per-cell file.
-pub const SUMMARY_FILE: &str = "summary.csv";
-/// The metadata file.
-pub const META_FILE: &str = "meta.json";
+pub use crate::results::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
 
 /// Where a sweep writes.
 #[derive(Debug, Clone)]
@@ -82,8 +71,6 @@ pub enum Target {
 pub struct Request {
     /// New sweep or resume.
     pub target: Target,
-    /// Do not draw charts at the end.
-    pub no_plots: bool,
     /// Test only: stop as if Ctrl-C was pressed once this many cells are written.
     pub stop_after_cells: Option<usize>,
     /// The command line, program name first (recorded in `meta.json`).
@@ -101,34 +88,40 @@ struct Opened {
     /// Whether the CSV files are new (and need their header lines).
     fresh: bool,
     /// The directory's lock, held until the sweep ends.
+    lock: DirLock,
+}
+
+/// A sweep that has run (to the end or not): its files are complete and its directory still
+/// locked, so that the caller can draw the report into it before anyone else writes there.
+#[derive(Debug)]
+pub struct Finished {
+    dir: PathBuf,
+    plan: Plan,
+    /// Every finished cell's row, from every session.
+    rows: Vec<SummaryRow>,
+    status: SweepStatus,
     _lock: DirLock,
 }
 
 /// How long the busy-machine check before the plan watches the machine.
 const BUSY_CHECK: Duration = Duration::from_millis(300);
 
-/// Runs a sweep: plan, measure, write, summarise. Errors (after writing all that is done)
-/// when it was interrupted or a cell failed.
-pub fn run(request: Request) -> anyhow::Result<()> {
+/// Runs a sweep: plan, measure, write. Returns the finished sweep, whose
+/// [`outcome`](Finished::outcome) is the error to end with when it was interrupted or a cell
+/// failed; errors here are those that stop it before or while it measures.
+// Over ~60 lines on purpose: the sweep's steps in the order they print (open, plan, busy check, estimate, measure, conclude), each a call; what is left is handing values between them.
+pub fn run(request: Request) -> anyhow::Result<Finished> {
     // From the start: a Ctrl-C during the plan or the estimate also ends the sweep as
     // interrupted (after the estimate), never as a killed "running" one.
     runner::install_ctrlc_handler();
     let machine = Machine::detect();
     let hardware_threads = machine.hardware_threads;
     let session = Session::start(request.command_line.clone(), machine);
-    let opened = match &request.target {
+    let mut opened = match &request.target {
         Target::New { params, out, force } => start_new(params, out.as_deref(), *force, session)?,
         Target::Resume { dir } => reopen(dir, session)?,
     };
-    let Opened {
-        dir,
-        mut meta,
-        finished,
-        finished_trials,
-        fresh,
-        _lock,
-    } = opened;
-    let params = meta.params.clone();
+    let params = opened.meta.params.clone();
     let timing = Timing::new(
         params.fake_timings.as_deref(),
         params.fake_contention.as_deref(),
@@ -138,50 +131,33 @@ pub fn run(request: Request) -> anyhow::Result<()> {
         hardware_threads,
         hz: crate::contention::ticks_per_second(),
     };
-
-    let done: HashSet<CellKey> = finished.iter().map(SummaryRow::key).collect();
+    let done: HashSet<Cell> = opened.finished.iter().map(SummaryRow::key).collect();
     let todo: Vec<usize> = (0..plan.cells.len())
-        .filter(|&i| !done.contains(&plan.cells[i].key()))
+        .filter(|&i| !done.contains(&plan.cells[i]))
         .collect();
-    let mut references = finished_references(&plan, &finished, &finished_trials);
+    let mut references = finished_references(&plan, &opened.finished, &opened.finished_trials);
 
     // Say what will happen before anything slow: the plan, the machine's load, then the
     // estimate (from short, bounded seq runs).
-    print_plan(&dir, &params, &plan, &todo, hardware_threads);
+    print_plan(&opened.dir, &params, &plan, &todo, hardware_threads);
     let widest = plan.cells.iter().map(|c| c.cores).max().unwrap_or(1);
     let busy = busy_before(&timing, &threshold, widest);
-    if let Some(session) = meta.sessions.last_mut() {
+    if let Some(session) = opened.meta.sessions.last_mut() {
         session.busy_threads_at_start = busy.map(|b| b.threads);
     }
-    meta.write(&dir.join(META_FILE))?;
+    opened.meta.write(&opened.dir.join(META_FILE))?;
     if let Some(b) = busy.filter(|b| b.contended) {
         console_warn(&console::busy_warning(b.threads, hardware_threads));
     }
-    let run_s = estimate(&plan, &todo, &params, hardware_threads)?;
+    let run_ms = run_ms(&estimate(&plan, &todo, &params, hardware_threads)?);
 
-    let runs_per_cell = params.warmup + params.trials;
-    let run_ms: Vec<u64> = run_s
-        .iter()
-        .map(|s| {
-            if s.is_finite() {
-                (s * 1000.0).ceil().max(1.0) as u64
-            } else {
-                1
-            }
-        })
-        .collect();
     let exporter = export::Exporter::new(
-        append(&dir.join(TRIALS_FILE))?,
-        append(&dir.join(SUMMARY_FILE))?,
-        fresh,
+        append(&opened.dir.join(TRIALS_FILE))?,
+        append(&opened.dir.join(SUMMARY_FILE))?,
+        opened.fresh,
     )
     .context("cannot write the results")?;
-    let progress = progress_bar(
-        todo.iter()
-            .map(|&i| run_ms[i].saturating_mul(runs_per_cell as u64))
-            .fold(0u64, u64::saturating_add),
-    );
-    let mut runner = Runner {
+    let runner = Runner {
         plan: &plan,
         warmup: params.warmup,
         trials: params.trials,
@@ -192,79 +168,123 @@ pub fn run(request: Request) -> anyhow::Result<()> {
         timing,
         stop_after_cells: request.stop_after_cells,
         exporter,
-        progress: progress.clone(),
+        progress: ProgressBar::hidden(),
         run_ms,
     };
-    let outcome = runner.run(&todo, &mut references);
-    progress.finish_and_clear();
-    let outcome = outcome?;
+    let outcome = measure(runner, &todo, &mut references)?;
+    conclude(opened, plan, outcome.rows, outcome.interrupted)
+}
 
-    let all_rows: Vec<SummaryRow> = finished.iter().chain(&outcome.rows).cloned().collect();
-    let complete = all_rows.len() >= plan.cells.len();
-    let status = if outcome.interrupted || !complete {
+/// Runs the cells `todo` under a progress bar measured in estimated milliseconds (see
+/// [`progress_bar`]), cleared when the runner stops.
+fn measure<T: std::io::Write, S: std::io::Write>(
+    mut runner: Runner<'_, T, S>,
+    todo: &[usize],
+    references: &mut HashMap<Group, Reference>,
+) -> anyhow::Result<runner::SessionOutcome> {
+    let runs_per_cell = (runner.warmup + runner.trials) as u64;
+    let total_ms = todo
+        .iter()
+        .map(|&i| runner.run_ms[i].saturating_mul(runs_per_cell))
+        .fold(0u64, u64::saturating_add);
+    runner.progress = progress_bar(total_ms);
+    let outcome = runner.run(todo, references);
+    runner.progress.finish_and_clear();
+    outcome
+}
+
+/// Estimated milliseconds of one run of each cell (at least 1), from [`estimate`]'s seconds.
+fn run_ms(run_s: &[f64]) -> Vec<u64> {
+    run_s
+        .iter()
+        .map(|s| {
+            if s.is_finite() {
+                (s * 1000.0).ceil().max(1.0) as u64
+            } else {
+                1
+            }
+        })
+        .collect()
+}
+
+/// Records the session's end in `meta.json` and warns about contended cells.
+fn conclude(
+    mut opened: Opened,
+    plan: Plan,
+    new_rows: Vec<SummaryRow>,
+    interrupted: bool,
+) -> anyhow::Result<Finished> {
+    let cells_run = new_rows.len();
+    let mut rows = std::mem::take(&mut opened.finished);
+    rows.extend(new_rows);
+    let status = if interrupted || rows.len() < plan.cells.len() {
         SweepStatus::Interrupted
     } else {
         SweepStatus::Complete
     };
-    meta.finish(status, outcome.rows.len());
-    meta.write(&dir.join(META_FILE))?;
-    finish(&dir, &plan, &all_rows, status, request.no_plots)
-}
-
-/// The end of a sweep: what it found, where it is, and the error that says why it is not
-/// complete (if it is not).
-fn finish(
-    dir: &Path,
-    plan: &Plan,
-    all_rows: &[SummaryRow],
-    status: SweepStatus,
-    no_plots: bool,
-) -> anyhow::Result<()> {
-    // Standard output may be gone (`| head`): the sweep's files are complete by now, so
-    // printing failures are ignored and the sweep ends with its status.
-    let mut text = format!("\n{}", console::best_cells(plan, all_rows));
-    if let Some(contended) = console::contended_cells(all_rows) {
+    opened.meta.finish(status, cells_run);
+    opened.meta.write(&opened.dir.join(META_FILE))?;
+    if let Some(contended) = console::contended_cells(&rows) {
         console_warn(&contended);
     }
-    let charts = if status == SweepStatus::Complete {
-        render_charts(dir, no_plots)
-    } else {
-        Ok(String::new())
-    };
-    if let Ok(charts) = &charts {
-        text.push_str(charts);
-        text.push('\n');
-    }
-    text.push_str(&paths_text(dir, all_rows));
-    let _ = crate::output::console::line(text.trim_end());
-    charts?;
+    Ok(Finished {
+        dir: opened.dir,
+        plan,
+        rows,
+        status,
+        _lock: opened.lock,
+    })
+}
 
-    if status == SweepStatus::Interrupted {
-        bail!(
-            "interrupted: {} of {} cells are finished and saved in '{}'; \
-             continue with `bench-sph sweep --resume {}`",
-            all_rows.len(),
-            plan.cells.len(),
-            dir.display(),
-            dir.display()
-        );
+impl Finished {
+    /// The results directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
     }
-    let failed: Vec<&SummaryRow> = all_rows
-        .iter()
-        .filter(|r| r.status == Status::Failed)
-        .collect();
-    if let Some(first) = failed.first() {
-        bail!(
-            "{} of {} cells failed (status=failed in {}); the first: {} at {} cores: {}",
-            failed.len(),
-            plan.cells.len(),
-            dir.join(SUMMARY_FILE).display(),
-            first.strategy,
-            first.cores,
-            first.reason
-        );
+
+    /// Whether every planned cell is finished (the report is drawn only then).
+    pub fn is_complete(&self) -> bool {
+        self.status == SweepStatus::Complete
     }
-    Ok(())
+
+    /// What it found: the fastest cell of each strategy in each group, after a blank line.
+    pub fn best_text(&self) -> String {
+        format!("\n{}", console::best_cells(&self.plan, &self.rows))
+    }
+
+    /// Where everything is.
+    pub fn paths_text(&self) -> String {
+        paths_text(&self.dir, &self.rows)
+    }
+
+    /// The error that says why the sweep is not complete, or not all ok; `Ok` when it is.
+    /// Consumes the sweep, releasing its directory's lock.
+    pub fn outcome(self) -> anyhow::Result<()> {
+        let (dir, rows, planned) = (&self.dir, &self.rows, self.plan.cells.len());
+        if self.status == SweepStatus::Interrupted {
+            bail!(
+                "interrupted: {} of {} cells are finished and saved in '{}'; \
+                 continue with `bench-sph sweep --resume {}`",
+                rows.len(),
+                planned,
+                dir.display(),
+                dir.display()
+            );
+        }
+        let failed: Vec<&SummaryRow> = rows.iter().filter(|r| r.status == Status::Failed).collect();
+        if let Some(first) = failed.first() {
+            bail!(
+                "{} of {} cells failed (status=failed in {}); the first: {} at {} cores: {}",
+                failed.len(),
+                planned,
+                dir.join(SUMMARY_FILE).display(),
+                first.strategy,
+                first.cores,
+                first.reason
+            );
+        }
+        Ok(())
+    }
 }
 
 /// The references of groups whose `seq` cell an earlier session finished.
@@ -275,9 +295,9 @@ fn finished_references(
 ) -> HashMap<Group, Reference> {
     finished
         .iter()
-        .filter(|r| r.strategy == sph_strategies::StrategyName::Seq.as_str())
+        .filter(|r| r.key().is_reference())
         .filter_map(|r| {
-            let cell = plan.cells.iter().find(|c| c.key() == r.key())?;
+            let cell = plan.cells.iter().find(|&&c| c == r.key())?;
             let walls = trials
                 .iter()
                 .filter(|t| t.key() == r.key())
@@ -302,7 +322,7 @@ fn check_memory(plan: &Plan) -> anyhow::Result<()> {
             g.n,
             available.map(|a| a.saturating_sub(copy)),
         )
-        .with_context(|| format!("the group {} cannot run here", g.label()))?;
+        .with_context(|| format!("the group {} cannot run here", g.label(LabelStyle::Sweep)))?;
     }
     Ok(())
 }
@@ -321,7 +341,7 @@ struct Busy {
 fn busy_before(timing: &Timing, threshold: &Threshold, cores: usize) -> Option<Busy> {
     let (foreign_s, wall_s) = match timing.fake_busy_threads(threshold.hardware_threads) {
         Some(threads) => (threads * BUSY_CHECK.as_secs_f64(), BUSY_CHECK.as_secs_f64()),
-        None => crate::contention::sample_now(BUSY_CHECK)?,
+        None => crate::clock::sample_now(BUSY_CHECK)?,
     };
     Some(Busy {
         threads: foreign_s / wall_s,
@@ -367,7 +387,7 @@ fn estimate(
         text.push_str(&format!(
             "  seq ≈ {} per run: {}\n",
             console::duration(seq_run_s[g]),
-            g.label()
+            g.label(LabelStyle::Sweep)
         ));
     }
     text.push_str(&format!(
@@ -388,31 +408,6 @@ fn print(text: &str) {
 
 fn console_warn(text: &str) {
     crate::output::console::warn(text);
-}
-
-/// The one place where a finished sweep's charts are made: `bench-sph report` on the sweep's
-/// directory, writing into it. A drawing failure is an error, but the CSVs and meta.json are
-/// already complete by then.
-fn render_charts(dir: &Path, no_plots: bool) -> anyhow::Result<String> {
-    if no_plots {
-        return Ok("Charts: skipped (--no-plots).".to_owned());
-    }
-    // The sweep has claimed its directory already (foreign files stay only where its own
-    // --force allowed them): the report writes beside them, never over them.
-    let written =
-        crate::report::generate(&[dir.to_path_buf()], dir, &[], true).with_context(|| {
-            format!(
-                "the charts and REPORT.md could not be made (the results in '{}' are complete; \
-             retry with `bench-sph report {}`)",
-                dir.display(),
-                dir.display()
-            )
-        })?;
-    let mut text = format!("Charts and report ({} files):", written.len());
-    for p in &written {
-        text.push_str(&format!("\n  {}", p.display()));
-    }
-    Ok(text)
 }
 
 /// Creates (or, with `force`, reclaims) the directory of a new sweep, locks it and writes its
@@ -439,7 +434,7 @@ fn start_new(
         finished: Vec::new(),
         finished_trials: Vec::new(),
         fresh: true,
-        _lock: lock,
+        lock,
     })
 }
 
@@ -458,7 +453,7 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
     })?;
     let plan = Plan::new(&meta.params);
     check_memory(&plan)?;
-    let planned: HashSet<CellKey> = plan.cells.iter().map(|c| c.key()).collect();
+    let planned: HashSet<Cell> = plan.cells.iter().copied().collect();
     let trials = meta.params.trials;
     let check = |row: &SummaryRow| -> Result<(), String> {
         if !planned.contains(&row.key()) {
@@ -474,20 +469,7 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
         Ok(())
     };
     let repaired = resume::load_and_repair(dir, &check)?;
-    let (was, now) = (&meta.machine, &session.machine);
-    if was.cpu_model != now.cpu_model || was.hardware_threads != now.hardware_threads {
-        console_warn(&format!(
-            "warning: this sweep started on '{}' ({} hardware threads) and continues on '{}' \
-             ({}): times from the two machines are not comparable",
-            was.cpu_model, was.hardware_threads, now.cpu_model, now.hardware_threads
-        ));
-    }
-    if meta.git_commit != session.git_commit {
-        console_warn(&format!(
-            "warning: this sweep started with bench-sph {} and continues with {}",
-            meta.git_commit, session.git_commit
-        ));
-    }
+    warn_if_changed(&meta, &session);
     for why in &repaired.rejected {
         console_warn(&format!("warning: dropped, will run again: {why}"));
     }
@@ -510,8 +492,26 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
         finished: repaired.finished,
         finished_trials: repaired.finished_trials,
         fresh: false,
-        _lock: lock,
+        lock,
     })
+}
+
+/// Warns when a resumed sweep continues on another machine or with another build.
+fn warn_if_changed(meta: &Meta, session: &Session) {
+    let (was, now) = (&meta.machine, &session.machine);
+    if was.cpu_model != now.cpu_model || was.hardware_threads != now.hardware_threads {
+        console_warn(&format!(
+            "warning: this sweep started on '{}' ({} hardware threads) and continues on '{}' \
+             ({}): times from the two machines are not comparable",
+            was.cpu_model, was.hardware_threads, now.cpu_model, now.hardware_threads
+        ));
+    }
+    if meta.git_commit != session.git_commit {
+        console_warn(&format!(
+            "warning: this sweep started with bench-sph {} and continues with {}",
+            meta.git_commit, session.git_commit
+        ));
+    }
 }
 
 /// Opens `path` for appending (creating it).
@@ -534,7 +534,7 @@ fn print_plan(
 ) {
     let mut text = format!("bench-sph sweep → {}\n", dir.display());
     for group in &plan.groups {
-        text.push_str(&format!("  group: {}\n", group.label()));
+        text.push_str(&format!("  group: {}\n", group.label(LabelStyle::Sweep)));
     }
     let names: Vec<&str> = params.strategies.iter().map(|s| s.as_str()).collect();
     text.push_str(&format!(
@@ -549,10 +549,10 @@ fn print_plan(
     ));
     text.push_str(&format!(
         "  {} × ({} + {}) = {}\n",
-        console::plural(plan.cells.len(), "cell", "cells"),
-        console::plural(params.warmup, "warm-up", "warm-ups"),
-        console::plural(params.trials, "trial", "trials"),
-        console::plural(
+        plural(plan.cells.len(), "cell", "cells"),
+        plural(params.warmup, "warm-up", "warm-ups"),
+        plural(params.trials, "trial", "trials"),
+        plural(
             plan.cells.len() * (params.warmup + params.trials),
             "run",
             "runs"
@@ -612,12 +612,12 @@ fn paths_text(dir: &Path, rows: &[SummaryRow]) -> String {
     text.push_str(&format!(
         "  {:<40} {}\n",
         dir.join(TRIALS_FILE).display().to_string(),
-        console::plural(trial_rows, "trial row", "trial rows")
+        plural(trial_rows, "trial row", "trial rows")
     ));
     text.push_str(&format!(
         "  {:<40} {}{}\n",
         dir.join(SUMMARY_FILE).display().to_string(),
-        console::plural(rows.len(), "cell", "cells"),
+        plural(rows.len(), "cell", "cells"),
         if failed > 0 {
             format!(", {failed} failed")
         } else {

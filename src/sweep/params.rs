@@ -1,45 +1,7 @@
-//! Every parameter of a sweep: what `meta.json` records and what `--resume` reads back.
+//! Checking a sweep's parameters ([`SweepParams`], recorded in `meta.json`): the command line
+//! and `--resume` refuse the same things.
 
-use serde::{Deserialize, Serialize};
-use sph_strategies::StrategyName;
-
-use crate::sph::neighbors::NeighborMode;
-use crate::sph::params::Preset;
-
-/// The parameters of a sweep, after parsing and expansion: the lists are sorted and free of
-/// repeats, so two sweeps with equal parameters have the same plan.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SweepParams {
-    /// Strategies to measure, in registry order (`seq` is measured in any case).
-    #[serde(with = "names")]
-    pub strategies: Vec<StrategyName>,
-    /// Presets (one group each, multiplied by the other group keys).
-    #[serde(with = "names")]
-    pub presets: Vec<Preset>,
-    /// Neighbour searches.
-    #[serde(with = "names")]
-    pub neighbors: Vec<NeighborMode>,
-    /// Particle counts.
-    pub n: Vec<usize>,
-    /// Steps per run.
-    pub steps: usize,
-    /// Worker-thread counts.
-    pub cores: Vec<usize>,
-    /// Chunk counts, for strategies that use chunks.
-    pub chunks: Vec<usize>,
-    /// Timed runs per cell.
-    pub trials: usize,
-    /// Untimed runs before a cell's trials.
-    pub warmup: usize,
-    /// Seed of the initial jitter.
-    pub seed: u64,
-    /// Test only: trial times replacing the measured ones (see [`super::timing`]).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub fake_timings: Option<String>,
-    /// Test only: foreign-CPU shares replacing the measured ones (see [`super::timing`]).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub fake_contention: Option<String>,
-}
+pub use crate::results::params::SweepParams;
 
 impl SweepParams {
     /// Checks the parameters as the command line does: every list non-empty, sorted, free of
@@ -93,76 +55,12 @@ impl SweepParams {
     }
 }
 
-/// A type written by name in `meta.json` (the same name as on the command line and in CSVs).
-pub trait Named: Sized + Copy + 'static {
-    /// The name.
-    fn name(self) -> &'static str;
-    /// Every value, so a name can be looked up.
-    fn all() -> &'static [Self];
-}
-
-impl Named for StrategyName {
-    fn name(self) -> &'static str {
-        self.as_str()
-    }
-    fn all() -> &'static [Self] {
-        StrategyName::ALL
-    }
-}
-
-impl Named for Preset {
-    fn name(self) -> &'static str {
-        self.as_str()
-    }
-    fn all() -> &'static [Self] {
-        &Preset::ALL
-    }
-}
-
-impl Named for NeighborMode {
-    fn name(self) -> &'static str {
-        self.as_str()
-    }
-    fn all() -> &'static [Self] {
-        &NeighborMode::ALL
-    }
-}
-
-/// Looks a name up among `T::all()`.
-pub fn by_name<T: Named>(name: &str) -> Option<T> {
-    T::all().iter().copied().find(|v| v.name() == name)
-}
-
-/// Serde for a list of [`Named`] values as a list of their names.
-mod names {
-    use serde::de::Error;
-    use serde::{Deserialize, Deserializer, Serializer};
-
-    use super::{Named, by_name};
-
-    pub fn serialize<T: Named, S: Serializer>(values: &[T], s: S) -> Result<S::Ok, S::Error> {
-        s.collect_seq(values.iter().map(|v| v.name()))
-    }
-
-    pub fn deserialize<'de, T: Named, D: Deserializer<'de>>(d: D) -> Result<Vec<T>, D::Error> {
-        Vec::<String>::deserialize(d)?
-            .iter()
-            .map(|name| {
-                by_name(name).ok_or_else(|| {
-                    let known: Vec<&str> = T::all().iter().map(|v| v.name()).collect();
-                    D::Error::custom(format!(
-                        "unknown name '{name}' (known: {})",
-                        known.join(", ")
-                    ))
-                })
-            })
-            .collect()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sph::neighbors::NeighborMode;
+    use crate::sph::params::Preset;
+    use sph_strategies::StrategyName;
 
     fn example() -> SweepParams {
         SweepParams {

@@ -7,145 +7,10 @@
 //! other strategy in registry order and each cores value, one cell per chunks value for the
 //! strategies that use chunks, and one cell (chunks empty) for those that do not.
 
-use sph_strategies::{Config, StrategyName};
+use sph_strategies::StrategyName;
 
-use super::params::SweepParams;
-use crate::sph::neighbors::NeighborMode;
-use crate::sph::params::Preset;
-
-/// The keys shared by every cell of a group.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Group {
-    /// Constants and integration order.
-    pub preset: Preset,
-    /// Neighbour search.
-    pub neighbors: NeighborMode,
-    /// Particles.
-    pub n: usize,
-    /// Steps per run.
-    pub steps: usize,
-}
-
-impl Group {
-    /// E.g. `preset seed, all-pairs, N = 1000, 1000 steps`.
-    pub fn label(&self) -> String {
-        format!(
-            "preset {}, {}, N = {}, {}",
-            self.preset,
-            self.neighbors,
-            self.n,
-            super::console::plural(self.steps, "step", "steps")
-        )
-    }
-}
-
-/// One configuration to measure.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub struct Cell {
-    /// The group it belongs to.
-    pub group: Group,
-    /// The strategy.
-    pub strategy: StrategyName,
-    /// Worker threads (1 for `seq`).
-    pub cores: usize,
-    /// Requested chunks per pass; `None` for strategies without a chunks parameter.
-    pub chunks: Option<usize>,
-}
-
-/// A cell as written in the CSVs' key columns: what `--resume` matches on.
-#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct CellKey {
-    /// Strategy name.
-    pub strategy: String,
-    /// Neighbour search name.
-    pub neighbors: String,
-    /// Preset name.
-    pub preset: String,
-    /// Particles.
-    pub n: usize,
-    /// Steps per run.
-    pub steps: usize,
-    /// Worker threads.
-    pub cores: usize,
-    /// Requested chunks, if the strategy uses them.
-    pub chunks: Option<usize>,
-}
-
-impl CellKey {
-    /// E.g. `rayon-chunks, 2 cores, 10 chunks (preset seed, all-pairs, N = 1000, 300 steps)`.
-    pub fn label(&self) -> String {
-        let cores = if self.cores == 1 { "core" } else { "cores" };
-        let chunks = self
-            .chunks
-            .map(|k| format!(", {k} chunks"))
-            .unwrap_or_default();
-        format!(
-            "{}, {} {cores}{chunks} (preset {}, {}, N = {}, {})",
-            self.strategy,
-            self.cores,
-            self.preset,
-            self.neighbors,
-            self.n,
-            super::console::plural(self.steps, "step", "steps")
-        )
-    }
-}
-
-impl Cell {
-    /// Whether this is its group's `seq` reference cell.
-    pub fn is_reference(&self) -> bool {
-        self.strategy == StrategyName::Seq
-    }
-
-    /// The strategy configuration (strategies without chunks ignore `chunks`).
-    pub fn config(&self) -> Config {
-        Config {
-            cores: self.cores,
-            chunks: self.chunks.unwrap_or(1),
-        }
-    }
-
-    /// Particles in the largest of the `min(chunks, n)` balanced chunks: `ceil(n / min(chunks, n))`.
-    pub fn particles_per_chunk(&self) -> Option<usize> {
-        let n = self.group.n;
-        self.chunks.map(|k| n.div_ceil(k.min(n)))
-    }
-
-    /// Whether the cell asks for more threads than the machine has.
-    pub fn oversubscribed(&self, hardware_threads: usize) -> bool {
-        self.cores > hardware_threads
-    }
-
-    /// The CSV key of the cell.
-    pub fn key(&self) -> CellKey {
-        CellKey {
-            strategy: self.strategy.as_str().to_owned(),
-            neighbors: self.group.neighbors.as_str().to_owned(),
-            preset: self.group.preset.as_str().to_owned(),
-            n: self.group.n,
-            steps: self.group.steps,
-            cores: self.cores,
-            chunks: self.chunks,
-        }
-    }
-
-    /// The text that seeds the cell's bootstrap streams ([`super::bootstrap::rng_for`]): frozen,
-    /// so that a display change never changes a results file (`rayon-chunks, 2 cores, 10
-    /// chunks`, `seq, 1 core`).
-    pub fn stream_key(&self) -> String {
-        let cores = if self.cores == 1 { "core" } else { "cores" };
-        match self.chunks {
-            Some(k) => format!("{}, {} {cores}, {k} chunks", self.strategy, self.cores),
-            None => format!("{}, {} {cores}", self.strategy, self.cores),
-        }
-    }
-
-    /// E.g. `rayon-chunks, 2 cores, 10 chunks`: today the same text as the frozen
-    /// [`stream_key`](Self::stream_key); a display change goes here, never there.
-    pub fn label(&self) -> String {
-        self.stream_key()
-    }
-}
+pub use crate::results::key::{Cell, Group, LabelStyle};
+use crate::results::params::SweepParams;
 
 /// Every cell of a sweep, grouped, in the order they run.
 #[derive(Debug, Clone, PartialEq)]
@@ -216,6 +81,8 @@ pub fn estimate_run_s(cell: &Cell, seq_run_s: f64, hardware_threads: usize) -> f
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sph::neighbors::NeighborMode;
+    use crate::sph::params::Preset;
 
     fn params(strategies: &[StrategyName]) -> SweepParams {
         SweepParams {

@@ -7,7 +7,7 @@
 //! back without it, and the cell runs again. Failed cells are finished too: their failure is a
 //! result (delete their rows by hand to retry them).
 //!
-//! A finished cell is believed only if it passes [`super::validate::cell`] (finite positive
+//! A finished cell is believed only if it passes [`crate::results::validate::cell`] (finite positive
 //! times, statistics that are those of its trials) and the caller's own check (`--resume`:
 //! the cell is in the plan and has the sweep's number of trials); otherwise it is dropped,
 //! listed in [`Repaired::rejected`], and runs again.
@@ -17,15 +17,15 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::export::{SUMMARY_COLUMNS, TRIAL_COLUMNS, to_csv};
-use super::plan::CellKey;
-use super::rows::{SummaryRow, TrialRow};
+use super::export::to_csv;
+use super::plan::Cell;
+use crate::results::rows::{SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow};
 
 /// A results file whose header is not this version's.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 #[error(
     "{file} has the columns '{found}', not those bench-sph {} writes",
-    super::meta::VERSION
+    crate::results::meta::VERSION
 )]
 pub struct UnexpectedColumns {
     /// The file's name.
@@ -57,6 +57,7 @@ pub struct Repaired {
 
 /// Repairs the contents of `trials.csv` and `summary.csv` (either may be empty: no file);
 /// `check` is the caller's own test of a finished cell (see the module docs).
+// Over ~60 lines on purpose: the repair is one pass over the rows whose steps (first row per cell, trials once per number, finished = complete and believed) are the module docs' list in order.
 pub fn repair(
     trials: &[u8],
     summary: &[u8],
@@ -77,7 +78,7 @@ pub fn repair(
             dropped_summary_rows += 1;
         }
     }
-    let mut by_cell: HashMap<CellKey, Vec<TrialRow>> = HashMap::new();
+    let mut by_cell: HashMap<Cell, Vec<TrialRow>> = HashMap::new();
     for row in trial_rows {
         let rows = by_cell.entry(row.key()).or_default();
         if rows.iter().any(|r| r.trial == row.trial) {
@@ -97,12 +98,12 @@ pub fn repair(
         let complete =
             trials.len() == row.trials && trials.iter().enumerate().all(|(i, t)| t.trial == i + 1);
         let believed = if complete {
-            super::validate::cell(&row, &trials).and_then(|()| check(&row))
+            crate::results::validate::cell(&row, &trials).and_then(|()| check(&row))
         } else {
             Ok(())
         };
         if let Err(why) = &believed {
-            rejected.push(format!("{}: {why}", row.key().label()));
+            rejected.push(format!("{}: {why}", row.key().label_with_group()));
         }
         if complete && believed.is_ok() {
             kept.extend(trials);

@@ -1,34 +1,15 @@
-//! The rows of `trials.csv` and `summary.csv`, and how a cell's measurements become them.
-//!
-//! Field names are the column names. Times are seconds; an empty field means "not defined"
-//! (chunks of a strategy without chunks, the stddev of one trial, any statistic of a failed
-//! cell, anything unmeasurable on this OS). `status` is `ok` or `failed`; a failed cell's
-//! `reason` says why, and its summary carries no statistic, speedup or efficiency: a bug must
-//! never become a number.
-//!
-//! Columns added after the first release are appended at the end of each row (older readers
-//! keep working): per trial `foreign_cpu_s, steal_s, load1` ([`crate::contention`]); per cell
-//! the 95 % bootstrap intervals `mean_ci_low_s, mean_ci_high_s, speedup_ci_low,
-//! speedup_ci_high` ([`super::bootstrap`]), `foreign_cpu_mean_s` and `contended` (some trial
-//! saw more foreign CPU than [`Threshold::allowed_s`]).
+//! How a cell's measurements become its rows of `trials.csv` and `summary.csv`
+//! ([`crate::results::rows`]): the statistics, the speedup over the group's `seq`, the
+//! bootstrap intervals ([`super::bootstrap`]) and the contention flag (some trial saw more
+//! foreign CPU than [`Threshold::allowed_s`]). A failed cell's summary carries no statistic,
+//! speedup or efficiency: a bug must never become a number.
 
-use serde::{Deserialize, Serialize};
-
-use super::bootstrap::{self, Interval};
-use super::plan::{Cell, CellKey};
-use super::stats::{Stats, mean};
+use super::bootstrap;
 use crate::clock::Elapsed;
 use crate::contention::Threshold;
-
-/// Whether a cell's numbers can be used.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Status {
-    /// Every run finished and reproduced the group's `seq` checksum.
-    Ok,
-    /// A run failed or its checksum differed: see `reason`.
-    Failed,
-}
+use crate::results::key::Cell;
+use crate::results::rows::{Status, SummaryRow, TrialRow};
+use crate::results::stats::{Interval, Stats, mean};
 
 /// One timed run: its times and the checksum of its final state.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,159 +22,19 @@ pub struct Measured {
     pub checksum: String,
 }
 
-/// One row of `trials.csv`: one timed run.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TrialRow {
-    /// Strategy name.
-    pub strategy: String,
-    /// Neighbour search.
-    pub neighbors: String,
-    /// Preset.
-    pub preset: String,
-    /// Particles.
-    pub n: usize,
-    /// Steps.
-    pub steps: usize,
-    /// Worker threads.
-    pub cores: usize,
-    /// Requested chunks (empty for strategies without chunks).
-    pub chunks: Option<usize>,
-    /// Particles in the largest chunk (empty for strategies without chunks).
-    pub particles_per_chunk: Option<usize>,
-    /// Trial number, from 1.
-    pub trial: usize,
-    /// Wall-clock seconds of the step loop.
-    pub wall_s: f64,
-    /// Process CPU seconds (user + system) over the same window.
-    pub cpu_s: f64,
-    /// Checksum of the final state (16 hex digits).
-    pub checksum: String,
-    /// The cell's status.
-    pub status: Status,
-    /// Why the cell failed (empty when ok).
-    pub reason: String,
-    /// Busy CPU seconds of the machine not spent by this process over the same window.
-    #[serde(default)]
-    pub foreign_cpu_s: Option<f64>,
-    /// Of those, seconds stolen by the hypervisor.
-    #[serde(default)]
-    pub steal_s: Option<f64>,
-    /// The 1-minute load average when the trial started.
-    #[serde(default)]
-    pub load1: Option<f64>,
-}
-
-/// One row of `summary.csv`: one cell.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SummaryRow {
-    /// Strategy name.
-    pub strategy: String,
-    /// Neighbour search.
-    pub neighbors: String,
-    /// Preset.
-    pub preset: String,
-    /// Particles.
-    pub n: usize,
-    /// Steps.
-    pub steps: usize,
-    /// Worker threads.
-    pub cores: usize,
-    /// Requested chunks (empty for strategies without chunks).
-    pub chunks: Option<usize>,
-    /// Particles in the largest chunk (empty for strategies without chunks).
-    pub particles_per_chunk: Option<usize>,
-    /// Trials completed (the rows of this cell in `trials.csv`).
-    pub trials: usize,
-    /// Mean wall seconds.
-    pub mean_s: Option<f64>,
-    /// Sample standard deviation of the wall seconds (empty for one trial).
-    pub stddev_s: Option<f64>,
-    /// Fastest trial, wall seconds.
-    pub min_s: Option<f64>,
-    /// Median wall seconds.
-    pub median_s: Option<f64>,
-    /// Slowest trial, wall seconds.
-    pub max_s: Option<f64>,
-    /// Mean CPU seconds (user + system).
-    pub cpu_mean_s: Option<f64>,
-    /// The group's `seq` mean divided by this cell's mean.
-    pub speedup: Option<f64>,
-    /// Speedup divided by cores.
-    pub efficiency: Option<f64>,
-    /// Trials with |t − median| > 3 MAD.
-    pub outliers: Option<usize>,
-    /// Whether cores exceed the machine's hardware threads.
-    pub oversubscribed: bool,
-    /// The checksum every trial reproduced (empty for a failed cell).
-    pub checksum: String,
-    /// `ok` or `failed`.
-    pub status: Status,
-    /// Why the cell failed (empty when ok).
-    pub reason: String,
-    /// Lower end of the 95 % bootstrap interval of the mean wall seconds.
-    #[serde(default)]
-    pub mean_ci_low_s: Option<f64>,
-    /// Upper end of that interval.
-    #[serde(default)]
-    pub mean_ci_high_s: Option<f64>,
-    /// Lower end of the 95 % bootstrap interval of the speedup.
-    #[serde(default)]
-    pub speedup_ci_low: Option<f64>,
-    /// Upper end of that interval.
-    #[serde(default)]
-    pub speedup_ci_high: Option<f64>,
-    /// Mean foreign CPU seconds per trial.
-    #[serde(default)]
-    pub foreign_cpu_mean_s: Option<f64>,
-    /// Whether some trial saw more foreign CPU than the threshold (empty where unknown).
-    #[serde(default)]
-    pub contended: Option<bool>,
-}
-
-impl TrialRow {
-    /// The row's cell.
-    pub fn key(&self) -> CellKey {
-        CellKey {
-            strategy: self.strategy.clone(),
-            neighbors: self.neighbors.clone(),
-            preset: self.preset.clone(),
-            n: self.n,
-            steps: self.steps,
-            cores: self.cores,
-            chunks: self.chunks,
-        }
-    }
-}
-
-impl SummaryRow {
-    /// The row's cell.
-    pub fn key(&self) -> CellKey {
-        CellKey {
-            strategy: self.strategy.clone(),
-            neighbors: self.neighbors.clone(),
-            preset: self.preset.clone(),
-            n: self.n,
-            steps: self.steps,
-            cores: self.cores,
-            chunks: self.chunks,
-        }
-    }
-}
-
 /// The trial rows of a cell: one per measured run, all with the cell's status and reason.
 pub fn trial_rows(cell: &Cell, measured: &[Measured], failure: Option<&str>) -> Vec<TrialRow> {
-    let key = cell.key();
     measured
         .iter()
         .enumerate()
         .map(|(i, m)| TrialRow {
-            strategy: key.strategy.clone(),
-            neighbors: key.neighbors.clone(),
-            preset: key.preset.clone(),
-            n: key.n,
-            steps: key.steps,
-            cores: key.cores,
-            chunks: key.chunks,
+            strategy: cell.strategy,
+            neighbors: cell.group.neighbors,
+            preset: cell.group.preset,
+            n: cell.group.n,
+            steps: cell.group.steps,
+            cores: cell.cores,
+            chunks: cell.chunks,
             particles_per_chunk: cell.particles_per_chunk(),
             trial: i + 1,
             wall_s: m.elapsed.wall_s,
@@ -226,13 +67,13 @@ pub struct CellContext<'a> {
 
 /// The summary row of a cell, against `ctx`; a failed cell has no statistics, speedup or
 /// intervals.
+// Over ~60 lines on purpose: most of it is one struct literal, every column of summary.csv in order.
 pub fn summary_row(
     cell: &Cell,
     measured: &[Measured],
     failure: Option<&str>,
     ctx: &CellContext<'_>,
 ) -> SummaryRow {
-    let key = cell.key();
     let walls: Vec<f64> = measured.iter().map(|m| m.elapsed.wall_s).collect();
     let cpus: Vec<f64> = measured.iter().map(|m| m.elapsed.cpu_s).collect();
     let stats = Stats::of(&walls).filter(|_| failure.is_none());
@@ -256,13 +97,13 @@ pub fn summary_row(
         .collect();
     let foreign = foreign.filter(|f| !f.is_empty());
     SummaryRow {
-        strategy: key.strategy,
-        neighbors: key.neighbors,
-        preset: key.preset,
-        n: key.n,
-        steps: key.steps,
-        cores: key.cores,
-        chunks: key.chunks,
+        strategy: cell.strategy,
+        neighbors: cell.group.neighbors,
+        preset: cell.group.preset,
+        n: cell.group.n,
+        steps: cell.group.steps,
+        cores: cell.cores,
+        chunks: cell.chunks,
         particles_per_chunk: cell.particles_per_chunk(),
         trials: measured.len(),
         mean_s: stats.map(|s| s.mean),
@@ -321,9 +162,9 @@ fn status_of(failure: Option<&str>) -> Status {
 mod tests {
     use super::*;
     use crate::contention::Foreign;
+    use crate::results::key::Group;
     use crate::sph::neighbors::NeighborMode;
     use crate::sph::params::Preset;
-    use crate::sweep::plan::Group;
     use sph_strategies::StrategyName;
 
     fn cell(strategy: StrategyName, cores: usize, chunks: Option<usize>) -> Cell {
@@ -461,7 +302,7 @@ mod tests {
             (rows[0].trial, rows[0].wall_s, rows[0].cpu_s),
             (1, 0.5, 1.0)
         );
-        assert_eq!(rows[1].key(), c.key());
+        assert_eq!(rows[1].key(), c);
         assert_eq!(rows[1].particles_per_chunk, Some(12));
         assert_eq!(rows[0].status, Status::Ok);
     }

@@ -23,10 +23,11 @@ use sph_strategies::StrategyName;
 use super::console;
 use super::export::Exporter;
 use super::plan::{Cell, Group, Plan};
-use super::rows::{CellContext, Measured, Status, SummaryRow, summary_row, trial_rows};
+use super::rows::{CellContext, Measured, summary_row, trial_rows};
 use super::timing::{Timing, Trial};
 use crate::checksum::checksum_hex;
 use crate::contention::Threshold;
+use crate::results::rows::{Status, SummaryRow};
 use crate::run::run_timed;
 use crate::scene::dam_break;
 use crate::solver::Simulation;
@@ -224,7 +225,7 @@ const CALIBRATION_N_ALL_PAIRS: usize = 4000;
 const CALIBRATION_N_GRID: usize = 200_000;
 
 /// Seconds one `seq` run of `group` takes, estimated from a short timed run of at most
-/// `CALIBRATION_N_ALL_PAIRS` (all-pairs) or `CALIBRATION_N_GRID` (grid) particles,
+/// 4000 (all-pairs, `CALIBRATION_N_ALL_PAIRS`) or 200 000 (grid, `CALIBRATION_N_GRID`) particles,
 /// scaled by (N / sample)² or N / sample: one step, then doubling the steps until a run
 /// takes 50 ms or covers all steps. NaN when the run fails (the sweep will then report the
 /// failure properly).
@@ -294,6 +295,32 @@ pub struct SessionOutcome {
     pub interrupted: bool,
 }
 
+/// What `cell` is measured against: the checksum its runs must reproduce and the group's
+/// `seq` walls (both `None` for the reference cell itself), or why it cannot run.
+type Against = (Option<String>, Option<String>, Option<Vec<f64>>);
+
+/// The group's reference as `cell` needs it (see [`Against`]): `(checksum, failure, walls)`.
+fn against(cell: &Cell, references: &HashMap<Group, Reference>) -> Against {
+    if cell.is_reference() {
+        return (None, None, None);
+    }
+    match references.get(&cell.group) {
+        Some(Reference::Ok { checksum, walls }) => {
+            (Some(checksum.clone()), None, Some(walls.clone()))
+        }
+        Some(Reference::Failed(why)) => (
+            None,
+            Some(format!("not run: the group's seq reference failed ({why})")),
+            None,
+        ),
+        None => (
+            None,
+            Some("not run: the group has no seq reference".to_owned()),
+            None,
+        ),
+    }
+}
+
 impl<T: Write, S: Write> Runner<'_, T, S> {
     /// Runs the cells at positions `todo` of the plan (ascending), measuring each against its
     /// group's entry in `references` (filled in as `seq` cells finish), and writes each
@@ -313,25 +340,7 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
                 break;
             }
             let cell = self.plan.cells[index];
-            let (measured, failure, seq_walls) = if cell.is_reference() {
-                (None, None, None)
-            } else {
-                match references.get(&cell.group) {
-                    Some(Reference::Ok { checksum, walls }) => {
-                        (Some(checksum.clone()), None, Some(walls.clone()))
-                    }
-                    Some(Reference::Failed(why)) => (
-                        None,
-                        Some(format!("not run: the group's seq reference failed ({why})")),
-                        None,
-                    ),
-                    None => (
-                        None,
-                        Some("not run: the group has no seq reference".to_owned()),
-                        None,
-                    ),
-                }
-            };
+            let (measured, failure, seq_walls) = against(&cell, references);
             let (measured, failure) = if let Some(failure) = failure {
                 self.progress
                     .inc(self.run_ms[index].saturating_mul((self.warmup + self.trials) as u64));
@@ -351,29 +360,10 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
                 }
             };
 
-            let seq_walls = if cell.is_reference() {
-                failure.is_none().then(|| walls(&measured))
-            } else {
-                seq_walls
-            };
-            let ctx = CellContext {
-                seq_walls: seq_walls.as_deref(),
-                hardware_threads: self.hardware_threads,
-                threshold: self.threshold,
-                seed: self.seed,
-                resamples: self.resamples,
-            };
-            let summary = summary_row(&cell, &measured, failure.as_deref(), &ctx);
-            let trials = trial_rows(&cell, &measured, failure.as_deref());
-            self.exporter
-                .write_cell(&trials, &summary)
-                .context("cannot write the results")?;
-            if cell.is_reference() {
-                references.insert(cell.group, Reference::from_row(&summary, walls(&measured)));
-            }
+            let summary = self.record(index, &measured, failure, seq_walls, references)?;
             let mut text = String::new();
             if self.plan.groups.len() > 1 && shown_group != Some(cell.group) {
-                text = format!("{}:\n", cell.group.label());
+                text = format!("{}:\n", cell.group.label(super::plan::LabelStyle::Sweep));
                 shown_group = Some(cell.group);
             }
             text.push_str(&console::cell_line(
@@ -390,6 +380,40 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
             outcome.rows.push(summary);
         }
         Ok(outcome)
+    }
+
+    /// Writes the cell at `index` of the plan (its trial rows and summary row, against the
+    /// group's `seq` walls), and records a reference cell in `references`.
+    fn record(
+        &mut self,
+        index: usize,
+        measured: &[Measured],
+        failure: Option<String>,
+        seq_walls: Option<Vec<f64>>,
+        references: &mut HashMap<Group, Reference>,
+    ) -> anyhow::Result<SummaryRow> {
+        let cell = self.plan.cells[index];
+        let seq_walls = if cell.is_reference() {
+            failure.is_none().then(|| walls(measured))
+        } else {
+            seq_walls
+        };
+        let ctx = CellContext {
+            seq_walls: seq_walls.as_deref(),
+            hardware_threads: self.hardware_threads,
+            threshold: self.threshold,
+            seed: self.seed,
+            resamples: self.resamples,
+        };
+        let summary = summary_row(&cell, measured, failure.as_deref(), &ctx);
+        let trials = trial_rows(&cell, measured, failure.as_deref());
+        self.exporter
+            .write_cell(&trials, &summary)
+            .context("cannot write the results")?;
+        if cell.is_reference() {
+            references.insert(cell.group, Reference::from_row(&summary, walls(measured)));
+        }
+        Ok(summary)
     }
 
     /// The runs of one cell, with the progress bar advanced after each.

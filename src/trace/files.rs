@@ -1,7 +1,7 @@
 //! The files of a trace directory, and how `trace` recognises its own: what `trace --out`
 //! may replace, and what `report` accepts as a trace.
 
-use std::io::Read;
+use crate::output::sniff::{PNG_SIGNATURE, starts_with};
 use std::path::Path;
 
 use super::stats::CSV_HEADER;
@@ -17,18 +17,8 @@ pub const STATS_CSV: &str = "stats.csv";
 /// The configuration and totals.
 pub const META_JSON: &str = "meta.json";
 
-/// The first bytes of every PNG file.
-pub const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n'];
 /// How `trace.json` starts.
 const TRACE_JSON_START: &[u8] = b"{\"traceEvents\":";
-
-/// Whether the file at `path` starts with `prefix` (false if it cannot be read).
-pub fn starts_with(path: &Path, prefix: &[u8]) -> bool {
-    let mut head = vec![0; prefix.len()];
-    std::fs::File::open(path)
-        .and_then(|mut f| f.read_exact(&mut head))
-        .is_ok_and(|()| head == prefix)
-}
 
 /// Whether a `meta.json` text is a trace's: `"tool": "bench-sph trace"`, or, written before
 /// that field existed, no `tool` but the trace's own `timeline_steps` and `kernel_calls`.

@@ -28,7 +28,7 @@ use crate::plot::font;
 use crate::solver::Pass;
 
 /// Width of the image in pixels.
-pub const WIDTH: u32 = 1600;
+pub const WIDTH: u32 = crate::results::files::TIMELINE_WIDTH;
 const HEADER_PX: u32 = 84;
 const TOP_PX: u32 = 40;
 const ROW_PX: u32 = 56;
@@ -500,7 +500,7 @@ mod tests {
         .unwrap();
         let mut bytes = Vec::new();
         write_png(&trace, &stats.workers, &config(), 1..=2, &mut bytes).unwrap();
-        assert_eq!(&bytes[..8], crate::trace::files::PNG_SIGNATURE);
+        assert_eq!(&bytes[..8], crate::output::sniff::PNG_SIGNATURE);
         if let Ok(path) = std::env::var("TIMELINE_PNG") {
             std::fs::write(path, &bytes).unwrap();
         }

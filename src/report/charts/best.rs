@@ -56,6 +56,7 @@ pub fn draw(path: &Path, title: &str, subtitle: &str, chart: &BestChart<'_>) -> 
     super::render(path, title, subtitle, &legend, |area| plot(area, chart, c))
 }
 
+// Over ~60 lines on purpose: a plotters builder chain for two stacked panels; each call is one visual element.
 fn plot(area: &Area<'_>, chart: &BestChart<'_>, c: RGBColor) -> DrawResult {
     let (top, bottom) = area.split_vertically(area.dim_in_pixel().1 / 2);
     let (labels, descs) = axis_styles();

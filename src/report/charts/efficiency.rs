@@ -34,6 +34,7 @@ pub fn draw(
     })
 }
 
+// Over ~60 lines on purpose: a plotters builder chain for two stacked panels; each call is one visual element.
 fn plot(area: &Area<'_>, efficiency: &[Line], serial: &[Line]) -> DrawResult {
     let (top, bottom) = area.split_vertically(area.dim_in_pixel().1 / 2);
     let (labels, descs) = axis_styles();

@@ -19,10 +19,11 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 use super::series::{Line, Point};
 use crate::plot::font;
 
-/// Width of every chart, pixels.
-pub const WIDTH: u32 = 1000;
+/// Width of every chart, pixels (the results directory's schema knows it: a chart is
+/// recognised by its size).
+pub const WIDTH: u32 = crate::results::files::CHART_WIDTH;
 /// Height of every chart, pixels.
-pub const HEIGHT: u32 = 650;
+pub const HEIGHT: u32 = crate::results::files::CHART_HEIGHT;
 /// Width of the legend panel on the right, pixels.
 const LEGEND_PX: u32 = 250;
 /// Height of the title band, pixels.

@@ -7,6 +7,35 @@
 //! - MAD: the median absolute deviation, median(|t − median|), unscaled;
 //! - outliers: trials with |t − median| > 3 · MAD ([`OUTLIER_MADS`]). When more than half the
 //!   trials are equal the MAD is 0, and every trial that differs from the median counts.
+//!
+//! And what the summary's intervals are: [`Interval`]s at [`CONFIDENCE`] from [`RESAMPLES`]
+//! bootstrap resamples (computed by [`crate::sweep::bootstrap`]).
+
+/// Resamples per interval.
+pub const RESAMPLES: usize = 10_000;
+/// The intervals' confidence level.
+pub const CONFIDENCE: f64 = 0.95;
+
+/// A confidence interval.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Interval {
+    /// Lower end.
+    pub low: f64,
+    /// Upper end.
+    pub high: f64,
+}
+
+impl Interval {
+    /// Whether the two intervals share a point.
+    pub fn overlaps(&self, other: &Interval) -> bool {
+        self.low <= other.high && other.low <= self.high
+    }
+
+    /// Whether `x` lies inside.
+    pub fn contains(&self, x: f64) -> bool {
+        self.low <= x && x <= self.high
+    }
+}
 
 /// How many MADs from the median make a trial an outlier.
 pub const OUTLIER_MADS: f64 = 3.0;

@@ -12,6 +12,7 @@ use anyhow::Context;
 use serde::{Deserialize, Serialize};
 
 use super::params::SweepParams;
+use super::stats::{CONFIDENCE, RESAMPLES};
 
 /// The version of bench-sph that wrote the file.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -129,8 +130,8 @@ impl Statistics {
     /// This version's settings for a sweep with `seed`.
     pub fn current(seed: u64) -> Statistics {
         Statistics {
-            bootstrap_resamples: super::bootstrap::RESAMPLES,
-            confidence: super::bootstrap::CONFIDENCE,
+            bootstrap_resamples: RESAMPLES,
+            confidence: CONFIDENCE,
             bootstrap_seed: seed,
             contended_share: crate::contention::CONTENDED_SHARE,
         }

@@ -1,5 +1,5 @@
-//! Reading results directories: `meta.json`, `summary.csv` and `trials.csv` into the sweep's
-//! own types ([`Meta`], [`SummaryRow`], [`TrialRow`]), with errors that name the file and the
+//! Reading results directories leniently (`bench-sph report`): `meta.json`, `summary.csv` and
+//! `trials.csv` into the schema's types ([`Meta`], [`SummaryRow`], [`TrialRow`]), with errors that name the file and the
 //! line, and every cell checked before it can become a number in the report.
 //!
 //! - Files of this version and of the first release (before the contention and interval
@@ -18,14 +18,14 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
-use crate::sweep::export::{
-    LEGACY_SUMMARY_COLUMNS, LEGACY_TRIAL_COLUMNS, SUMMARY_COLUMNS, TRIAL_COLUMNS,
+use super::files::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
+use super::key::Cell;
+use super::meta::Meta;
+use super::rows::{
+    LEGACY_SUMMARY_COLUMNS, LEGACY_TRIAL_COLUMNS, SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS,
+    TrialRow,
 };
-use crate::sweep::meta::Meta;
-use crate::sweep::plan::CellKey;
-use crate::sweep::rows::{SummaryRow, TrialRow};
-use crate::sweep::validate;
-use crate::sweep::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
+use super::validate;
 
 /// One sweep's results.
 #[derive(Debug, Clone)]
@@ -60,14 +60,14 @@ pub fn load_all(dirs: &[PathBuf]) -> anyhow::Result<Vec<Sweep>> {
         .iter()
         .map(|d| load(d))
         .collect::<anyhow::Result<Vec<_>>>()?;
-    let mut owner: HashMap<CellKey, &Path> = HashMap::new();
+    let mut owner: HashMap<Cell, &Path> = HashMap::new();
     for s in &sweeps {
         for r in &s.rows {
             if let Some(first) = owner.insert(r.key(), &s.dir) {
                 bail!(
                     "the cell {} is in both '{}' and '{}': report them separately, or remove \
                      it from one (a cell must count once)",
-                    r.key().label(),
+                    r.key().label_with_group(),
                     first.display(),
                     s.dir.display()
                 );
@@ -100,7 +100,7 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
     } else {
         None
     };
-    let mut by_cell: HashMap<CellKey, Vec<TrialRow>> = HashMap::new();
+    let mut by_cell: HashMap<Cell, Vec<TrialRow>> = HashMap::new();
     for t in trials.iter().flatten() {
         by_cell.entry(t.key()).or_default().push(t.clone());
     }
@@ -118,7 +118,7 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
         };
         match checked {
             Ok(()) => rows.push(row),
-            Err(why) => dropped.push(format!("{}: {why}", row.key().label())),
+            Err(why) => dropped.push(format!("{}: {why}", row.key().label_with_group())),
         }
     }
     if rows.is_empty() {
@@ -218,5 +218,22 @@ mod tests {
         let (rows, _) = read_summary(&path).unwrap();
         assert_eq!(rows.len(), 1);
         assert_eq!((rows[0].mean_ci_low_s, rows[0].contended), (None, None));
+    }
+
+    #[test]
+    fn a_row_naming_an_unknown_strategy_is_left_out_as_unreadable() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("summary.csv");
+        let header = SUMMARY_COLUMNS[..LEGACY_SUMMARY_COLUMNS].join(",");
+        let row = "all-pairs,seed,60,3,1,,,2,1.5,0.5,1.0,1.5,2.0,1.5,1.0,1.0,0,false,00000000000000aa,ok,";
+        std::fs::write(&path, format!("{header}\nseq,{row}\nturbo,{row}\n")).unwrap();
+        let (rows, bad) = read_summary(&path).unwrap();
+        assert_eq!(rows.len(), 1);
+        assert_eq!(rows[0].strategy, sph_strategies::StrategyName::Seq);
+        assert_eq!(bad.len(), 1);
+        assert!(
+            bad[0].contains("line 3: not a bench-sph summary row"),
+            "{bad:?}"
+        );
     }
 }

@@ -1,0 +1,359 @@
+//! Which charts a report draws, as data: for each chart its file name, caption, titles and
+//! series, and for each chart that does not apply, why. A pure function of the summary rows
+//! ([`plan`]); [`super::generate`] then only draws each [`ChartPlan`] and writes the text
+//! (criterion's "compute the series, then draw").
+
+use sph_strategies::StrategyName;
+
+use super::charts::best::BestChart;
+use super::markdown::Skipped;
+use super::paper;
+use super::series::{self, Line, Metric};
+use crate::results::key::{Group, LabelStyle};
+use crate::results::rows::SummaryRow;
+use crate::sph::params::Preset;
+
+/// What a chart shows, with its series.
+#[derive(Debug, Clone)]
+pub enum ChartKind {
+    /// Charts 1 and 2: `metric` against chunks, one line per core count.
+    Chunks {
+        /// The y axis' description.
+        y_desc: &'static str,
+        /// One line per core count.
+        lines: Vec<Line>,
+        /// Whether each line's minimum is crossed (runtime, not CPU time).
+        mark_min: bool,
+    },
+    /// Chart 3: one strategy's best runtime and speedup against cores.
+    Best(BestChart<'static>),
+    /// Chart 4: every strategy's best speedup against cores.
+    Speedup(Vec<Line>),
+    /// Chart 5: efficiency and the Karp–Flatt serial fraction against cores.
+    Efficiency {
+        /// Efficiency lines.
+        efficiency: Vec<Line>,
+        /// Serial-fraction lines.
+        serial: Vec<Line>,
+    },
+    /// Chart 6: all-pairs against grid, seconds per step against N.
+    Neighbors(Vec<Line>),
+}
+
+/// One chart to draw.
+#[derive(Debug, Clone)]
+pub struct ChartPlan {
+    /// File name, relative to the report.
+    pub file: String,
+    /// The group it belongs to (`None` for charts across groups).
+    pub group: Option<Group>,
+    /// The report's one-sentence caption.
+    pub caption: String,
+    /// The title drawn on the chart.
+    pub title: String,
+    /// The subtitle drawn under it.
+    pub subtitle: String,
+    /// The series.
+    pub kind: ChartKind,
+}
+
+/// Every chart of a report, in the order drawn, and the notes on those not drawn.
+#[derive(Debug, Clone, Default)]
+pub struct ReportPlan {
+    /// Charts to draw, group by group, then the charts across groups.
+    pub charts: Vec<ChartPlan>,
+    /// Charts that do not apply, and why.
+    pub skipped: Vec<Skipped>,
+}
+
+/// The charts of `rows` (see the module docs of [`super`] for the list).
+pub fn plan(rows: &[SummaryRow]) -> ReportPlan {
+    let mut out = ReportPlan::default();
+    for g in series::groups(rows) {
+        chunk_charts(rows, &g, &mut out);
+        cores_charts(rows, &g, &mut out);
+    }
+    for preset in series::presets(rows) {
+        neighbor_chart(rows, preset, &mut out);
+    }
+    out
+}
+
+impl ReportPlan {
+    fn skip(&mut self, group: &Group, note: &str) {
+        self.skipped.push(Skipped {
+            group: Some(*group),
+            note: note.to_owned(),
+        });
+    }
+
+    fn chart(
+        &mut self,
+        group: &Group,
+        file: String,
+        title: String,
+        caption: String,
+        kind: ChartKind,
+    ) {
+        self.charts.push(ChartPlan {
+            file,
+            group: Some(*group),
+            caption,
+            title,
+            subtitle: group.label(LabelStyle::Report),
+            kind,
+        });
+    }
+}
+
+/// Charts 1 and 2 for each chunked strategy of `g`.
+fn chunk_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
+    let subtitle = g.label(LabelStyle::Report);
+    let chunked: Vec<StrategyName> = series::strategies(rows, g)
+        .into_iter()
+        .filter(|&s| series::is_chunked(rows, g, s))
+        .collect();
+    if chunked.is_empty() {
+        out.skip(
+            g,
+            "Charts 1–2 (time against chunks) are not drawn: no strategy with chunks was \
+             measured in this group.",
+        );
+    }
+    for s in chunked {
+        for (metric, n, what, y_desc) in [
+            (Metric::Wall, 1, "runtime", "mean runtime (s)"),
+            (Metric::Cpu, 2, "cpu", "mean CPU time, user + sys (s)"),
+        ] {
+            let lines = series::chunk_lines(rows, g, s, metric);
+            if lines.is_empty() {
+                continue;
+            }
+            let (title, caption) = match metric {
+                Metric::Wall => (
+                    format!("Runtime against chunks: {s}"),
+                    format!(
+                        "Chart 1: {s}, mean runtime against chunks per pass, one line per core \
+                         count, each line's minimum crossed (the paper's Figure 7); {subtitle}."
+                    ),
+                ),
+                Metric::Cpu => (
+                    format!("CPU time against chunks: {s}"),
+                    format!(
+                        "Chart 2: {s}, mean CPU time (user + sys) against chunks per pass, \
+                         one line per core count (the paper's Figure 8); {subtitle}."
+                    ),
+                ),
+            };
+            let file = format!("{}-{n}-{what}-vs-chunks-{s}.png", g.slug());
+            let mark_min = metric == Metric::Wall;
+            let kind = ChartKind::Chunks {
+                y_desc,
+                lines,
+                mark_min,
+            };
+            out.chart(g, file, title, caption, kind);
+        }
+    }
+}
+
+/// Charts 3–5 of `g`, or why they are not drawn.
+fn cores_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
+    let cores = series::cores(rows, g);
+    match series::seq_mean(rows, g) {
+        Some(seq_s) if cores.len() > 1 => {
+            best_charts(rows, g, seq_s, out);
+            speedup_and_efficiency_charts(rows, g, out);
+        }
+        Some(_) => match cores.first() {
+            Some(&c) => out.skip(
+                g,
+                &format!(
+                    "Charts 3–5 (against cores) are not drawn: only {} was measured.",
+                    series::cores_label(c)
+                ),
+            ),
+            None => out.skip(
+                g,
+                "Charts 3–5 (against cores) are not drawn: no parallel strategy has a usable \
+                 cell.",
+            ),
+        },
+        None => out.skip(
+            g,
+            "Charts 3–5 (against cores) are not drawn: there is no usable seq reference.",
+        ),
+    }
+}
+
+/// Chart 3 for each strategy of `g` with at least two core counts.
+fn best_charts(rows: &[SummaryRow], g: &Group, seq_s: f64, out: &mut ReportPlan) {
+    let subtitle = g.label(LabelStyle::Report);
+    let comparable = paper::comparable(g);
+    let speedups = series::speedup_lines(rows, g);
+    for s in series::strategies(rows, g)
+        .into_iter()
+        .filter(|&s| s != StrategyName::Seq)
+    {
+        let best = series::best_per_cores(rows, g, s);
+        if best.len() < 2 {
+            continue;
+        }
+        let Some(speedup) = speedups.iter().find(|l| l.label == s.as_str()).cloned() else {
+            continue;
+        };
+        let data = BestChart {
+            strategy: s.as_str(),
+            runtime: series::runtime_line(&best, s.as_str()),
+            speedup,
+            seq_s,
+            paper: comparable,
+        };
+        let caption = format!(
+            "Chart 3: {s}, best runtime (above) and best speedup (below) against cores, \
+             bars: 95 % confidence intervals{} (the paper's Figures 9 and 10); {subtitle}.",
+            if comparable {
+                "; grey triangles: the paper's published speedups on its own machine, at the \
+                 core counts measured here"
+            } else {
+                ""
+            }
+        );
+        let file = format!("{}-3-best-{s}.png", g.slug());
+        let title = format!("Best runtime and speedup against cores: {s}");
+        out.chart(g, file, title, caption, ChartKind::Best(data));
+    }
+}
+
+/// Charts 4 and 5 of `g`.
+fn speedup_and_efficiency_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
+    let subtitle = g.label(LabelStyle::Report);
+    out.chart(
+        g,
+        format!("{}-4-speedup.png", g.slug()),
+        "Speedup against cores, every strategy".to_owned(),
+        format!(
+            "Chart 4: every strategy's best speedup against cores, error bars the 95 % \
+             bootstrap interval of the best cell's speedup; {subtitle}."
+        ),
+        ChartKind::Speedup(series::speedup_lines(rows, g)),
+    );
+    let (efficiency, serial) = series::efficiency_lines(rows, g);
+    out.chart(
+        g,
+        format!("{}-5-efficiency.png", g.slug()),
+        "Efficiency and Karp–Flatt serial fraction against cores".to_owned(),
+        format!(
+            "Chart 5: parallel efficiency S/p (above) and the Karp–Flatt serial fraction \
+             e = (1/S − 1/p)/(1 − 1/p) (below, only where S > 1 and p > 1) against \
+             cores; {subtitle}."
+        ),
+        ChartKind::Efficiency { efficiency, serial },
+    );
+}
+
+/// Chart 6 of `preset`, or why it is not drawn.
+fn neighbor_chart(rows: &[SummaryRow], preset: Preset, out: &mut ReportPlan) {
+    match series::neighbor_lines(rows, preset) {
+        Some(lines) if !lines.is_empty() => out.charts.push(ChartPlan {
+            file: format!("{preset}-6-neighbors.png"),
+            group: None,
+            caption: format!(
+                "Chart 6: all-pairs against grid, seconds per step against N ({preset} \
+                 preset), for seq and for the fastest parallel cell, one line per step \
+                 count (runs of different lengths are never joined); bars: 95 % \
+                 confidence intervals."
+            ),
+            title: "All-pairs against grid: time per step against N".to_owned(),
+            subtitle: format!("{preset} preset; seq at 1 core and the fastest parallel cell"),
+            kind: ChartKind::Neighbors(lines),
+        }),
+        _ => out.skipped.push(Skipped {
+            group: None,
+            note: format!(
+                "Chart 6 (all-pairs against grid) is not drawn for the {preset} preset: the \
+                 results hold only one neighbour search."
+            ),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::results::rows::tests::row;
+    use crate::sph::neighbors::NeighborMode;
+
+    fn files(p: &ReportPlan) -> Vec<&str> {
+        p.charts.iter().map(|c| c.file.as_str()).collect()
+    }
+
+    #[test]
+    fn a_group_with_chunks_and_several_core_counts_gets_charts_one_to_five_in_order() {
+        let rows = vec![
+            row(StrategyName::Seq, 1, None, 4.0),
+            row(StrategyName::RayonChunks, 1, Some(5), 4.1),
+            row(StrategyName::RayonChunks, 2, Some(5), 2.5),
+            row(StrategyName::RayonChunks, 2, Some(10), 2.2),
+        ];
+        let p = plan(&rows);
+        assert_eq!(
+            files(&p),
+            [
+                "seed-all-pairs-n60-s3-1-runtime-vs-chunks-rayon-chunks.png",
+                "seed-all-pairs-n60-s3-2-cpu-vs-chunks-rayon-chunks.png",
+                "seed-all-pairs-n60-s3-3-best-rayon-chunks.png",
+                "seed-all-pairs-n60-s3-4-speedup.png",
+                "seed-all-pairs-n60-s3-5-efficiency.png",
+            ]
+        );
+        assert!(
+            p.charts[2].caption.contains("grey triangles"),
+            "seed/all-pairs is the paper's"
+        );
+        assert!(
+            p.charts
+                .iter()
+                .all(|c| c.subtitle == "seed preset, all-pairs, N = 60, 3 steps")
+        );
+        let notes: Vec<&str> = p.skipped.iter().map(|s| s.note.as_str()).collect();
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(notes[0].starts_with("Chart 6 (all-pairs against grid) is not drawn for the seed"));
+    }
+
+    #[test]
+    fn one_core_count_and_no_chunks_skip_their_charts_with_a_reason() {
+        let rows = vec![
+            row(StrategyName::Seq, 1, None, 4.0),
+            row(StrategyName::RayonIter, 2, None, 2.0),
+        ];
+        let p = plan(&rows);
+        assert!(p.charts.is_empty(), "{:?}", files(&p));
+        let notes: Vec<&str> = p.skipped.iter().map(|s| s.note.as_str()).collect();
+        assert!(notes[0].contains("no strategy with chunks"), "{notes:?}");
+        assert!(notes[1].contains("only 2 cores was measured"), "{notes:?}");
+    }
+
+    #[test]
+    fn without_a_seq_reference_no_chart_against_cores_is_planned() {
+        let rows = vec![
+            row(StrategyName::RayonIter, 2, None, 2.0),
+            row(StrategyName::RayonIter, 3, None, 1.5),
+        ];
+        let p = plan(&rows);
+        assert!(p.charts.is_empty());
+        assert!(p.skipped[1].note.contains("no usable seq reference"));
+    }
+
+    #[test]
+    fn both_neighbour_searches_of_a_preset_give_chart_six_across_groups() {
+        let mut rows = vec![row(StrategyName::Seq, 1, None, 4.0)];
+        let mut grid = row(StrategyName::Seq, 1, None, 1.0);
+        grid.neighbors = NeighborMode::Grid;
+        rows.push(grid);
+        let p = plan(&rows);
+        assert_eq!(files(&p), ["seed-6-neighbors.png"]);
+        assert_eq!(p.charts[0].group, None);
+        assert!(matches!(&p.charts[0].kind, ChartKind::Neighbors(lines) if lines.len() == 2));
+    }
+}

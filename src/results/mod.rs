@@ -1,0 +1,27 @@
+//! The results directory's schema, below both the sweep that writes it and the report that
+//! reads it: file names ([`files`]), the cell key ([`key`]), the rows and columns of
+//! `trials.csv` and `summary.csv` ([`rows`]), `meta.json` ([`meta`]) with the sweep's
+//! parameters ([`params`]) written by name ([`names`]), the statistics of a cell ([`stats`]),
+//! the checks a cell read back must pass ([`validate`]) and the lenient reading of whole
+//! directories ([`load`]).
+//!
+//! A results directory holds:
+//! - `trials.csv`: one row per timed trial (columns [`rows::TRIAL_COLUMNS`]);
+//! - `summary.csv`: one row per cell (columns [`rows::SUMMARY_COLUMNS`]): mean, sample
+//!   stddev, min, median, max of the wall seconds, mean CPU seconds, speedup over the group's
+//!   `seq` mean, efficiency = speedup / cores, outliers (|t − median| > 3 MAD),
+//!   oversubscribed, the common checksum, status and reason;
+//! - `meta.json`: machine, build, times, command lines and every parameter;
+//! - `sweep.lock` while a sweep runs, and the report drawn from it (`REPORT.md`, charts).
+
+pub mod files;
+pub mod key;
+pub mod load;
+pub mod meta;
+pub mod names;
+pub mod params;
+pub mod rows;
+pub mod stats;
+pub mod validate;
+
+pub use files::{LOCK_FILE, META_FILE, REPORT_FILE, SUMMARY_FILE, TRIALS_FILE, is_report_file};

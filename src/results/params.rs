@@ -1,0 +1,44 @@
+//! Every parameter of a sweep: what `meta.json` records and what `--resume` reads back
+//! (checked by [`crate::sweep::params`]).
+
+use serde::{Deserialize, Serialize};
+use sph_strategies::StrategyName;
+
+use super::names::name_list;
+use crate::sph::neighbors::NeighborMode;
+use crate::sph::params::Preset;
+
+/// The parameters of a sweep, after parsing and expansion: the lists are sorted and free of
+/// repeats, so two sweeps with equal parameters have the same plan.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepParams {
+    /// Strategies to measure, in registry order (`seq` is measured in any case).
+    #[serde(with = "name_list")]
+    pub strategies: Vec<StrategyName>,
+    /// Presets (one group each, multiplied by the other group keys).
+    #[serde(with = "name_list")]
+    pub presets: Vec<Preset>,
+    /// Neighbour searches.
+    #[serde(with = "name_list")]
+    pub neighbors: Vec<NeighborMode>,
+    /// Particle counts.
+    pub n: Vec<usize>,
+    /// Steps per run.
+    pub steps: usize,
+    /// Worker-thread counts.
+    pub cores: Vec<usize>,
+    /// Chunk counts, for strategies that use chunks.
+    pub chunks: Vec<usize>,
+    /// Timed runs per cell.
+    pub trials: usize,
+    /// Untimed runs before a cell's trials.
+    pub warmup: usize,
+    /// Seed of the initial jitter.
+    pub seed: u64,
+    /// Test only: trial times replacing the measured ones (see [`crate::sweep::timing`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fake_timings: Option<String>,
+    /// Test only: foreign-CPU shares replacing the measured ones (see [`crate::sweep::timing`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fake_contention: Option<String>,
+}

@@ -1,0 +1,362 @@
+//! The rows of `trials.csv` and `summary.csv`, their columns, their cell key, and the one rule
+//! that picks a group's fastest cell.
+//!
+//! Field names are the column names. Times are seconds; an empty field means "not defined"
+//! (chunks of a strategy without chunks, the stddev of one trial, any statistic of a failed
+//! cell, anything unmeasurable on this OS). `status` is `ok` or `failed`; a failed cell's
+//! `reason` says why, and its summary carries no statistic, speedup or efficiency: a bug must
+//! never become a number.
+//!
+//! Columns added after the first release are appended at the end of each row (older readers
+//! keep working): per trial `foreign_cpu_s, steal_s, load1` ([`crate::contention`]); per cell
+//! the 95 % bootstrap intervals `mean_ci_low_s, mean_ci_high_s, speedup_ci_low,
+//! speedup_ci_high` ([`crate::sweep::bootstrap`]), `foreign_cpu_mean_s` and `contended` (some trial
+//! saw more foreign CPU than [`crate::contention::Threshold::allowed_s`]).
+
+use serde::{Deserialize, Serialize};
+use sph_strategies::StrategyName;
+
+use super::key::{Cell, Group};
+use crate::sph::neighbors::NeighborMode;
+use crate::sph::params::Preset;
+
+/// The columns of `trials.csv`, in order.
+pub const TRIAL_COLUMNS: [&str; 17] = [
+    "strategy",
+    "neighbors",
+    "preset",
+    "n",
+    "steps",
+    "cores",
+    "chunks",
+    "particles_per_chunk",
+    "trial",
+    "wall_s",
+    "cpu_s",
+    "checksum",
+    "status",
+    "reason",
+    "foreign_cpu_s",
+    "steal_s",
+    "load1",
+];
+
+/// The columns of `summary.csv`, in order.
+pub const SUMMARY_COLUMNS: [&str; 28] = [
+    "strategy",
+    "neighbors",
+    "preset",
+    "n",
+    "steps",
+    "cores",
+    "chunks",
+    "particles_per_chunk",
+    "trials",
+    "mean_s",
+    "stddev_s",
+    "min_s",
+    "median_s",
+    "max_s",
+    "cpu_mean_s",
+    "speedup",
+    "efficiency",
+    "outliers",
+    "oversubscribed",
+    "checksum",
+    "status",
+    "reason",
+    "mean_ci_low_s",
+    "mean_ci_high_s",
+    "speedup_ci_low",
+    "speedup_ci_high",
+    "foreign_cpu_mean_s",
+    "contended",
+];
+
+/// How many leading columns of each file bench-sph 0.1.0 wrote before the contention and
+/// confidence-interval columns were appended: a file with exactly those is an older sweep.
+pub const LEGACY_TRIAL_COLUMNS: usize = 14;
+/// See [`LEGACY_TRIAL_COLUMNS`].
+pub const LEGACY_SUMMARY_COLUMNS: usize = 22;
+
+/// Whether a cell's numbers can be used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// Every run finished and reproduced the group's `seq` checksum.
+    Ok,
+    /// A run failed or its checksum differed: see `reason`.
+    Failed,
+}
+
+/// One row of `trials.csv`: one timed run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrialRow {
+    /// Strategy.
+    #[serde(with = "super::names::name")]
+    pub strategy: StrategyName,
+    /// Neighbour search.
+    #[serde(with = "super::names::name")]
+    pub neighbors: NeighborMode,
+    /// Preset.
+    #[serde(with = "super::names::name")]
+    pub preset: Preset,
+    /// Particles.
+    pub n: usize,
+    /// Steps.
+    pub steps: usize,
+    /// Worker threads.
+    pub cores: usize,
+    /// Requested chunks (empty for strategies without chunks).
+    pub chunks: Option<usize>,
+    /// Particles in the largest chunk (empty for strategies without chunks).
+    pub particles_per_chunk: Option<usize>,
+    /// Trial number, from 1.
+    pub trial: usize,
+    /// Wall-clock seconds of the step loop.
+    pub wall_s: f64,
+    /// Process CPU seconds (user + system) over the same window.
+    pub cpu_s: f64,
+    /// Checksum of the final state (16 hex digits).
+    pub checksum: String,
+    /// The cell's status.
+    pub status: Status,
+    /// Why the cell failed (empty when ok).
+    pub reason: String,
+    /// Busy CPU seconds of the machine not spent by this process over the same window.
+    #[serde(default)]
+    pub foreign_cpu_s: Option<f64>,
+    /// Of those, seconds stolen by the hypervisor.
+    #[serde(default)]
+    pub steal_s: Option<f64>,
+    /// The 1-minute load average when the trial started.
+    #[serde(default)]
+    pub load1: Option<f64>,
+}
+
+/// One row of `summary.csv`: one cell. Its first columns repeat [`TrialRow`]'s cell key on
+/// purpose: the csv crate cannot write a nested (`flatten`ed) key struct as flat columns.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SummaryRow {
+    /// Strategy.
+    #[serde(with = "super::names::name")]
+    pub strategy: StrategyName,
+    /// Neighbour search.
+    #[serde(with = "super::names::name")]
+    pub neighbors: NeighborMode,
+    /// Preset.
+    #[serde(with = "super::names::name")]
+    pub preset: Preset,
+    /// Particles.
+    pub n: usize,
+    /// Steps.
+    pub steps: usize,
+    /// Worker threads.
+    pub cores: usize,
+    /// Requested chunks (empty for strategies without chunks).
+    pub chunks: Option<usize>,
+    /// Particles in the largest chunk (empty for strategies without chunks).
+    pub particles_per_chunk: Option<usize>,
+    /// Trials completed (the rows of this cell in `trials.csv`).
+    pub trials: usize,
+    /// Mean wall seconds.
+    pub mean_s: Option<f64>,
+    /// Sample standard deviation of the wall seconds (empty for one trial).
+    pub stddev_s: Option<f64>,
+    /// Fastest trial, wall seconds.
+    pub min_s: Option<f64>,
+    /// Median wall seconds.
+    pub median_s: Option<f64>,
+    /// Slowest trial, wall seconds.
+    pub max_s: Option<f64>,
+    /// Mean CPU seconds (user + system).
+    pub cpu_mean_s: Option<f64>,
+    /// The group's `seq` mean divided by this cell's mean.
+    pub speedup: Option<f64>,
+    /// Speedup divided by cores.
+    pub efficiency: Option<f64>,
+    /// Trials with |t − median| > 3 MAD.
+    pub outliers: Option<usize>,
+    /// Whether cores exceed the machine's hardware threads.
+    pub oversubscribed: bool,
+    /// The checksum every trial reproduced (empty for a failed cell).
+    pub checksum: String,
+    /// `ok` or `failed`.
+    pub status: Status,
+    /// Why the cell failed (empty when ok).
+    pub reason: String,
+    /// Lower end of the 95 % bootstrap interval of the mean wall seconds.
+    #[serde(default)]
+    pub mean_ci_low_s: Option<f64>,
+    /// Upper end of that interval.
+    #[serde(default)]
+    pub mean_ci_high_s: Option<f64>,
+    /// Lower end of the 95 % bootstrap interval of the speedup.
+    #[serde(default)]
+    pub speedup_ci_low: Option<f64>,
+    /// Upper end of that interval.
+    #[serde(default)]
+    pub speedup_ci_high: Option<f64>,
+    /// Mean foreign CPU seconds per trial.
+    #[serde(default)]
+    pub foreign_cpu_mean_s: Option<f64>,
+    /// Whether some trial saw more foreign CPU than the threshold (empty where unknown).
+    #[serde(default)]
+    pub contended: Option<bool>,
+}
+
+/// The columns that name a row's cell, shared by both files.
+macro_rules! keyed {
+    ($row:ty) => {
+        impl $row {
+            /// The row's group.
+            pub fn group(&self) -> Group {
+                Group {
+                    preset: self.preset,
+                    neighbors: self.neighbors,
+                    n: self.n,
+                    steps: self.steps,
+                }
+            }
+
+            /// The row's cell.
+            pub fn key(&self) -> Cell {
+                Cell {
+                    group: self.group(),
+                    strategy: self.strategy,
+                    cores: self.cores,
+                    chunks: self.chunks,
+                }
+            }
+        }
+    };
+}
+keyed!(TrialRow);
+keyed!(SummaryRow);
+
+impl TrialRow {
+    /// Whether the row is a trial of its group's `seq` reference cell.
+    pub fn is_reference(&self) -> bool {
+        self.key().is_reference()
+    }
+}
+
+impl SummaryRow {
+    /// Whether the row is its group's `seq` reference cell.
+    pub fn is_reference(&self) -> bool {
+        self.key().is_reference()
+    }
+
+    /// Whether the row's numbers may be used: status ok, with a mean.
+    pub fn is_usable(&self) -> bool {
+        self.status == Status::Ok && self.mean_s.is_some()
+    }
+}
+
+/// How [`fastest`] treats cells that other work disturbed (`contended = true`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Contended {
+    /// They compete like any other cell (the sweep's end-of-run table, which shows what was
+    /// measured).
+    Compete,
+    /// Only when every candidate is contended (the report, whose findings trust no
+    /// contended cell).
+    LastResort,
+}
+
+/// The one "best cell" rule: the usable row of `rows` with the lowest mean (the first of
+/// equals), contended rows treated as `contended` says.
+pub fn fastest<'a>(
+    rows: impl IntoIterator<Item = &'a SummaryRow>,
+    contended: Contended,
+) -> Option<&'a SummaryRow> {
+    let disturbed =
+        |r: &SummaryRow| contended == Contended::LastResort && r.contended == Some(true);
+    rows.into_iter().filter(|r| r.is_usable()).min_by(|a, b| {
+        disturbed(a).cmp(&disturbed(b)).then(
+            a.mean_s
+                .unwrap_or(f64::INFINITY)
+                .total_cmp(&b.mean_s.unwrap_or(f64::INFINITY)),
+        )
+    })
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// A usable summary row for tests.
+    pub(crate) fn row(
+        strategy: StrategyName,
+        cores: usize,
+        chunks: Option<usize>,
+        mean: f64,
+    ) -> SummaryRow {
+        SummaryRow {
+            strategy,
+            neighbors: NeighborMode::AllPairs,
+            preset: Preset::Seed,
+            n: 60,
+            steps: 3,
+            cores,
+            chunks,
+            particles_per_chunk: chunks.map(|k| 60usize.div_ceil(k)),
+            trials: 3,
+            mean_s: Some(mean),
+            stddev_s: Some(mean * 0.01),
+            min_s: Some(mean * 0.9),
+            median_s: Some(mean),
+            max_s: Some(mean * 1.1),
+            cpu_mean_s: Some(mean * cores as f64),
+            speedup: Some(4.0 / mean),
+            efficiency: Some(4.0 / mean / cores as f64),
+            outliers: Some(0),
+            oversubscribed: cores > 2,
+            checksum: "00000000000000aa".to_owned(),
+            status: Status::Ok,
+            reason: String::new(),
+            mean_ci_low_s: Some(mean * 0.98),
+            mean_ci_high_s: Some(mean * 1.02),
+            speedup_ci_low: Some(4.0 / mean * 0.95),
+            speedup_ci_high: Some(4.0 / mean * 1.05),
+            foreign_cpu_mean_s: Some(0.0),
+            contended: Some(false),
+        }
+    }
+
+    #[test]
+    fn the_fastest_cell_skips_failed_ones_and_takes_a_contended_one_only_as_a_last_resort() {
+        let mut contended = row(StrategyName::RayonIter, 2, None, 1.0);
+        contended.contended = Some(true);
+        let mut failed = row(StrategyName::RayonIter, 2, None, 0.5);
+        failed.status = Status::Failed;
+        let calm = row(StrategyName::RayonIter, 2, None, 2.0);
+        let rows = [contended, failed, calm];
+        assert_eq!(
+            fastest(&rows, Contended::Compete).unwrap().mean_s,
+            Some(1.0)
+        );
+        assert_eq!(
+            fastest(&rows, Contended::LastResort).unwrap().mean_s,
+            Some(2.0)
+        );
+        assert_eq!(
+            fastest(&rows[..1], Contended::LastResort).unwrap().mean_s,
+            Some(1.0)
+        );
+        assert!(fastest(&rows[1..2], Contended::Compete).is_none());
+    }
+
+    #[test]
+    fn rows_write_the_names_the_command_line_uses() {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        w.serialize(row(StrategyName::CrossbeamPool, 2, Some(4), 1.0))
+            .unwrap();
+        let text = String::from_utf8(w.into_inner().unwrap()).unwrap();
+        let line = text.lines().nth(1).unwrap();
+        assert!(
+            line.starts_with("crossbeam-pool,all-pairs,seed,60,3,2,4,"),
+            "{line}"
+        );
+    }
+}
