@@ -336,19 +336,24 @@ fn paper_context(md: &mut String, g: &Group) {
     );
 }
 
+/// A chart embedded as an image, its caption below it in italics.
+fn chart(md: &mut String, c: &ChartPlan) {
+    let _ = writeln!(
+        md,
+        "![{}]({})\n\n*{}*\n",
+        alt(&c.caption),
+        c.file,
+        c.caption
+    );
+}
+
 /// The group's charts with their captions, then the notes on those not drawn.
 fn group_charts(md: &mut String, g: &Group, input: &Input<'_>) {
     let charts: Vec<&ChartPlan> = charts_of(input, Some(g)).collect();
     if !charts.is_empty() {
         let _ = writeln!(md, "### Charts\n");
         for c in charts {
-            let _ = writeln!(
-                md,
-                "![{}]({})\n\n*{}*\n",
-                alt(&c.caption),
-                c.file,
-                c.caption
-            );
+            chart(md, c);
         }
     }
     for s in input.skipped.iter().filter(|s| s.group.as_ref() == Some(g)) {
@@ -441,13 +446,7 @@ fn across_groups(md: &mut String, input: &Input<'_>) {
     }
     let _ = writeln!(md, "## All-pairs vs grid\n");
     for c in charts {
-        let _ = writeln!(
-            md,
-            "![{}]({})\n\n*{}*\n",
-            alt(&c.caption),
-            c.file,
-            c.caption
-        );
+        chart(md, c);
     }
     for s in skipped {
         let _ = writeln!(md, "- {}", s.note);

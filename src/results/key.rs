@@ -121,6 +121,17 @@ impl Cell {
     }
 }
 
+/// A seed-preset group of `neighbors` with 60 particles and 3 steps: the tests' small cell.
+#[cfg(test)]
+pub(crate) fn test_group(neighbors: crate::sph::neighbors::NeighborMode) -> Group {
+    Group {
+        preset: crate::sph::params::Preset::Seed,
+        neighbors,
+        n: 60,
+        steps: 3,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

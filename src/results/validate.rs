@@ -181,20 +181,15 @@ fn show(v: Option<f64>) -> String {
 mod tests {
     use super::*;
     use crate::clock::Elapsed;
-    use crate::results::key::{Cell, Group};
+    use crate::results::key::Cell;
+    use crate::results::key::test_group;
     use crate::sph::neighbors::NeighborMode;
-    use crate::sph::params::Preset;
     use crate::sweep::rows::{Measured, summary_row, test_context, trial_rows};
     use sph_strategies::StrategyName;
 
     fn rows() -> (SummaryRow, Vec<TrialRow>) {
         let cell = Cell {
-            group: Group {
-                preset: Preset::Seed,
-                neighbors: NeighborMode::AllPairs,
-                n: 60,
-                steps: 3,
-            },
+            group: test_group(NeighborMode::AllPairs),
             strategy: StrategyName::RayonChunks,
             cores: 2,
             chunks: Some(4),

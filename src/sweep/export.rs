@@ -65,20 +65,15 @@ mod tests {
     use super::*;
     use crate::clock::Elapsed;
     use crate::contention::Foreign;
+    use crate::results::key::test_group;
     use crate::sph::neighbors::NeighborMode;
-    use crate::sph::params::Preset;
-    use crate::sweep::plan::{Cell, Group};
+    use crate::sweep::plan::Cell;
     use crate::sweep::rows::{Measured, summary_row, test_context, trial_rows};
     use sph_strategies::StrategyName;
 
     fn cell() -> Cell {
         Cell {
-            group: Group {
-                preset: Preset::Seed,
-                neighbors: NeighborMode::Grid,
-                n: 60,
-                steps: 3,
-            },
+            group: test_group(NeighborMode::Grid),
             strategy: StrategyName::RayonChunks,
             cores: 2,
             chunks: Some(5),

@@ -203,21 +203,16 @@ pub fn load_and_repair(
 mod tests {
     use super::*;
     use crate::clock::Elapsed;
+    use crate::results::key::test_group;
     use crate::sph::neighbors::NeighborMode;
-    use crate::sph::params::Preset;
     use crate::sweep::export::Exporter;
-    use crate::sweep::plan::{Cell, Group};
+    use crate::sweep::plan::Cell;
     use crate::sweep::rows::{Measured, summary_row, test_context, trial_rows};
     use sph_strategies::StrategyName;
 
     fn cell(cores: usize) -> Cell {
         Cell {
-            group: Group {
-                preset: Preset::Seed,
-                neighbors: NeighborMode::AllPairs,
-                n: 60,
-                steps: 3,
-            },
+            group: test_group(NeighborMode::AllPairs),
             strategy: StrategyName::RayonIter,
             cores,
             chunks: None,

@@ -162,19 +162,13 @@ fn status_of(failure: Option<&str>) -> Status {
 mod tests {
     use super::*;
     use crate::contention::Foreign;
-    use crate::results::key::Group;
+    use crate::results::key::test_group;
     use crate::sph::neighbors::NeighborMode;
-    use crate::sph::params::Preset;
     use sph_strategies::StrategyName;
 
     fn cell(strategy: StrategyName, cores: usize, chunks: Option<usize>) -> Cell {
         Cell {
-            group: Group {
-                preset: Preset::Seed,
-                neighbors: NeighborMode::AllPairs,
-                n: 60,
-                steps: 3,
-            },
+            group: test_group(NeighborMode::AllPairs),
             strategy,
             cores,
             chunks,

@@ -7,8 +7,8 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::{
-    Area, CoresAxis, DrawResult, LegendEntry, Mark, axis_styles, cores_range, draw_dashed,
-    draw_line, integer_label, oversubscribed_entry, strategy_color, tick_label, y_max,
+    Area, DrawResult, LegendEntry, Mark, cores_panel, cores_range, draw_dashed, draw_line,
+    oversubscribed_entry, strategy_color, y_max,
 };
 use crate::report::paper;
 use crate::report::series::Line;
@@ -56,10 +56,8 @@ pub fn draw(path: &Path, title: &str, subtitle: &str, chart: &BestChart<'_>) -> 
     super::render(path, title, subtitle, &legend, |area| plot(area, chart, c))
 }
 
-// Over ~60 lines on purpose: a plotters builder chain for two stacked panels; each call is one visual element.
 fn plot(area: &Area<'_>, chart: &BestChart<'_>, c: RGBColor) -> DrawResult {
     let (top, bottom) = area.split_vertically(area.dim_in_pixel().1 / 2);
-    let (labels, descs) = axis_styles();
     let grey = RGBColor(90, 90, 90);
 
     // The axis spans the measured cores only; the paper's speedups are drawn where they
@@ -85,20 +83,7 @@ fn plot(area: &Area<'_>, chart: &BestChart<'_>, c: RGBColor) -> DrawResult {
 
     // Runtime.
     let y1 = y_max(std::slice::from_ref(&chart.runtime)).max(chart.seq_s) * 1.1;
-    let mut ch = ChartBuilder::on(&top)
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(76)
-        .build_cartesian_2d(CoresAxis::new(x0, x1), 0f64..y1)?;
-    ch.configure_mesh()
-        .disable_x_mesh()
-        .x_label_formatter(&integer_label)
-        .y_label_formatter(&tick_label)
-        .x_desc("cores")
-        .y_desc("best runtime (s)")
-        .label_style(labels.clone())
-        .axis_desc_style(descs.clone())
-        .draw()?;
+    let mut ch = cores_panel(&top, (x0, x1), 0f64..y1, 76, "best runtime (s)")?;
     let ideal: Vec<(f64, f64)> = chart
         .runtime
         .points
@@ -110,20 +95,7 @@ fn plot(area: &Area<'_>, chart: &BestChart<'_>, c: RGBColor) -> DrawResult {
 
     // Speedup.
     let s1 = (y_max(&lines).max(x1 - 0.4)) * 1.1;
-    let mut ch = ChartBuilder::on(&bottom)
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(76)
-        .build_cartesian_2d(CoresAxis::new(x0, x1), 0f64..s1)?;
-    ch.configure_mesh()
-        .disable_x_mesh()
-        .x_label_formatter(&integer_label)
-        .y_label_formatter(&tick_label)
-        .x_desc("cores")
-        .y_desc("best speedup (×)")
-        .label_style(labels)
-        .axis_desc_style(descs)
-        .draw()?;
+    let mut ch = cores_panel(&bottom, (x0, x1), 0f64..s1, 76, "best speedup (×)")?;
     draw_dashed(&mut ch, vec![(1.0, 1.0), (x1 - 0.4, x1 - 0.4)], grey)?;
     if !paper_points.is_empty() {
         ch.draw_series(LineSeries::new(

@@ -7,8 +7,8 @@ use std::path::Path;
 use plotters::prelude::*;
 
 use super::{
-    Area, CoresAxis, DrawResult, LegendEntry, Mark, axis_styles, cores_range, draw_dashed,
-    draw_line, integer_label, oversubscribed_entry, strategy_color, tick_label, y_max,
+    Area, DrawResult, LegendEntry, Mark, cores_panel, cores_range, draw_dashed, draw_line,
+    oversubscribed_entry, strategy_color, y_max,
 };
 use crate::report::series::Line;
 
@@ -34,28 +34,13 @@ pub fn draw(
     })
 }
 
-// Over ~60 lines on purpose: a plotters builder chain for two stacked panels; each call is one visual element.
 fn plot(area: &Area<'_>, efficiency: &[Line], serial: &[Line]) -> DrawResult {
     let (top, bottom) = area.split_vertically(area.dim_in_pixel().1 / 2);
-    let (labels, descs) = axis_styles();
     let grey = RGBColor(90, 90, 90);
     let (x0, x1) = cores_range(efficiency);
 
     let y1 = y_max(efficiency).max(1.0) * 1.1;
-    let mut ch = ChartBuilder::on(&top)
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(70)
-        .build_cartesian_2d(CoresAxis::new(x0, x1), 0f64..y1)?;
-    ch.configure_mesh()
-        .disable_x_mesh()
-        .x_label_formatter(&integer_label)
-        .y_label_formatter(&tick_label)
-        .x_desc("cores")
-        .y_desc("efficiency S / p")
-        .label_style(labels.clone())
-        .axis_desc_style(descs.clone())
-        .draw()?;
+    let mut ch = cores_panel(&top, (x0, x1), 0f64..y1, 70, "efficiency S / p")?;
     draw_dashed(&mut ch, vec![(x0, 1.0), (x1, 1.0)], grey)?;
     for line in efficiency {
         draw_line(&mut ch, line, strategy_color(&line.label), false)?;
@@ -73,20 +58,13 @@ fn plot(area: &Area<'_>, efficiency: &[Line], serial: &[Line]) -> DrawResult {
     let lo = ys.clone().fold(0f64, f64::min);
     let hi = ys.fold(0.1f64, f64::max);
     let pad = (hi - lo) * 0.1;
-    let mut ch = ChartBuilder::on(&bottom)
-        .margin(12)
-        .x_label_area_size(44)
-        .y_label_area_size(70)
-        .build_cartesian_2d(CoresAxis::new(x0, x1), (lo - pad)..(hi + pad))?;
-    ch.configure_mesh()
-        .disable_x_mesh()
-        .x_label_formatter(&integer_label)
-        .y_label_formatter(&tick_label)
-        .x_desc("cores")
-        .y_desc("serial fraction e")
-        .label_style(labels)
-        .axis_desc_style(descs)
-        .draw()?;
+    let mut ch = cores_panel(
+        &bottom,
+        (x0, x1),
+        (lo - pad)..(hi + pad),
+        70,
+        "serial fraction e",
+    )?;
     draw_dashed(&mut ch, vec![(x0, 0.0), (x1, 0.0)], grey)?;
     for line in serial {
         draw_line(&mut ch, line, strategy_color(&line.label), false)?;

@@ -34,6 +34,40 @@ pub(crate) type DrawResult = Result<(), Box<dyn std::error::Error>>;
 /// A drawing area in pixels.
 pub(crate) type Area<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
 
+/// A panel of the best-cell and efficiency charts: the cores across (integer labels), `y`
+/// up, described as `y_desc`, its mesh drawn; `y_area` pixels for the y labels.
+pub fn cores_panel<'a, 'b>(
+    area: &'a Area<'b>,
+    (x0, x1): (f64, f64),
+    y: std::ops::Range<f64>,
+    y_area: u32,
+    y_desc: &str,
+) -> Result<CoresPanel<'a, 'b>, Box<dyn std::error::Error>> {
+    let (labels, descs) = axis_styles();
+    let mut ch = ChartBuilder::on(area)
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(y_area)
+        .build_cartesian_2d(CoresAxis::new(x0, x1), y)?;
+    ch.configure_mesh()
+        .disable_x_mesh()
+        .x_label_formatter(&integer_label)
+        .y_label_formatter(&tick_label)
+        .x_desc("cores")
+        .y_desc(y_desc)
+        .label_style(labels)
+        .axis_desc_style(descs)
+        .draw()?;
+    Ok(ch)
+}
+
+/// What [`cores_panel`] builds.
+pub type CoresPanel<'a, 'b> = ChartContext<
+    'a,
+    BitMapBackend<'b>,
+    Cartesian2d<CoresAxis, plotters::coord::types::RangedCoordf64>,
+>;
+
 /// A colour per index, from the Tableau 10 palette (cycled).
 pub fn color(i: usize) -> RGBColor {
     const PALETTE: [(u8, u8, u8); 10] = [
