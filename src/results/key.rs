@@ -73,6 +73,19 @@ pub struct Cell {
 }
 
 impl Cell {
+    /// The group's reference cell: `seq`, at the one core (and no chunks) the registry says
+    /// it uses. It is measured once per group: the denominator of the group's speedups and
+    /// the source of its reference checksum.
+    pub fn reference(group: Group) -> Cell {
+        let info = StrategyName::Seq.info();
+        Cell {
+            group,
+            strategy: StrategyName::Seq,
+            cores: info.effective_cores(1),
+            chunks: info.effective_chunks(1),
+        }
+    }
+
     /// Whether this is its group's `seq` reference cell.
     pub fn is_reference(&self) -> bool {
         self.strategy == StrategyName::Seq

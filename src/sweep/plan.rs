@@ -39,12 +39,7 @@ impl Plan {
         }
         let mut cells = Vec::new();
         for &group in &groups {
-            cells.push(Cell {
-                group,
-                strategy: StrategyName::Seq,
-                cores: 1,
-                chunks: None,
-            });
+            cells.push(Cell::reference(group));
             for &strategy in params
                 .strategies
                 .iter()

@@ -18,7 +18,6 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::Context;
 use indicatif::ProgressBar;
-use sph_strategies::StrategyName;
 
 use super::console;
 use super::export::Exporter;
@@ -240,12 +239,7 @@ pub fn calibrate(group: Group, seed: u64) -> f64 {
     };
     let scale = (group.n as f64 / sample.n as f64).powi(exponent);
     let input = GroupInput::new(sample, seed);
-    let seq = Cell {
-        group: sample,
-        strategy: StrategyName::Seq,
-        cores: 1,
-        chunks: None,
-    };
+    let seq = Cell::reference(sample);
     let mut steps = 1;
     loop {
         let Ok(m) = input.run_steps(&seq, steps) else {
@@ -452,6 +446,7 @@ fn walls(measured: &[Measured]) -> Vec<f64> {
 mod tests {
     use super::*;
     use crate::clock::Elapsed;
+    use sph_strategies::StrategyName;
     use std::cell::Cell as Counter;
 
     fn ok(checksum: &str) -> Result<Measured, String> {
