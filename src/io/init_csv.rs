@@ -139,16 +139,19 @@ fn present<'de, D: serde::Deserializer<'de>>(cell: D) -> Result<Option<String>, 
     String::deserialize(cell).map(Some)
 }
 
-/// Reads `path`. Checks numbers, not walls (the tank depends on N; see [`check_walls`]).
-pub fn read(path: &Path) -> Result<InitRows, InitError> {
-    let shown = path.display().to_string();
+/// A CSV reader of `path` (shown as `shown`) past its header, and the header, which names at
+/// least the columns `x` and `y`.
+fn open(
+    path: &Path,
+    shown: &str,
+) -> Result<(csv::Reader<BoundedLines<std::fs::File>>, csv::StringRecord), InitError> {
     let io = |source| InitError::Io {
-        path: shown.clone(),
+        path: shown.to_owned(),
         source,
     };
     if std::fs::metadata(path).map_err(io)?.is_dir() {
         return Err(InitError::Directory {
-            path: shown.clone(),
+            path: shown.to_owned(),
         });
     }
     let file = std::fs::File::open(path).map_err(io)?;
@@ -156,20 +159,28 @@ pub fn read(path: &Path) -> Result<InitRows, InitError> {
         .trim(csv::Trim::All)
         .comment(Some(b'#'))
         .from_reader(BoundedLines::new(file, MAX_LINES));
-    let headers = reader.headers().map_err(|e| malformed(e, &shown))?.clone();
+    let headers = reader.headers().map_err(|e| malformed(e, shown))?.clone();
     if headers.is_empty() || headers.iter().all(str::is_empty) {
-        return Err(InitError::Empty { path: shown });
+        return Err(InitError::Empty {
+            path: shown.to_owned(),
+        });
     }
     if let Some(column) = ["x", "y"]
         .into_iter()
         .find(|&c| !headers.iter().any(|h| h == c))
     {
         return Err(InitError::MissingColumn {
-            path: shown,
+            path: shown.to_owned(),
             column,
         });
     }
+    Ok((reader, headers))
+}
 
+/// Reads `path`. Checks numbers, not walls (the tank depends on N; see [`check_walls`]).
+pub fn read(path: &Path) -> Result<InitRows, InitError> {
+    let shown = path.display().to_string();
+    let (mut reader, headers) = open(path, &shown)?;
     let (mut x, mut y, mut vx, mut vy, mut lines) = (vec![], vec![], vec![], vec![], vec![]);
     for record in reader.records() {
         let record = record.map_err(|e| malformed(e, &shown))?;
