@@ -5,7 +5,10 @@
 use std::path::Path;
 
 mod common;
-use common::{bench_sph, fails_with_in, names, run_in, stderr, succeeds};
+use common::{
+    DIVERGING_INIT, assert_file_holds, bench_sph, fails_with_in, names, run_in, stderr, succeeds,
+    wait_until,
+};
 
 /// The image size the render reports: "… of W × H px …".
 fn reported_size(out: &str) -> (u32, u32) {
@@ -154,11 +157,7 @@ fn every_strategy_renders_the_same_gif() {
 #[test]
 fn a_diverging_run_is_an_error_and_keeps_the_frames_before_it() {
     let dir = tempfile::tempdir().unwrap();
-    std::fs::write(
-        dir.path().join("boom.csv"),
-        "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n",
-    )
-    .unwrap();
+    std::fs::write(dir.path().join("boom.csv"), DIVERGING_INIT).unwrap();
     fails_with_in(
         dir.path(),
         &[
@@ -275,10 +274,7 @@ fn a_frames_folder_with_other_files_is_refused_and_force_writes_beside_them() {
         names(&f),
         ["frame_00000.png", "frame_00001.png", "notes.txt"]
     );
-    assert_eq!(
-        std::fs::read_to_string(f.join("notes.txt")).unwrap(),
-        "mine"
-    );
+    assert_file_holds(&f.join("notes.txt"), "mine");
     fails_with_in(dir.path(), &["render", "--force"], &["--frames"]);
 }
 
@@ -296,7 +292,6 @@ fn an_interrupted_render_leaves_the_earlier_gif_untouched() {
         .spawn()
         .unwrap();
     // Wait until frames are being written (the temporary file has grown), then kill it.
-    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
     let writing = || {
         std::fs::read_dir(dir.path()).unwrap().any(|e| {
             let e = e.unwrap();
@@ -304,35 +299,20 @@ fn an_interrupted_render_leaves_the_earlier_gif_untouched() {
                 && e.metadata().unwrap().len() > 20_000
         })
     };
-    while !writing() {
-        assert!(std::time::Instant::now() < deadline, "no frames written");
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
+    wait_until("no frames written", writing);
     child.kill().unwrap();
     child.wait().unwrap();
-    assert_eq!(
-        std::fs::read_to_string(dir.path().join("a.gif")).unwrap(),
-        "earlier"
-    );
+    assert_file_holds(&dir.path().join("a.gif"), "earlier");
 }
 
 #[test]
 fn a_gif_that_cannot_be_written_is_one_error_line() {
     let dir = tempfile::tempdir().unwrap();
-    let o = run_in(
-        dir.path(),
-        &[
-            "render",
-            "--n",
-            "20",
-            "--steps",
-            "2",
-            "--every",
-            "1",
-            "--out",
-            "/dev/full",
-        ],
-    );
+    let full = "/dev/full";
+    let args = [
+        "render", "--n", "20", "--steps", "2", "--every", "1", "--out", full,
+    ];
+    let o = run_in(dir.path(), &args);
     assert!(!o.status.success());
     assert_eq!(
         stderr(&o),

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 mod common;
-use common::{run, text};
+use common::{assert_holds_all, run, scratch, sweep_into, text};
 
 const WIDTH: u32 = 1000;
 const HEIGHT: u32 = 650;
@@ -121,7 +121,7 @@ fn the_report_carries_the_fixture_best_cells_speedups_and_the_paper_beside_them(
         out.path().to_str().unwrap(),
     ]);
     let md = std::fs::read_to_string(out.path().join("REPORT.md")).unwrap();
-    for needle in [
+    let needles = [
         "| CPU |",
         "| hardware threads | 2 |",
         "--fake-timings",
@@ -142,15 +142,13 @@ fn the_report_carries_the_fixture_best_cells_speedups_and_the_paper_beside_them(
         "e = 0.0886",
         "Speedups compare; absolute times do not",
         "None: every cell reproduced its group's `seq` checksum.",
-    ] {
-        assert!(md.contains(needle), "REPORT.md lacks {needle:?}:\n{md}");
-    }
+    ];
+    assert_holds_all("REPORT.md", &md, &needles);
 }
 
 #[test]
 fn a_results_directory_with_one_neighbour_search_skips_chart_six_and_says_so() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("results");
+    let (_tmp, dir) = scratch("results");
     filtered_fixture(&dir, |l| l.contains(",all-pairs,seed,60,"));
     report(&[dir.to_str().unwrap()]);
     assert!(!dir.join("seed-6-neighbors.png").exists());
@@ -164,8 +162,7 @@ fn a_results_directory_with_one_neighbour_search_skips_chart_six_and_says_so() {
 
 #[test]
 fn a_single_core_count_skips_the_charts_against_cores_and_says_so() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("results");
+    let (_tmp, dir) = scratch("results");
     filtered_fixture(&dir, |l| l.contains(",grid,seed,60,3,1,"));
     report(&[dir.to_str().unwrap()]);
     let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
@@ -178,8 +175,7 @@ fn a_single_core_count_skips_the_charts_against_cores_and_says_so() {
 
 #[test]
 fn trace_directories_under_the_results_or_given_with_trace_are_embedded() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("results");
+    let (tmp, dir) = scratch("results");
     filtered_fixture(&dir, |l| l.contains(",all-pairs,seed,60,"));
     let stats = "kind,name,threads,kernel_calls,busy_ms,span_ms,idle_pct,imbalance\n\
                  worker,0,1,90,10.0,12.0,16.7,\nworker,1,1,90,9.0,12.0,25.0,\n\
@@ -218,8 +214,7 @@ fn trace_directories_under_the_results_or_given_with_trace_are_embedded() {
 
 #[test]
 fn a_missing_or_garbled_summary_or_meta_is_one_error_line_and_a_failure() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("results");
+    let (_tmp, dir) = scratch("results");
     let d = dir.to_str().unwrap();
     report_fails(&[d], "does not exist");
     filtered_fixture(&dir, |_| true);
@@ -236,27 +231,12 @@ fn a_missing_or_garbled_summary_or_meta_is_one_error_line_and_a_failure() {
 
 #[test]
 fn a_sweep_without_no_plots_writes_its_charts_and_report() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("sweep");
-    let o = run(&[
-        "sweep",
-        "--strategies",
-        "rayon-chunks",
-        "--cores",
-        "1..2",
-        "--chunks",
-        "2,5",
-        "--n",
-        "60",
-        "--steps",
-        "3",
-        "--trials",
-        "2",
-        "--warmup",
-        "0",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    let (_tmp, dir) = scratch("sweep");
+    let o = sweep_into(
+        &dir,
+        "--strategies rayon-chunks --cores 1..2 --chunks 2,5 --n 60 --steps 3 --trials 2 \
+         --warmup 0",
+    );
     assert!(
         o.status.success(),
         "{}\n{}",

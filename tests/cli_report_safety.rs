@@ -6,34 +6,36 @@ use std::path::Path;
 use std::process::Output;
 
 mod common;
-use common::{run, text};
+use common::{assert_file_holds, fake_sweep, line_containing, run, scratch, sweep_into, text};
 
 /// A small finished sweep under fake times: seq, rayon-chunks and rayon-iter at 1 and 2 cores.
 fn sweep(dir: &Path, extra: &[&str]) -> Output {
-    let mut args = vec![
-        "sweep",
-        "--n",
-        "60",
-        "--steps",
-        "3",
-        "--trials",
-        "3",
-        "--warmup",
-        "0",
-        "--cores",
-        "1..2",
-        "--chunks",
-        "4",
-        "--strategies",
+    let mut args = fake_sweep(
         "seq,rayon-chunks,rayon-iter",
-        "--fake-timings",
         "1.0,1.1,0.9,0.5,0.55,0.6,0.7,0.8,0.75",
-        "--no-plots",
-        "--out",
-        dir.to_str().unwrap(),
-    ];
+    );
+    args.extend(["--no-plots", "--out", dir.to_str().unwrap()]);
     args.extend(extra);
     run(&args)
+}
+
+/// Runs `report` on `dirs` into `out`, then `extra`.
+fn report_into(dirs: &[&Path], out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec!["report"];
+    args.extend(dirs.iter().map(|d| d.to_str().unwrap()));
+    args.extend(["--out", out.to_str().unwrap()]);
+    args.extend(extra);
+    run(&args)
+}
+
+/// Asserts that the report `o` into `out` failed, naming every one of `needles`, and wrote no
+/// REPORT.md there; returns its standard error.
+fn refused(o: &Output, out: &Path, needles: &[&str]) -> String {
+    assert!(!o.status.success());
+    let err = text(&o.stderr);
+    assert!(needles.iter().all(|n| err.contains(n)), "{err}");
+    assert!(!out.join("REPORT.md").exists());
+    err
 }
 
 fn finished(dir: &Path) {
@@ -99,8 +101,7 @@ fn impossible_rows_are_left_out_with_a_listed_warning() {
 
 #[test]
 fn a_line_cut_off_by_a_kill_is_left_out_with_a_warning_not_an_error() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     finished(&dir);
     let mut trials = std::fs::read_to_string(dir.join("trials.csv")).unwrap();
     trials.push_str("rayon-iter,all-pairs,seed,60,3,2,,,4,0.");
@@ -118,8 +119,7 @@ fn a_line_cut_off_by_a_kill_is_left_out_with_a_warning_not_an_error() {
 
 #[test]
 fn the_same_directory_twice_or_the_same_cells_in_two_directories_are_refused() {
-    let tmp = tempfile::tempdir().unwrap();
-    let a = tmp.path().join("a");
+    let (tmp, a) = scratch("a");
     finished(&a);
     let o = run(&["report", a.to_str().unwrap(), a.to_str().unwrap()]);
     assert!(!o.status.success());
@@ -132,63 +132,30 @@ fn the_same_directory_twice_or_the_same_cells_in_two_directories_are_refused() {
     let b = tmp.path().join("b");
     finished(&b);
     let out = tmp.path().join("out");
-    let o = run(&[
-        "report",
-        a.to_str().unwrap(),
-        b.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(!o.status.success());
-    let err = text(&o.stderr);
-    assert!(
-        err.starts_with("Error: the cell") && err.contains("is in both"),
-        "{err}"
-    );
-    assert!(!out.join("REPORT.md").exists());
+    let o = report_into(&[&a, &b], &out, &[]);
+    let err = refused(&o, &out, &["is in both"]);
+    assert!(err.starts_with("Error: the cell"), "{err}");
 }
 
 #[test]
 fn an_out_directory_with_foreign_files_is_refused_unless_force_which_keeps_them() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (tmp, dir) = scratch("r");
     finished(&dir);
     let out = tmp.path().join("out");
     std::fs::create_dir(&out).unwrap();
     std::fs::write(out.join("dambreak.gif"), "mine").unwrap();
-    let o = run(&[
-        "report",
-        dir.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(!o.status.success());
-    let err = text(&o.stderr);
-    assert!(
-        err.contains("'dambreak.gif'") && err.contains("--force"),
-        "{err}"
-    );
-    assert!(!out.join("REPORT.md").exists());
+    let o = report_into(&[&dir], &out, &[]);
+    refused(&o, &out, &["'dambreak.gif'", "--force"]);
 
-    let o = run(&[
-        "report",
-        dir.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--force",
-    ]);
+    let o = report_into(&[&dir], &out, &["--force"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(out.join("REPORT.md").is_file());
-    assert_eq!(
-        std::fs::read_to_string(out.join("dambreak.gif")).unwrap(),
-        "mine"
-    );
+    assert_file_holds(&out.join("dambreak.gif"), "mine");
 }
 
 #[test]
 fn charts_of_an_earlier_report_that_are_not_drawn_again_are_removed() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     finished(&dir);
     // A chart of a group the data no longer holds (a copy of a real chart).
     assert!(run(&["report", dir.to_str().unwrap()]).status.success());
@@ -217,17 +184,13 @@ fn charts_of_an_earlier_report_that_are_not_drawn_again_are_removed() {
 
 #[test]
 fn a_partial_study_says_so_at_the_top_naming_the_strategies_never_measured() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     let o = sweep(&dir, &["--stop-after-cells", "3"]);
     assert!(!o.status.success());
     let o = run(&["report", dir.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
-    let banner = md
-        .lines()
-        .find(|l| l.contains("Partial study"))
-        .unwrap_or_else(|| panic!("no banner:\n{md}"));
+    let banner = line_containing(&md, "Partial study");
     assert!(
         banner.contains("3 of 5 planned cells measured")
             && banner.contains("never measured: rayon-chunks"),
@@ -239,25 +202,11 @@ fn a_partial_study_says_so_at_the_top_naming_the_strategies_never_measured() {
 
 #[test]
 fn a_one_cell_report_reads_naturally() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
-    let o = run(&[
-        "sweep",
-        "--n",
-        "60",
-        "--steps",
-        "3",
-        "--trials",
-        "2",
-        "--strategies",
-        "seq",
-        "--cores",
-        "1",
-        "--fake-timings",
-        "1.0,1.1",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    let (_tmp, dir) = scratch("r");
+    let o = sweep_into(
+        &dir,
+        "--n 60 --steps 3 --trials 2 --strategies seq --cores 1 --fake-timings 1.0,1.1",
+    );
     assert!(o.status.success(), "{}", text(&o.stderr));
     let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
     assert!(md.contains(": 1 cell in 1 group."), "{md}");

@@ -3,10 +3,13 @@
 
 use std::path::Path;
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 mod common;
-use common::{bench_sph, fails_with, names, run, stderr, stdout};
+use common::{
+    DIVERGING_INIT, assert_holds_all, bench_sph, fails_with, names, run, scratch, start, stderr,
+    stdout, wait_until,
+};
 
 fn write(dir: &Path, name: &str, text: &str) -> String {
     let path = dir.join(name);
@@ -44,8 +47,7 @@ fn text_output_names_n_steps_wall_and_cpu_time() {
         "cpp",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let out = stdout(&o);
-    for needle in [
+    let needles = [
         "N = 40",
         "3 steps",
         "wall",
@@ -54,9 +56,8 @@ fn text_output_names_n_steps_wall_and_cpu_time() {
         "checksum",
         "cpp",
         "grid",
-    ] {
-        assert!(out.contains(needle), "missing {needle:?} in\n{out}");
-    }
+    ];
+    assert_holds_all("stdout", &stdout(&o), &needles);
 }
 
 #[test]
@@ -95,11 +96,7 @@ fn init_accepts_any_column_order_and_ignores_extra_columns() {
 #[test]
 fn a_diverging_run_is_an_error_naming_step_and_particle_and_its_dump_shows_the_state() {
     let dir = tempfile::tempdir().unwrap();
-    let f = write(
-        dir.path(),
-        "boom.csv",
-        "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n",
-    );
+    let f = write(dir.path(), "boom.csv", DIVERGING_INIT);
     let dump = dir.path().join("out.csv");
     fails_with(
         &["simulate", "--init", &f, "--dump", dump.to_str().unwrap()],
@@ -359,18 +356,14 @@ fn a_full_or_closed_stdout_is_one_error_line_not_a_panic() {
 
 #[test]
 fn ctrl_c_during_a_dumping_run_keeps_the_earlier_file_and_leaves_no_temporary() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dump = tmp.path().join("d.csv");
+    let (tmp, dump) = scratch("d.csv");
     std::fs::write(&dump, "keep").unwrap();
-    let child = bench_sph()
-        .args(["simulate", "--n", "3000", "--steps", "1000000", "--dump"])
-        .arg(&dump)
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    // Wait for the temporary file: the run is under way.
-    let deadline = Instant::now() + Duration::from_secs(60);
+    let child = start(
+        bench_sph()
+            .args(["simulate", "--n", "3000", "--steps", "1000000", "--dump"])
+            .arg(&dump),
+        Stdio::null(),
+    );
     let temporaries = || {
         std::fs::read_dir(tmp.path())
             .unwrap()
@@ -383,10 +376,8 @@ fn ctrl_c_during_a_dumping_run_keeps_the_earlier_file_and_leaves_no_temporary() 
             })
             .count()
     };
-    while temporaries() == 0 {
-        assert!(Instant::now() < deadline, "the run never started its dump");
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    // Wait for the temporary file: the run is under way.
+    wait_until("the run never started its dump", || temporaries() > 0);
     let killed = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()

@@ -6,10 +6,13 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 mod common;
-use common::{Row, bench_sph, fails_with, rows, run, stderr, stdout};
+use common::{
+    Row, assert_file_holds, assert_holds_all, bench_sph, fails_with, num, poll_until, rows, run,
+    scratch, start, stderr, stdout, sweep_into,
+};
 
 const TRIAL_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
     trial,wall_s,cpu_s,checksum,status,reason,foreign_cpu_s,steal_s,load1";
@@ -59,12 +62,6 @@ fn header(path: &Path) -> String {
         .next()
         .unwrap_or_default()
         .to_owned()
-}
-
-fn num(row: &Row, column: &str) -> f64 {
-    row[column]
-        .parse()
-        .unwrap_or_else(|_| panic!("{column} = {:?} in {row:?}", row[column]))
 }
 
 /// The columns that name a cell.
@@ -127,8 +124,7 @@ fn median(xs: &[f64]) -> f64 {
 
 #[test]
 fn a_tiny_sweep_writes_trials_summary_and_meta_with_the_documented_columns() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     let o = tiny_sweep(&dir, &[]);
 
     assert_eq!(header(&dir.join("trials.csv")), TRIAL_HEADER);
@@ -218,24 +214,24 @@ fn a_tiny_sweep_writes_trials_summary_and_meta_with_the_documented_columns() {
             .any(|a| a == "--chunks")
     );
 
-    let out = stdout(&o);
-    for needle in [
-        "15 cells",
-        "1 warm-up + 2 trials",
-        "estimated time",
-        "Fastest cell per strategy",
-        "trials.csv",
-        "summary.csv",
-        "meta.json",
-    ] {
-        assert!(out.contains(needle), "stdout lacks {needle:?}:\n{out}");
-    }
+    assert_holds_all(
+        "stdout",
+        &stdout(&o),
+        &[
+            "15 cells",
+            "1 warm-up + 2 trials",
+            "estimated time",
+            "Fastest cell per strategy",
+            "trials.csv",
+            "summary.csv",
+            "meta.json",
+        ],
+    );
 }
 
 #[test]
 fn summary_statistics_agree_exactly_with_the_trial_rows_under_fake_timings() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     // Seven items for three trials a cell: each cell gets a different slice of the list.
     let fake = "1:0.5,2:1,3:1.5,2:2,2:2,9:3,4:4";
     let mut args: Vec<&str> = TINY.to_vec();
@@ -395,30 +391,24 @@ const SLOW_CELLS: usize = 75;
 /// Starts a sweep big enough to still be running when the first cells are written, and
 /// returns it once `summary.csv` holds `cells` rows (or it has ended).
 fn spawn_until_cells(dir: &Path, cells: usize) -> std::process::Child {
-    let mut child = bench_sph()
-        .args(SLOW)
-        .args(["--out", dir.to_str().unwrap()])
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("binary starts");
-    let start = Instant::now();
+    let mut child = start(
+        bench_sph()
+            .args(SLOW)
+            .args(["--out", dir.to_str().unwrap()]),
+        Stdio::null(),
+    );
     let summary = dir.join("summary.csv");
-    while start.elapsed() < Duration::from_secs(120) {
+    poll_until(Duration::from_secs(120), Duration::from_millis(5), || {
         let written =
             std::fs::read_to_string(&summary).map_or(0, |t| t.lines().count().saturating_sub(1));
-        if written >= cells || child.try_wait().unwrap().is_some() {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
+        written >= cells || child.try_wait().unwrap().is_some()
+    });
     child
 }
 
 #[test]
 fn a_sweep_killed_outright_resumes_without_duplicating_rows() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     let mut child = spawn_until_cells(&dir, 2);
     let was_running = child.try_wait().unwrap().is_none();
     let _ = child.kill(); // SIGKILL: no chance to tidy up
@@ -439,8 +429,7 @@ fn a_sweep_killed_outright_resumes_without_duplicating_rows() {
 
 #[test]
 fn ctrl_c_keeps_the_finished_cells_and_exits_with_an_error_naming_resume() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     let mut child = spawn_until_cells(&dir, 1);
     let still_running = child.try_wait().unwrap().is_none();
     let sent = Command::new("kill")
@@ -464,8 +453,7 @@ fn ctrl_c_keeps_the_finished_cells_and_exits_with_an_error_naming_resume() {
 
 #[test]
 fn an_existing_results_directory_is_refused_without_resume_or_force() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (tmp, dir) = scratch("r");
     tiny_sweep(&dir, &[]);
     let d = dir.to_str().unwrap();
     let mut args = TINY.to_vec();
@@ -485,10 +473,7 @@ fn an_existing_results_directory_is_refused_without_resume_or_force() {
     std::fs::write(dir.join("notes.txt"), "mine").unwrap();
     tiny_sweep(&dir, &["--force", "--strategies", "seq"]);
     assert_one_row_per_trial(&dir, 2, 1);
-    assert_eq!(
-        std::fs::read_to_string(dir.join("notes.txt")).unwrap(),
-        "mine"
-    );
+    assert_file_holds(&dir.join("notes.txt"), "mine");
 
     // An existing empty directory is fine.
     let empty = tmp.path().join("empty");
@@ -498,8 +483,7 @@ fn an_existing_results_directory_is_refused_without_resume_or_force() {
 
 #[test]
 fn bad_ranges_give_a_clear_error_and_a_non_zero_exit() {
-    let tmp = tempfile::tempdir().unwrap();
-    let out = tmp.path().join("never");
+    let (_tmp, out) = scratch("never");
     let o = out.to_str().unwrap();
     for (option, value, needle) in [
         ("--cores", "5..1", "reversed"),
@@ -521,8 +505,7 @@ fn bad_ranges_give_a_clear_error_and_a_non_zero_exit() {
 
 #[test]
 fn an_unwritable_out_directory_is_an_error_before_anything_runs() {
-    let tmp = tempfile::tempdir().unwrap();
-    let file = tmp.path().join("plain-file");
+    let (_tmp, file) = scratch("plain-file");
     std::fs::write(&file, "x").unwrap();
     let under_file = file.join("results");
     let mut args = TINY.to_vec();
@@ -548,27 +531,15 @@ fn resume_needs_a_sweep_directory_and_takes_no_new_parameters() {
 #[test]
 fn cells_with_more_cores_than_hardware_threads_are_marked_and_warned_about() {
     let hw = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     let cores = format!("{hw}..{}", hw + 1);
-    let o = run(&[
-        "sweep",
-        "--n",
-        "40",
-        "--steps",
-        "2",
-        "--trials",
-        "1",
-        "--warmup",
-        "0",
-        "--strategies",
-        "rayon-iter",
-        "--cores",
-        &cores,
-        "--no-plots",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    let o = sweep_into(
+        &dir,
+        &format!(
+            "--n 40 --steps 2 --trials 1 --warmup 0 --strategies rayon-iter --cores {cores} \
+             --no-plots"
+        ),
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("oversubscribed"), "{}", stderr(&o));
     assert!(stdout(&o).contains("(oversubscribed)"), "{}", stdout(&o));

@@ -7,41 +7,35 @@ use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 
 mod common;
-use common::{bench_sph, no_panic, rows, run, text};
-use std::time::{Duration, Instant};
+use common::{
+    assert_file_holds, bench_sph, fake_sweep, no_panic, num, rows, run, scratch, start,
+    sweep_command, sweep_into, text, wait_until,
+};
 
 /// A tiny sweep of seq and rayon-chunks under fake times.
-const TINY: &[&str] = &[
-    "sweep",
-    "--n",
-    "60",
-    "--steps",
-    "3",
-    "--trials",
-    "3",
-    "--warmup",
-    "0",
-    "--cores",
-    "1..2",
-    "--chunks",
-    "4",
-    "--strategies",
-    "seq,rayon-chunks",
-    "--fake-timings",
-    "1.0,1.1,0.9,0.5,0.55,0.6",
-];
+fn tiny_args() -> Vec<&'static str> {
+    fake_sweep("seq,rayon-chunks", "1.0,1.1,0.9,0.5,0.55,0.6")
+}
 
+/// Runs the tiny sweep into `dir`, then `extra`.
 fn tiny(dir: &Path, extra: &[&str]) -> Output {
-    let mut args = TINY.to_vec();
-    args.extend(["--out", dir.to_str().unwrap()]);
-    args.extend(extra);
-    run(&args)
+    run(&[&tiny_args()[..], &["--out", dir.to_str().unwrap()], extra].concat())
+}
+
+/// The tiny sweep without charts into `out` (with none, into a new directory under `results/`
+/// of its working directory), as a command whose streams the caller sets.
+fn tiny_without_plots(out: Option<&Path>) -> Command {
+    let mut cmd = bench_sph();
+    cmd.args(tiny_args()).arg("--no-plots");
+    if let Some(dir) = out {
+        cmd.arg("--out").arg(dir);
+    }
+    cmd
 }
 
 #[test]
 fn fake_contention_marks_cells_contended_and_warns_in_the_output_and_the_report() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     let o = tiny(&dir, &["--fake-contention", "0.5"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let err = text(&o.stderr);
@@ -53,29 +47,24 @@ fn fake_contention_marks_cells_contended_and_warns_in_the_output_and_the_report(
         "{summary:?}"
     );
     let trials = rows(&dir.join("trials.csv"));
-    assert!(
-        trials
-            .iter()
-            .all(|r| r["foreign_cpu_s"].parse::<f64>().unwrap() > 0.0)
-    );
+    assert!(trials.iter().all(|r| num(r, "foreign_cpu_s") > 0.0));
     let report = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
     assert!(report.contains("contended"), "{report}");
 }
 
 #[test]
 fn a_quiet_fake_machine_gives_no_contended_cell_and_intervals_around_the_mean() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     let o = tiny(&dir, &["--no-plots"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(!text(&o.stderr).contains("busy with other work"));
     for r in rows(&dir.join("summary.csv")) {
         assert_eq!(r["contended"], "false", "{r:?}");
-        let num = |k: &str| r[k].parse::<f64>().unwrap();
-        assert!(num("mean_ci_low_s") <= num("mean_s") && num("mean_s") <= num("mean_ci_high_s"));
+        let at = |column: &str| num(&r, column);
+        assert!(at("mean_ci_low_s") <= at("mean_s") && at("mean_s") <= at("mean_ci_high_s"));
         if r["strategy"] != "seq" {
-            assert!(num("speedup_ci_low") <= num("speedup"));
-            assert!(num("speedup") <= num("speedup_ci_high"));
+            assert!(at("speedup_ci_low") <= at("speedup"));
+            assert!(at("speedup") <= at("speedup_ci_high"));
         }
     }
 }
@@ -113,34 +102,19 @@ fn a_sweep_beside_busy_processes_measures_their_cpu_and_marks_its_cells_contende
     if !Path::new("/proc/stat").exists() {
         return; // Not Linux: the columns stay empty, tested by the unit tests.
     }
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     let _busy = Busy::start();
-    let o = run(&[
-        "sweep",
-        "--n",
-        "1000",
-        "--steps",
-        "400",
-        "--trials",
-        "2",
-        "--warmup",
-        "0",
-        "--cores",
-        "1",
-        "--strategies",
-        "seq",
-        "--no-plots",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    let o = sweep_into(
+        &dir,
+        "--n 1000 --steps 400 --trials 2 --warmup 0 --cores 1 --strategies seq --no-plots",
+    );
     assert!(o.status.success(), "{}", text(&o.stderr));
     let err = text(&o.stderr);
     assert!(err.contains("cores busy with other work"), "{err}");
     let summary = rows(&dir.join("summary.csv"));
     assert_eq!(summary[0]["contended"], "true", "{summary:?}");
     for t in rows(&dir.join("trials.csv")) {
-        assert!(t["foreign_cpu_s"].parse::<f64>().unwrap() > 0.0, "{t:?}");
+        assert!(num(&t, "foreign_cpu_s") > 0.0, "{t:?}");
         assert!(!t["load1"].is_empty());
     }
 }
@@ -148,41 +122,22 @@ fn a_sweep_beside_busy_processes_measures_their_cpu_and_marks_its_cells_contende
 /// Starts a sweep that runs long enough to be caught holding its directory's lock, and waits
 /// until it holds it.
 fn long_sweep(dir: &Path) -> Child {
-    let child = bench_sph()
-        .args([
-            "sweep",
-            "--n",
-            "2000",
-            "--steps",
-            "1000",
-            "--trials",
-            "50",
-            "--cores",
-            "1",
-            "--strategies",
-            "seq",
-            "--no-plots",
-            "--out",
-            dir.to_str().unwrap(),
-        ])
+    let options = "--n 2000 --steps 1000 --trials 50 --cores 1 --strategies seq --no-plots";
+    let child = sweep_command(dir, options)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    let deadline = Instant::now() + Duration::from_secs(60);
-    while !std::fs::read_to_string(dir.join("sweep.lock"))
-        .is_ok_and(|s| s.trim() == child.id().to_string())
-    {
-        assert!(Instant::now() < deadline, "the sweep never took its lock");
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    let lock = dir.join("sweep.lock");
+    wait_until("the sweep never took its lock", || {
+        std::fs::read_to_string(&lock).is_ok_and(|s| s.trim() == child.id().to_string())
+    });
     child
 }
 
 #[test]
 fn a_second_sweep_on_a_directory_in_use_is_refused_naming_the_holders_pid() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     let mut first = long_sweep(&dir);
     let pid = first.id().to_string();
     let o = run(&["sweep", "--resume", dir.to_str().unwrap()]);
@@ -218,16 +173,7 @@ fn two_sweeps_racing_for_the_same_new_directory_leave_one_winner_and_a_clear_ref
     let tmp = tempfile::tempdir().unwrap();
     for round in 0..3 {
         let dir = tmp.path().join(format!("same{round}"));
-        let spawn = || {
-            let mut args = TINY.to_vec();
-            args.extend(["--no-plots", "--out", dir.to_str().unwrap()]);
-            bench_sph()
-                .args(&args)
-                .stdout(Stdio::null())
-                .stderr(Stdio::piped())
-                .spawn()
-                .unwrap()
-        };
+        let spawn = || start(&mut tiny_without_plots(Some(&dir)), Stdio::null());
         let (a, b) = (spawn(), spawn());
         let outs = [a.wait_with_output().unwrap(), b.wait_with_output().unwrap()];
         let ok = outs.iter().filter(|o| o.status.success()).count();
@@ -249,15 +195,10 @@ fn two_sweeps_racing_for_the_same_new_directory_leave_one_winner_and_a_clear_ref
 fn default_directories_of_sweeps_started_in_the_same_second_do_not_collide() {
     let tmp = tempfile::tempdir().unwrap();
     let spawn = || {
-        let mut args = TINY.to_vec();
-        args.push("--no-plots");
-        bench_sph()
-            .args(&args)
-            .current_dir(tmp.path())
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap()
+        start(
+            tiny_without_plots(None).current_dir(tmp.path()),
+            Stdio::null(),
+        )
     };
     let children: Vec<Child> = (0..3).map(|_| spawn()).collect();
     for c in children {
@@ -279,14 +220,7 @@ fn a_closed_standard_output_ends_the_sweep_like_ctrl_c_without_a_panic() {
     let tmp = tempfile::tempdir().unwrap();
     // A reader that goes away at once (`sweep | head -0`).
     let dir = tmp.path().join("pipe");
-    let mut args = TINY.to_vec();
-    args.extend(["--no-plots", "--out", dir.to_str().unwrap()]);
-    let mut child = bench_sph()
-        .args(&args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = start(&mut tiny_without_plots(Some(&dir)), Stdio::piped());
     drop(child.stdout.take());
     let o = child.wait_with_output().unwrap();
     assert!(!o.status.success());
@@ -306,13 +240,14 @@ fn a_closed_standard_output_ends_the_sweep_like_ctrl_c_without_a_panic() {
     // A full device.
     if Path::new("/dev/full").exists() {
         let dir = tmp.path().join("full");
-        let mut args = TINY.to_vec();
-        args.extend(["--no-plots", "--out", dir.to_str().unwrap()]);
         let full = std::fs::OpenOptions::new()
             .write(true)
             .open("/dev/full")
             .unwrap();
-        let o = bench_sph().args(&args).stdout(full).output().unwrap();
+        let o = tiny_without_plots(Some(&dir))
+            .stdout(full)
+            .output()
+            .unwrap();
         assert!(!o.status.success());
         no_panic(&o);
         let meta = std::fs::read_to_string(dir.join("meta.json")).unwrap();
@@ -322,25 +257,9 @@ fn a_closed_standard_output_ends_the_sweep_like_ctrl_c_without_a_panic() {
 
 #[test]
 fn the_plan_of_a_huge_all_pairs_sweep_is_printed_before_any_long_run() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
-    let mut child = bench_sph()
-        .args([
-            "sweep",
-            "--n",
-            "300000",
-            "--strategies",
-            "seq",
-            "--cores",
-            "1",
-            "--steps",
-            "1",
-            "--trials",
-            "1",
-            "--no-plots",
-            "--out",
-            dir.to_str().unwrap(),
-        ])
+    let (_tmp, dir) = scratch("r");
+    let options = "--n 300000 --strategies seq --cores 1 --steps 1 --trials 1 --no-plots";
+    let mut child = sweep_command(&dir, options)
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
@@ -369,8 +288,7 @@ fn the_plan_of_a_huge_all_pairs_sweep_is_printed_before_any_long_run() {
 
 #[test]
 fn resume_rechecks_its_meta_json_and_reruns_corrupt_or_short_cells() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (_tmp, dir) = scratch("r");
     assert!(tiny(&dir, &["--no-plots"]).status.success());
     let d = dir.to_str().unwrap();
     let meta_path = dir.join("meta.json");
@@ -411,11 +329,7 @@ fn resume_rechecks_its_meta_json_and_reruns_corrupt_or_short_cells() {
         "{err}"
     );
     let again = rows(&dir.join("trials.csv"));
-    assert!(
-        again
-            .iter()
-            .all(|r| r["wall_s"].parse::<f64>().unwrap() > 0.0)
-    );
+    assert!(again.iter().all(|r| num(r, "wall_s") > 0.0));
     assert_eq!(again.len(), 9);
 
     // trials changed from 3 to 5: every cell runs again with 5.
@@ -430,8 +344,7 @@ fn resume_rechecks_its_meta_json_and_reruns_corrupt_or_short_cells() {
 
 #[test]
 fn force_replaces_a_sweeps_earlier_report_and_keeps_foreign_files() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
+    let (tmp, dir) = scratch("r");
     assert!(tiny(&dir, &[]).status.success());
     assert!(dir.join("REPORT.md").is_file());
     std::fs::write(dir.join("notes.txt"), "mine").unwrap();
@@ -452,10 +365,7 @@ fn force_replaces_a_sweeps_earlier_report_and_keeps_foreign_files() {
         })
         .count();
     assert_eq!(pngs, 0);
-    assert_eq!(
-        std::fs::read_to_string(dir.join("notes.txt")).unwrap(),
-        "mine"
-    );
+    assert_file_holds(&dir.join("notes.txt"), "mine");
 
     // A trace's (or any foreign) meta.json is never overwritten, even with --force.
     let other = tmp.path().join("other");
@@ -480,20 +390,8 @@ fn force_replaces_a_sweeps_earlier_report_and_keeps_foreign_files() {
 
 #[test]
 fn a_group_larger_than_the_available_memory_is_refused_before_anything_is_written() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("r");
-    let o = bench_sph()
-        .args([
-            "sweep",
-            "--n",
-            "1000,200000",
-            "--neighbors",
-            "grid",
-            "--strategies",
-            "seq",
-            "--out",
-            dir.to_str().unwrap(),
-        ])
+    let (_tmp, dir) = scratch("r");
+    let o = sweep_command(&dir, "--n 1000,200000 --neighbors grid --strategies seq")
         .env("BENCH_SPH_FAKE_MEM_AVAILABLE", "10000000")
         .output()
         .unwrap();
@@ -511,17 +409,9 @@ fn a_group_larger_than_the_available_memory_is_refused_before_anything_is_writte
 
 #[test]
 fn a_sweep_whose_stdout_and_stderr_are_both_closed_still_exits_cleanly() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("both");
-    let mut args = TINY.to_vec();
-    args.extend(["--no-plots", "--out", dir.to_str().unwrap()]);
+    let (_tmp, dir) = scratch("both");
     // `bench-sph sweep 2>&1 | head -0`: nobody reads either stream.
-    let mut child = bench_sph()
-        .args(&args)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = start(&mut tiny_without_plots(Some(&dir)), Stdio::piped());
     drop(child.stdout.take());
     drop(child.stderr.take());
     let status = child.wait().unwrap();

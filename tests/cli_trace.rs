@@ -14,7 +14,10 @@ use serde_json::Value;
 use sph_strategies::StrategyName;
 
 mod common;
-use common::{fails_with, names, run, stderr, stdout};
+use common::{
+    DIVERGING_INIT, assert_file_holds, fails_with, line_containing, names, run, scratch, stderr,
+    stdout,
+};
 
 const N: usize = 200;
 const STEPS: usize = 2;
@@ -298,8 +301,7 @@ fn the_timeline_can_show_only_the_last_steps() {
 
 #[test]
 fn an_unwritable_output_directory_is_an_error_before_anything_runs() {
-    let tmp = tempfile::tempdir().unwrap();
-    let file = tmp.path().join("a-file");
+    let (_tmp, file) = scratch("a-file");
     std::fs::write(&file, "x").unwrap();
     let out = file.join("sub");
     let o = run(&[
@@ -317,23 +319,24 @@ fn an_unwritable_output_directory_is_an_error_before_anything_runs() {
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
 
-#[test]
-fn a_diverging_run_is_an_error_and_leaves_no_trace_files() {
-    let tmp = tempfile::tempdir().unwrap();
-    let init = tmp.path().join("boom.csv");
-    std::fs::write(&init, "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n").unwrap();
-    let out = tmp.path().join("t");
-    let o = run(&[
-        "trace",
-        "--strategy",
-        "rayon-chunks",
-        "--cores",
-        "2",
+/// Runs `trace` with `options` from a diverging init file (written into `dir`) into `out`.
+fn trace_diverging(dir: &Path, out: &Path, options: &[&str]) -> Output {
+    let init = dir.join("boom.csv");
+    std::fs::write(&init, DIVERGING_INIT).unwrap();
+    let files = [
         "--init",
         init.to_str().unwrap(),
         "--out",
         out.to_str().unwrap(),
-    ]);
+    ];
+    run(&[&["trace"][..], options, &files].concat())
+}
+
+#[test]
+fn a_diverging_run_is_an_error_and_leaves_no_trace_files() {
+    let (tmp, out) = scratch("t");
+    let options = ["--strategy", "rayon-chunks", "--cores", "2"];
+    let o = trace_diverging(tmp.path(), &out, &options);
     let err = stderr(&o);
     assert!(!o.status.success());
     assert!(
@@ -346,26 +349,18 @@ fn a_diverging_run_is_an_error_and_leaves_no_trace_files() {
 #[test]
 fn bad_counts_and_names_are_rejected() {
     let base = ["trace", "--out", "unused-dir", "--strategy"];
-    fails_with(
-        &[&base[..], &["turbo"]].concat(),
-        &["unknown strategy 'turbo'"],
-    );
-    fails_with(
-        &[&base[..], &["seq", "--steps", "0"]].concat(),
-        &["at least 1"],
-    );
-    fails_with(
-        &[&base[..], &["seq", "--cores", "0"]].concat(),
-        &["at least 1"],
-    );
-    fails_with(
-        &[&base[..], &["seq", "--compare", "x"]].concat(),
-        &["whole number"],
-    );
-    fails_with(
-        &[&base[..], &["seq", "--warmup", "1001"]].concat(),
-        &["warm-ups must be between 0 and 1000, not 1001"],
-    );
+    for (rest, needle) in [
+        (&["turbo"][..], "unknown strategy 'turbo'"),
+        (&["seq", "--steps", "0"], "at least 1"),
+        (&["seq", "--cores", "0"], "at least 1"),
+        (&["seq", "--compare", "x"], "whole number"),
+        (
+            &["seq", "--warmup", "1001"],
+            "warm-ups must be between 0 and 1000, not 1001",
+        ),
+    ] {
+        fails_with(&[&base[..], rest].concat(), &[needle]);
+    }
     fails_with(&["trace", "--strategy", "seq"], &["--out"]);
     assert!(!Path::new("unused-dir").exists());
 }
@@ -405,8 +400,7 @@ fn meta(dir: &Path) -> Value {
 
 #[test]
 fn trace_into_a_finished_sweep_directory_is_refused_and_the_sweep_is_untouched() {
-    let tmp = tempfile::tempdir().unwrap();
-    let sweep = tmp.path().join("sweep");
+    let (_tmp, sweep) = scratch("sweep");
     finished_sweep(&sweep);
     let before = contents(&sweep);
     let o = trace(StrategyName::Seq, &sweep, &[]);
@@ -441,10 +435,7 @@ fn force_writes_beside_foreign_files_and_leaves_them_as_they_are() {
             "trace.json"
         ]
     );
-    assert_eq!(
-        std::fs::read_to_string(tmp.path().join("notes.txt")).unwrap(),
-        "mine"
-    );
+    assert_file_holds(&tmp.path().join("notes.txt"), "mine");
 }
 
 #[test]
@@ -468,30 +459,18 @@ fn a_second_trace_replaces_its_own_files_and_meta_json_names_the_tool_and_warm_u
 
 #[test]
 fn a_failed_trace_leaves_an_earlier_trace_in_its_directory_as_it_was() {
-    let tmp = tempfile::tempdir().unwrap();
-    let out = tmp.path().join("t");
+    let (tmp, out) = scratch("t");
     let o = trace(StrategyName::Seq, &out, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let before = contents(&out);
-    let init = tmp.path().join("boom.csv");
-    std::fs::write(&init, "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n").unwrap();
-    let o = run(&[
-        "trace",
-        "--strategy",
-        "seq",
-        "--init",
-        init.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let o = trace_diverging(tmp.path(), &out, &["--strategy", "seq"]);
     one_error_line(&o, "diverged at step 1");
     assert_eq!(contents(&out), before);
 }
 
 #[test]
 fn a_trace_too_large_is_refused_before_it_runs_naming_the_estimate_and_what_to_lower() {
-    let tmp = tempfile::tempdir().unwrap();
-    let out = tmp.path().join("big");
+    let (_tmp, out) = scratch("big");
     let o = run(&[
         "trace",
         "--strategy",
@@ -553,8 +532,7 @@ fn report(results: &Path, extra: &[&str]) -> Output {
 
 #[test]
 fn report_refuses_a_named_trace_directory_whose_timeline_is_not_a_png() {
-    let tmp = tempfile::tempdir().unwrap();
-    let results = tmp.path().join("results");
+    let (tmp, results) = scratch("results");
     finished_sweep(&results);
     let junk: PathBuf = tmp.path().join("junk");
     real_trace(&junk);
@@ -565,8 +543,7 @@ fn report_refuses_a_named_trace_directory_whose_timeline_is_not_a_png() {
 
 #[test]
 fn report_skips_a_junk_trace_found_under_the_results_with_a_warning_and_embeds_a_good_one() {
-    let tmp = tempfile::tempdir().unwrap();
-    let results = tmp.path().join("results");
+    let (_tmp, results) = scratch("results");
     finished_sweep(&results);
     real_trace(&results.join("trace-good"));
     let junk = results.join("trace-junk");
@@ -575,10 +552,7 @@ fn report_skips_a_junk_trace_found_under_the_results_with_a_warning_and_embeds_a
     let o = report(&results, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let err = stderr(&o);
-    let warning = err
-        .lines()
-        .find(|l| l.contains("trace-junk"))
-        .unwrap_or_else(|| panic!("no warning about trace-junk:\n{err}"));
+    let warning = line_containing(&err, "trace-junk");
     assert!(
         warning.starts_with("warning: skipping trace directory '")
             && warning.ends_with("': stats.csv does not have the trace's columns (kind,name,threads,kernel_calls,busy_ms,span_ms,idle_pct,imbalance)"),

@@ -5,12 +5,14 @@
 #![allow(dead_code)] // each test file uses its own subset
 
 use std::collections::HashMap;
-use std::path::Path;
-use std::process::{Command, Output};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
 
 use assert_cmd::assert::Assert;
 use predicates::prelude::*;
 use predicates::str::contains;
+use tempfile::TempDir;
 
 /// A CSV row by column name.
 pub type Row = HashMap<String, String>;
@@ -32,6 +34,66 @@ pub fn run_in(dir: &Path, args: &[&str]) -> Output {
         .current_dir(dir)
         .output()
         .expect("binary runs")
+}
+
+/// Starts `cmd` with standard output to `stdout` and standard error piped, to be read with
+/// `wait_with_output`.
+pub fn start(cmd: &mut Command, stdout: Stdio) -> Child {
+    cmd.stdout(stdout)
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary starts")
+}
+
+/// `bench-sph sweep` with `options`, then `--out dir`, ready to run or start. The options are
+/// written as on a command line, in one string split at white space (no value here holds a
+/// space).
+pub fn sweep_command(dir: &Path, options: &str) -> Command {
+    let mut cmd = bench_sph();
+    cmd.arg("sweep")
+        .args(options.split_whitespace())
+        .arg("--out")
+        .arg(dir);
+    cmd
+}
+
+/// Runs [`sweep_command`] to the end, whatever its outcome.
+pub fn sweep_into(dir: &Path, options: &str) -> Output {
+    sweep_command(dir, options).output().expect("binary runs")
+}
+
+/// The arguments of a small sweep timed by the hidden `--fake-timings`, so that every number
+/// it reports is known: N = 60 over 3 steps, no warm-up, 3 trials a cell at 1 and 2 cores and
+/// 4 chunks, of `strategies` (comma-separated), the trials' times taken in turn from `timings`
+/// (seconds, comma-separated). Callers add `--out` and whatever else they test.
+pub fn fake_sweep<'a>(strategies: &'a str, timings: &'a str) -> Vec<&'a str> {
+    let mut args: Vec<&str> =
+        "sweep --n 60 --steps 3 --trials 3 --warmup 0 --cores 1..2 --chunks 4"
+            .split_whitespace()
+            .collect();
+    args.extend(["--strategies", strategies, "--fake-timings", timings]);
+    args
+}
+
+/// Checks `ready` every `every` until it holds or `limit` has passed; says whether it held.
+pub fn poll_until(limit: Duration, every: Duration, mut ready: impl FnMut() -> bool) -> bool {
+    let deadline = Instant::now() + limit;
+    loop {
+        if ready() {
+            return true;
+        }
+        if Instant::now() >= deadline {
+            return false;
+        }
+        std::thread::sleep(every);
+    }
+}
+
+/// Waits until `ready` holds, checking every 20 ms; fails the test with `never` if it does not
+/// within a minute (a bound on a hang, not a timing).
+pub fn wait_until(never: &str, ready: impl FnMut() -> bool) {
+    let held = poll_until(Duration::from_secs(60), Duration::from_millis(20), ready);
+    assert!(held, "{never}");
 }
 
 /// Runs `cmd` to the end under `assert_cmd`.
@@ -77,6 +139,20 @@ pub fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
+/// Asserts that `text` (named `what` in the failure) holds every one of `needles`.
+pub fn assert_holds_all(what: &str, text: &str, needles: &[&str]) {
+    for needle in needles {
+        assert!(text.contains(needle), "{what} lacks {needle:?}:\n{text}");
+    }
+}
+
+/// The first line of `text` that holds `needle`; fails the test, showing `text`, if none does.
+pub fn line_containing<'a>(text: &'a str, needle: &str) -> &'a str {
+    text.lines()
+        .find(|l| l.contains(needle))
+        .unwrap_or_else(|| panic!("no line holds {needle:?}:\n{text}"))
+}
+
 /// A run's standard output as text.
 pub fn stdout(o: &Output) -> String {
     text(&o.stdout)
@@ -87,6 +163,24 @@ pub fn stderr(o: &Output) -> String {
     text(&o.stderr)
 }
 
+/// A new temporary directory (removed when the returned guard drops) and the path `name`
+/// inside it, not yet created.
+pub fn scratch(name: &str) -> (TempDir, PathBuf) {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join(name);
+    (tmp, path)
+}
+
+/// An init file's text whose two particles start at velocities of ±1e308: the first step
+/// overflows.
+pub const DIVERGING_INIT: &str = "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n";
+
+/// Asserts that the file at `path` holds exactly `text` (a file the run had to leave alone).
+pub fn assert_file_holds(path: &Path, text: &str) {
+    let held = std::fs::read_to_string(path).unwrap();
+    assert_eq!(held, text, "{}", path.display());
+}
+
 /// The names of the entries of `dir`, sorted.
 pub fn names(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
@@ -95,6 +189,13 @@ pub fn names(dir: &Path) -> Vec<String> {
         .collect();
     v.sort();
     v
+}
+
+/// The number in `row`'s `column`; fails the test, showing the row, if it is not one.
+pub fn num(row: &Row, column: &str) -> f64 {
+    row[column]
+        .parse()
+        .unwrap_or_else(|_| panic!("{column} = {:?} in {row:?}", row[column]))
 }
 
 /// The rows of a results CSV.
