@@ -28,16 +28,18 @@ fn main() {
         rustc_version.as_deref().unwrap_or("unknown")
     );
     println!("cargo:rustc-env=BENCH_SPH_GIT_COMMIT={}", git_commit());
-    // Rerun when the commit may have moved (HEAD, the branch refs) or the build's inputs
-    // changed (dirty or clean). Git's files are located by git itself, so a worktree (where
-    // `.git` is a file) works; only existing paths are named, since a missing one makes Cargo
-    // rerun the script on every build.
-    let git_paths = ["HEAD", "refs", "packed-refs"].map(|p| git(&["rev-parse", "--git-path", p]));
-    for path in git_paths
+    // Rerun when the commit may have moved (HEAD, the branch it points to, packed refs) or
+    // the build's inputs changed (dirty or clean); not when other refs move (a fetch). Git's
+    // files are located by git itself, so a worktree (where `.git` is a file) works; only
+    // existing paths are named, since a missing one makes Cargo rerun the script on every
+    // build.
+    let branch = git(&["symbolic-ref", "-q", "HEAD"]);
+    let watched = ["HEAD", "packed-refs"]
+        .map(str::to_owned)
         .into_iter()
-        .flatten()
-        .chain(BUILD_INPUTS.map(str::to_owned))
-    {
+        .chain(branch);
+    let git_paths = watched.filter_map(|p| git(&["rev-parse", "--git-path", &p]));
+    for path in git_paths.chain(BUILD_INPUTS.map(str::to_owned)) {
         if Path::new(&path).exists() {
             println!("cargo:rerun-if-changed={path}");
         }

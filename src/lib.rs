@@ -4,8 +4,9 @@
 //! - [`sph`]: the pure physics (constants, state, neighbour search, per-particle passes);
 //! - [`solver`]: one step as three passes run by a strategy's executor;
 //! - [`scene`]: initial dam-break states; [`io`]: CSV in and out;
-//! - [`run`]: timed runs; [`clock`], [`checksum`]: what a run reports; [`contention`]: what
-//!   the rest of the machine did meanwhile;
+//! - [`run`]: a run in one strategy session: the step loop timed (in segments, with an
+//!   observer between them), warm-up, fault injection; [`clock`], [`checksum`]: what a run
+//!   reports; [`contention`]: what the rest of the machine did meanwhile;
 //! - [`limits`]: the documented range of every numeric option;
 //! - [`output`]: files written whole or not at all, output directories, a closable stdout;
 //! - [`plot`]: the bundled font shared by charts and animations;

@@ -1,4 +1,6 @@
-//! The `bench-sph` command line (clap derive): one module for the definitions, one per command.
+//! The `bench-sph` command line (clap derive): one module per command, plus the options
+//! several commands share (`scene`: the initial state; `parallel`: strategy, cores, chunks)
+//! and the CLI's names for the domain's enums (`values`).
 
 mod list;
 mod parallel;

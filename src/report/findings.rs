@@ -8,15 +8,85 @@
 //! - A speedup above 1 at one core is labelled noise in the reference, never a win.
 //! - The Karp–Flatt serial fraction is given only where the speedup is above 1 on at least 2
 //!   cores, as a measurement at that core count, never extrapolated.
+//!
+//! [`findings`] decides what the data supports, as [`Finding`] values; [`Finding::sentence`]
+//! words each one.
 
 use super::numbers::{interval, percent, secs, times};
 use super::paper;
 use super::series::{self, Best, Group};
 use crate::results::rows::SummaryRow;
+use crate::results::stats::Interval;
 use sph_strategies::StrategyName;
 
-/// The sentences for group `g` of `rows`.
-pub fn findings(rows: &[SummaryRow], g: &Group) -> Vec<String> {
+/// What the data of a group supports, decided before it is worded.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Finding {
+    /// The group's `seq` reference was contended: no speedup-based finding follows.
+    ContendedReference,
+    /// Who is fastest at one core count, if anyone can be said to be.
+    AtCores(AtCores),
+    /// A speedup above 1 at one core: the reference's noise, not a win.
+    OneCoreNoise {
+        /// The strategy.
+        strategy: StrategyName,
+        /// Its speedup at 1 core.
+        speedup: f64,
+        /// The speedup's 95 % interval.
+        ci: Option<Interval>,
+    },
+    /// Where more chunks stop paying for a chunked strategy.
+    ChunkingStops {
+        /// The strategy.
+        strategy: StrategyName,
+        /// (chunks from which more stop paying, at this many cores), by cores.
+        from: Vec<(usize, usize)>,
+    },
+    /// The Karp–Flatt serial fraction of the fastest trusted cell at the most cores.
+    SerialFraction {
+        /// The strategy.
+        strategy: StrategyName,
+        /// Its cell.
+        best: Best,
+        /// The serial fraction e.
+        e: f64,
+    },
+    /// The paper's published speedups beside the best here, per comparable core count.
+    AgainstPaper(Vec<PaperPoint>),
+}
+
+/// The verdict at one core count, with what its sentence needs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AtCores {
+    /// Worker threads.
+    pub cores: usize,
+    /// Some cell there had more threads than the machine.
+    pub oversubscribed: bool,
+    /// Contended cells left out.
+    pub contended: usize,
+    /// Whether the winner's speedup may be stated (more than 1 core, trusted reference).
+    pub show_speedup: bool,
+    /// The verdict on the cells measured without contention.
+    pub verdict: Verdict,
+}
+
+/// One core count of [`Finding::AgainstPaper`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct PaperPoint {
+    /// Worker threads.
+    pub cores: usize,
+    /// The best cell here was oversubscribed.
+    pub oversubscribed: bool,
+    /// The best speedup here.
+    pub speedup: f64,
+    /// Its strategy.
+    pub strategy: StrategyName,
+    /// The paper's speedup at these cores.
+    pub paper: f64,
+}
+
+/// The findings for group `g` of `rows`.
+pub fn findings(rows: &[SummaryRow], g: &Group) -> Vec<Finding> {
     let strategies: Vec<StrategyName> = series::strategies(rows, g)
         .into_iter()
         .filter(|&s| s != StrategyName::Seq)
@@ -31,18 +101,14 @@ pub fn findings(rows: &[SummaryRow], g: &Group) -> Vec<String> {
         .any(|r| r.group() == *g && r.is_reference() && r.contended == Some(true));
     let mut out = Vec::new();
     if !seq_trusted {
-        out.push(
-            "The seq reference was contended (other work used the machine while it ran): no \
-             speedup, serial fraction or comparison with the paper is given as a finding."
-                .to_owned(),
-        );
+        out.push(Finding::ContendedReference);
     }
     for c in series::cores(rows, g) {
-        let at: Vec<(&str, &Best)> = bests
+        let at: Vec<Entry> = bests
             .iter()
-            .filter_map(|(s, b)| Some((s.as_str(), b.iter().find(|b| b.cores == c)?)))
+            .filter_map(|(s, b)| Some((*s, b.iter().find(|b| b.cores == c)?.clone())))
             .collect();
-        out.extend(winner(c, &at, seq_trusted));
+        out.extend(at_cores(c, &at, seq_trusted).map(Finding::AtCores));
         if c == 1 && seq_trusted {
             out.extend(one_core_noise(&at));
         }
@@ -56,55 +122,55 @@ pub fn findings(rows: &[SummaryRow], g: &Group) -> Vec<String> {
 }
 
 /// A strategy's best cell at one core count.
-type Entry<'a> = (&'a str, &'a Best);
+type Entry = (StrategyName, Best);
 
 /// What can be said about the fastest strategy at one core count, from the cells measured
 /// without contention (fastest first).
 #[derive(Debug, Clone, PartialEq)]
-enum Verdict<'a> {
+pub enum Verdict {
     /// Only one cell.
-    Only(Entry<'a>),
+    Only(Entry),
     /// Several, but some without confidence intervals: the lowest mean only.
-    NoIntervals(Entry<'a>),
+    NoIntervals(Entry),
     /// The fastest cell's interval overlaps no other's.
     Fastest {
         /// The fastest.
-        winner: Entry<'a>,
+        winner: Entry,
         /// The second fastest.
-        runner_up: Entry<'a>,
+        runner_up: Entry,
     },
     /// The fastest cell's interval overlaps these (the fastest first).
     Tied {
         /// The cells whose intervals overlap the fastest one's, and it.
-        tied: Vec<Entry<'a>>,
+        tied: Vec<Entry>,
         /// How many are slower beyond the overlap.
         slower: usize,
     },
 }
 
 /// The verdict on `trusted` (sorted fastest first); `None` when it is empty.
-fn verdict<'a>(trusted: &[Entry<'a>]) -> Option<Verdict<'a>> {
-    let &first = trusted.first()?;
+fn verdict(trusted: &[Entry]) -> Option<Verdict> {
+    let first = trusted.first()?.clone();
     if trusted.len() == 1 {
         return Some(Verdict::Only(first));
     }
     if trusted.iter().any(|(_, b)| b.mean_ci.is_none()) {
         return Some(Verdict::NoIntervals(first));
     }
-    let mut tied = vec![first];
+    let mut tied = vec![first.clone()];
     tied.extend(
         trusted[1..]
             .iter()
-            .copied()
             .filter(|(_, b)| match (first.1.mean_ci, b.mean_ci) {
                 (Some(a), Some(o)) => a.overlaps(&o),
                 _ => true,
-            }),
+            })
+            .cloned(),
     );
     Some(if tied.len() == 1 {
         Verdict::Fastest {
             winner: first,
-            runner_up: trusted[1],
+            runner_up: trusted[1].clone(),
         }
     } else {
         let slower = trusted.len() - tied.len();
@@ -112,77 +178,243 @@ fn verdict<'a>(trusted: &[Entry<'a>]) -> Option<Verdict<'a>> {
     })
 }
 
-/// Who is fastest at `cores`, if anyone can be said to be, as a sentence.
-// Over ~60 lines on purpose: one sentence per verdict ([`verdict`] decides; this only words it).
-fn winner(cores: usize, at: &[Entry<'_>], seq_trusted: bool) -> Option<String> {
-    let contended = at.iter().filter(|(_, b)| b.contended).count();
-    let mut trusted: Vec<Entry<'_>> = at.iter().copied().filter(|(_, b)| !b.contended).collect();
+/// The verdict at `cores` on the cells `at`, the contended ones left out.
+fn at_cores(cores: usize, at: &[Entry], seq_trusted: bool) -> Option<AtCores> {
+    let mut trusted: Vec<Entry> = at.iter().filter(|(_, b)| !b.contended).cloned().collect();
     trusted.sort_by(|a, b| a.1.mean_s.total_cmp(&b.1.mean_s));
-    let left_out = match contended {
-        0 => String::new(),
-        1 => " (1 contended cell left out)".to_owned(),
-        k => format!(" ({k} contended cells left out)"),
-    };
-    let where_ = format!(
-        "At {}{}",
-        series::cores_label(cores),
-        if at.iter().any(|(_, b)| b.oversubscribed) {
-            " (⚠ oversubscribed: more threads than the machine has)"
-        } else {
-            ""
-        }
-    );
-    let describe = |(s, b): Entry<'_>| {
-        format!(
-            "{s}{} ({} s{})",
-            b.chunks
-                .map_or_else(String::new, |k| format!(" with {k} chunks")),
-            secs(b.mean_s),
-            interval(b.mean_ci)
-        )
-    };
-    Some(match verdict(&trusted)? {
-        Verdict::Only(w) => {
-            let only = if contended > 0 {
-                "was measured without contention"
-            } else {
-                "was measured"
-            };
-            format!("{where_}, only {} {only}{left_out}.", describe(w))
-        }
-        Verdict::NoIntervals(w) => format!(
-            "{where_}, the lowest mean is {}, but these cells have no confidence intervals (one \
-             trial, or a sweep older than them), so no strategy can be called fastest{left_out}.",
-            describe(w)
-        ),
-        Verdict::Fastest { winner, runner_up } => {
-            let (wb, rb) = (winner.1, runner_up.1);
-            // At one core a speedup is the reference's noise (said separately), not a result.
-            let speed = wb
-                .speedup
-                .filter(|_| cores > 1 && seq_trusted)
-                .map_or_else(String::new, |s| {
-                    format!(", {}{} over seq", times(s), interval(wb.speedup_ci))
-                });
-            format!(
-                "{where_}, **{}** is fastest{speed}; its 95 % interval does not overlap the \
-                 runner-up {}, which takes {} more time{left_out}.",
-                describe(winner),
-                describe(runner_up),
-                percent((rb.mean_s - wb.mean_s) / wb.mean_s * 100.0)
-            )
-        }
-        Verdict::Tied { tied, slower } => format!(
-            "{where_}, {} are indistinguishable within the trial spread (their 95 % intervals \
-             overlap){}{left_out}.",
-            and_list(&tied.into_iter().map(describe).collect::<Vec<_>>()),
-            match slower {
-                0 => String::new(),
-                1 => "; the other strategy is slower".to_owned(),
-                _ => "; the others are slower".to_owned(),
-            }
-        ),
+    Some(AtCores {
+        cores,
+        oversubscribed: at.iter().any(|(_, b)| b.oversubscribed),
+        contended: at.len() - trusted.len(),
+        // At one core a speedup is the reference's noise (said separately), not a result.
+        show_speedup: cores > 1 && seq_trusted,
+        verdict: verdict(&trusted)?,
     })
+}
+
+/// A speedup above 1 at one core is the reference's noise.
+fn one_core_noise(at: &[Entry]) -> Vec<Finding> {
+    at.iter()
+        .filter(|(_, b)| !b.contended)
+        .filter_map(|(s, b)| {
+            Some(Finding::OneCoreNoise {
+                strategy: *s,
+                speedup: b.speedup.filter(|&sp| sp > 1.0)?,
+                ci: b.speedup_ci,
+            })
+        })
+        .collect()
+}
+
+/// Where more chunks stop paying, per chunked strategy.
+fn chunking(rows: &[SummaryRow], g: &Group, strategies: &[StrategyName]) -> Vec<Finding> {
+    let mut out = Vec::new();
+    for &s in strategies
+        .iter()
+        .filter(|&&s| series::is_chunked(rows, g, s))
+    {
+        let from: Vec<(usize, usize)> = series::chunk_table(rows, g, s)
+            .iter()
+            .filter(|(_, v)| v.len() > 1)
+            .filter_map(|(c, v)| Some((series::chunking_stops_paying(v)?, *c)))
+            .collect();
+        if !from.is_empty() {
+            out.push(Finding::ChunkingStops { strategy: s, from });
+        }
+    }
+    out
+}
+
+/// The serial fraction of the fastest trusted cell at the most cores not oversubscribed,
+/// where it means something.
+fn karp_flatt(bests: &[(StrategyName, Vec<Best>)]) -> Option<Finding> {
+    let (s, b) = bests
+        .iter()
+        .flat_map(|(s, b)| b.iter().map(move |b| (*s, b)))
+        .filter(|(_, b)| b.cores > 1 && !b.oversubscribed && !b.contended)
+        .filter(|(_, b)| b.speedup.is_some_and(|sp| sp > 1.0))
+        .max_by(|a, b| {
+            a.1.cores
+                .cmp(&b.1.cores)
+                .then(b.1.mean_s.total_cmp(&a.1.mean_s))
+        })?;
+    Some(Finding::SerialFraction {
+        strategy: s,
+        e: b.serial_fraction()?,
+        best: b.clone(),
+    })
+}
+
+/// The paper's published speedups beside ours, where comparable.
+fn against_paper(
+    rows: &[SummaryRow],
+    g: &Group,
+    bests: &[(StrategyName, Vec<Best>)],
+) -> Option<Finding> {
+    if !paper::comparable(g) {
+        return None;
+    }
+    let mut points = Vec::new();
+    for c in series::cores(rows, g) {
+        let Some(p) = paper::at(c) else { continue };
+        let best = bests
+            .iter()
+            .filter_map(|(s, b)| Some((*s, b.iter().find(|b| b.cores == c)?)))
+            .filter(|(_, b)| !b.contended)
+            .filter_map(|(s, b)| Some((s, b.speedup?, b.oversubscribed)))
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((strategy, speedup, oversubscribed)) = best {
+            points.push(PaperPoint {
+                cores: c,
+                oversubscribed,
+                speedup,
+                strategy,
+                paper: p.speedup,
+            });
+        }
+    }
+    (!points.is_empty()).then_some(Finding::AgainstPaper(points))
+}
+
+impl Finding {
+    /// The finding in one sentence (Markdown).
+    pub fn sentence(&self) -> String {
+        match self {
+            Finding::ContendedReference => "The seq reference was contended (other work used \
+                the machine while it ran): no speedup, serial fraction or comparison with the \
+                paper is given as a finding."
+                .to_owned(),
+            Finding::AtCores(at) => at.sentence(),
+            Finding::OneCoreNoise {
+                strategy,
+                speedup,
+                ci,
+            } => format!(
+                "{strategy}'s speedup of {}{} at 1 core is noise in the seq reference, not a \
+                 win: one worker runs the same passes as seq.",
+                times(*speedup),
+                interval(*ci)
+            ),
+            Finding::ChunkingStops { strategy, from } => {
+                let parts: Vec<String> = from
+                    .iter()
+                    .map(|(k, c)| format!("{k} chunks at {}", series::cores_label(*c)))
+                    .collect();
+                format!(
+                    "{strategy}: more chunks stop paying (no larger chunk count is faster by \
+                     more than the trial spread) from {}.",
+                    parts.join(", ")
+                )
+            }
+            Finding::SerialFraction { strategy, best, e } => format!(
+                "Karp–Flatt serial fraction of {strategy} at {} ({}{}): e = {}. It describes \
+                 the runs measured here; from so few core counts it forecasts nothing about \
+                 more cores.",
+                series::cores_label(best.cores),
+                times(best.speedup.unwrap_or(f64::NAN)),
+                interval(best.speedup_ci),
+                super::numbers::sig(*e)
+            ),
+            Finding::AgainstPaper(points) => format!(
+                "Against the paper's published speedups (its machine, its program): {}.",
+                points
+                    .iter()
+                    .map(PaperPoint::phrase)
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            ),
+        }
+    }
+}
+
+impl PaperPoint {
+    fn phrase(&self) -> String {
+        format!(
+            "at {}{} the best here is {} ({}) against the paper's {}",
+            series::cores_label(self.cores),
+            if self.oversubscribed {
+                " (⚠ oversubscribed here)"
+            } else {
+                ""
+            },
+            times(self.speedup),
+            self.strategy,
+            times(self.paper)
+        )
+    }
+}
+
+impl AtCores {
+    /// Who is fastest, as a sentence: one per verdict.
+    fn sentence(&self) -> String {
+        let left_out = match self.contended {
+            0 => String::new(),
+            1 => " (1 contended cell left out)".to_owned(),
+            k => format!(" ({k} contended cells left out)"),
+        };
+        let where_ = format!(
+            "At {}{}",
+            series::cores_label(self.cores),
+            if self.oversubscribed {
+                " (⚠ oversubscribed: more threads than the machine has)"
+            } else {
+                ""
+            }
+        );
+        match &self.verdict {
+            Verdict::Only(w) => {
+                let only = if self.contended > 0 {
+                    "was measured without contention"
+                } else {
+                    "was measured"
+                };
+                format!("{where_}, only {} {only}{left_out}.", describe(w))
+            }
+            Verdict::NoIntervals(w) => format!(
+                "{where_}, the lowest mean is {}, but these cells have no confidence intervals \
+                 (one trial, or a sweep older than them), so no strategy can be called \
+                 fastest{left_out}.",
+                describe(w)
+            ),
+            Verdict::Fastest { winner, runner_up } => {
+                let (wb, rb) = (&winner.1, &runner_up.1);
+                let speed = wb
+                    .speedup
+                    .filter(|_| self.show_speedup)
+                    .map_or_else(String::new, |s| {
+                        format!(", {}{} over seq", times(s), interval(wb.speedup_ci))
+                    });
+                format!(
+                    "{where_}, **{}** is fastest{speed}; its 95 % interval does not overlap the \
+                     runner-up {}, which takes {} more time{left_out}.",
+                    describe(winner),
+                    describe(runner_up),
+                    percent((rb.mean_s - wb.mean_s) / wb.mean_s * 100.0)
+                )
+            }
+            Verdict::Tied { tied, slower } => format!(
+                "{where_}, {} are indistinguishable within the trial spread (their 95 % \
+                 intervals overlap){}{left_out}.",
+                and_list(&tied.iter().map(describe).collect::<Vec<_>>()),
+                match slower {
+                    0 => String::new(),
+                    1 => "; the other strategy is slower".to_owned(),
+                    _ => "; the others are slower".to_owned(),
+                }
+            ),
+        }
+    }
+}
+
+/// A cell as findings name it: `rayon-chunks with 45 chunks (0.412 s [0.40, 0.42])`.
+fn describe((s, b): &Entry) -> String {
+    format!(
+        "{s}{} ({} s{})",
+        b.chunks
+            .map_or_else(String::new, |k| format!(" with {k} chunks")),
+        secs(b.mean_s),
+        interval(b.mean_ci)
+    )
 }
 
 /// `a`, `a and b`, `a, b and c`.
@@ -194,116 +426,14 @@ fn and_list(items: &[String]) -> String {
     }
 }
 
-/// A speedup above 1 at one core is the reference's noise.
-fn one_core_noise(at: &[(&str, &Best)]) -> Vec<String> {
-    at.iter()
-        .filter(|(_, b)| !b.contended)
-        .filter_map(|(s, b)| {
-            let sp = b.speedup.filter(|&sp| sp > 1.0)?;
-            Some(format!(
-                "{s}'s speedup of {}{} at 1 core is noise in the seq reference, not a win: one \
-                 worker runs the same passes as seq.",
-                times(sp),
-                interval(b.speedup_ci)
-            ))
-        })
-        .collect()
-}
-
-/// Where more chunks stop paying, per chunked strategy.
-fn chunking(rows: &[SummaryRow], g: &Group, strategies: &[StrategyName]) -> Vec<String> {
-    let mut out = Vec::new();
-    for &s in strategies
-        .iter()
-        .filter(|&&s| series::is_chunked(rows, g, s))
-    {
-        let parts: Vec<String> = series::chunk_table(rows, g, s)
-            .iter()
-            .filter(|(_, v)| v.len() > 1)
-            .filter_map(|(c, v)| {
-                let k = series::chunking_stops_paying(v)?;
-                Some(format!("{k} chunks at {}", series::cores_label(*c)))
-            })
-            .collect();
-        if !parts.is_empty() {
-            out.push(format!(
-                "{s}: more chunks stop paying (no larger chunk count is faster by more than the \
-                 trial spread) from {}.",
-                parts.join(", ")
-            ));
-        }
-    }
-    out
-}
-
-/// The serial fraction of the fastest trusted cell at the most cores not oversubscribed,
-/// where it means something.
-fn karp_flatt(bests: &[(StrategyName, Vec<Best>)]) -> Option<String> {
-    let (s, b) = bests
-        .iter()
-        .flat_map(|(s, b)| b.iter().map(move |b| (s.as_str(), b)))
-        .filter(|(_, b)| b.cores > 1 && !b.oversubscribed && !b.contended)
-        .filter(|(_, b)| b.speedup.is_some_and(|sp| sp > 1.0))
-        .max_by(|a, b| {
-            a.1.cores
-                .cmp(&b.1.cores)
-                .then(b.1.mean_s.total_cmp(&a.1.mean_s))
-        })?;
-    let e = b.serial_fraction()?;
-    Some(format!(
-        "Karp–Flatt serial fraction of {s} at {} ({}{}): e = {}. It describes the runs \
-         measured here; from so few core counts it forecasts nothing about more cores.",
-        series::cores_label(b.cores),
-        times(b.speedup?),
-        interval(b.speedup_ci),
-        super::numbers::sig(e)
-    ))
-}
-
-/// The paper's published speedups beside ours, where comparable.
-fn against_paper(
-    rows: &[SummaryRow],
-    g: &Group,
-    bests: &[(StrategyName, Vec<Best>)],
-) -> Option<String> {
-    if !paper::comparable(g) {
-        return None;
-    }
-    let mut parts = Vec::new();
-    for c in series::cores(rows, g) {
-        let Some(p) = paper::at(c) else { continue };
-        let best = bests
-            .iter()
-            .filter_map(|(s, b)| Some((s.as_str(), b.iter().find(|b| b.cores == c)?)))
-            .filter(|(_, b)| !b.contended)
-            .filter_map(|(s, b)| Some((s, b.speedup?, b.oversubscribed)))
-            .max_by(|a, b| a.1.total_cmp(&b.1));
-        if let Some((s, sp, over)) = best {
-            parts.push(format!(
-                "at {}{} the best here is {} ({s}) against the paper's {}",
-                series::cores_label(c),
-                if over {
-                    " (⚠ oversubscribed here)"
-                } else {
-                    ""
-                },
-                times(sp),
-                times(p.speedup)
-            ));
-        }
-    }
-    (!parts.is_empty()).then(|| {
-        format!(
-            "Against the paper's published speedups (its machine, its program): {}.",
-            parts.join("; ")
-        )
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::results::rows::tests::row;
+
+    fn sentences(rows: &[SummaryRow], g: &Group) -> Vec<String> {
+        findings(rows, g).iter().map(Finding::sentence).collect()
+    }
 
     fn with_ci(mut r: SummaryRow, low: f64, high: f64) -> SummaryRow {
         r.mean_ci_low_s = Some(low);
@@ -318,7 +448,7 @@ mod tests {
             with_ci(row(StrategyName::RayonChunks, 2, Some(10), 2.2), 2.0, 2.4),
             with_ci(row(StrategyName::RayonIter, 2, None, 2.3), 2.1, 2.5),
         ];
-        let f = findings(&rows, &rows[0].group());
+        let f = sentences(&rows, &rows[0].group());
         assert!(
             f[0].contains("indistinguishable within the trial spread") && !f[0].contains("fastest"),
             "{}",
@@ -333,7 +463,7 @@ mod tests {
             with_ci(row(StrategyName::RayonChunks, 2, Some(10), 2.2), 2.1, 2.3),
             with_ci(row(StrategyName::RayonIter, 2, None, 2.6), 2.5, 2.7),
         ];
-        let f = findings(&rows, &rows[0].group());
+        let f = sentences(&rows, &rows[0].group());
         assert!(
             f[0].starts_with(
                 "At 2 cores, **rayon-chunks with 10 chunks (2.20 s [2.10–2.30])** is fastest"
@@ -353,7 +483,7 @@ mod tests {
             with_ci(row(StrategyName::RayonChunks, 2, Some(10), 2.2), 2.1, 2.3),
             fast,
         ];
-        let f = findings(&rows, &rows[0].group());
+        let f = sentences(&rows, &rows[0].group());
         assert!(
             f[0].contains("only rayon-chunks") && f[0].contains("1 contended cell left out"),
             "{}",
@@ -368,7 +498,7 @@ mod tests {
             row(StrategyName::RayonChunks, 1, Some(10), 3.9),
             row(StrategyName::RayonChunks, 2, Some(10), 2.2),
         ];
-        let f = findings(&rows, &rows[0].group()).join("\n");
+        let f = sentences(&rows, &rows[0].group()).join("\n");
         assert!(f.contains("at 1 core is noise in the seq reference"), "{f}");
         assert!(f.contains("e = 0.100"), "{f}");
         assert!(!f.contains("no number of cores"), "{f}");
@@ -379,7 +509,7 @@ mod tests {
         let mut seq = row(StrategyName::Seq, 1, None, 4.0);
         seq.contended = Some(true);
         let rows = vec![seq, row(StrategyName::RayonChunks, 2, Some(10), 2.2)];
-        let f = findings(&rows, &rows[0].group()).join("\n");
+        let f = sentences(&rows, &rows[0].group()).join("\n");
         assert!(f.contains("The seq reference was contended"), "{f}");
         assert!(!f.contains("Karp–Flatt") && !f.contains("over seq"), "{f}");
         assert!(!f.contains("paper's"), "{f}");
@@ -391,7 +521,7 @@ mod tests {
             row(StrategyName::Seq, 1, None, 4.0),
             row(StrategyName::RayonIter, 2, None, 5.0),
         ];
-        let f = findings(&rows, &rows[0].group()).join("\n");
+        let f = sentences(&rows, &rows[0].group()).join("\n");
         assert!(!f.contains("Karp–Flatt"), "{f}");
     }
 }

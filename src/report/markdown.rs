@@ -280,8 +280,8 @@ fn group(md: &mut String, rows: &[SummaryRow], g: &Group, input: &Input<'_>) {
         table(md, s, &best, comparable && series::is_chunked(rows, g, s));
     }
     let _ = writeln!(md, "### Findings\n");
-    for sentence in super::findings::findings(rows, g) {
-        let _ = writeln!(md, "- {sentence}");
+    for finding in super::findings::findings(rows, g) {
+        let _ = writeln!(md, "- {}", finding.sentence());
     }
     md.push('\n');
     group_charts(md, g, input);
@@ -364,7 +364,8 @@ fn group_charts(md: &mut String, g: &Group, input: &Input<'_>) {
     }
 }
 
-// Over ~60 lines on purpose: the table with and without the paper's columns, row by row; the two layouts share every row.
+// Over ~60 lines on purpose: the table with and without the paper's columns, row by row; the two
+// layouts share every row.
 fn table(md: &mut String, strategy: StrategyName, best: &[Best], with_paper: bool) {
     let _ = writeln!(md, "**{strategy}**\n");
     if with_paper {

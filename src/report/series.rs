@@ -363,7 +363,8 @@ pub fn efficiency_lines(rows: &[SummaryRow], group: &Group) -> (Vec<Line>, Vec<L
 
 /// For chart 6: per neighbour mode of `preset`, seconds per step against N for `seq` and for
 /// the fastest cell of any other strategy. `None` unless both modes are present.
-// Over ~60 lines on purpose: one pass per (mode, steps) pair builds both lines; split, the two would have to share the per-step point closure.
+// Over ~60 lines on purpose: one pass per (mode, steps) pair builds both lines; split, the two
+// would have to share the per-step point closure.
 pub fn neighbor_lines(rows: &[SummaryRow], preset: Preset) -> Option<Vec<Line>> {
     let gs: Vec<Group> = groups(rows)
         .into_iter()

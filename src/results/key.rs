@@ -99,7 +99,8 @@ impl Cell {
         }
     }
 
-    /// Particles in the largest of the `min(chunks, n)` balanced chunks: `ceil(n / min(chunks, n))`.
+    /// Particles in the largest of the `min(chunks, n)` balanced chunks:
+    /// `ceil(n / min(chunks, n))`.
     pub fn particles_per_chunk(&self) -> Option<usize> {
         let n = self.group.n;
         self.chunks.map(|k| n.div_ceil(k.min(n)))
@@ -110,9 +111,9 @@ impl Cell {
         self.cores > hardware_threads
     }
 
-    /// The text that seeds the cell's bootstrap streams ([`crate::sweep::bootstrap::rng_for`]): frozen,
-    /// so that a display change never changes a results file (`rayon-chunks, 2 cores, 10
-    /// chunks`, `seq, 1 core`).
+    /// The text that seeds the cell's bootstrap streams (the sweep's `bootstrap::rng_for`),
+    /// frozen so that a display change never changes a results file (`rayon-chunks, 2 cores,
+    /// 10 chunks`, `seq, 1 core`).
     pub fn stream_key(&self) -> String {
         let cores = if self.cores == 1 { "core" } else { "cores" };
         match self.chunks {

@@ -1,6 +1,7 @@
 //! Reading results directories leniently (`bench-sph report`): `meta.json`, `summary.csv` and
-//! `trials.csv` into the schema's types ([`Meta`], [`SummaryRow`], [`TrialRow`]), with errors that name the file and the
-//! line, and every cell checked before it can become a number in the report.
+//! `trials.csv` into the schema's types ([`Meta`], [`SummaryRow`], [`TrialRow`]), with errors
+//! that name the file and the line, and every cell checked before it can become a number in
+//! the report.
 //!
 //! - Files of this version and of the first release (before the contention and interval
 //!   columns) are read; the missing columns are empty.

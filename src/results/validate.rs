@@ -15,7 +15,8 @@ use crate::limits;
 const TOLERANCE: f64 = 1e-9;
 
 /// Why the cell cannot be believed, or `Ok`.
-// Over ~60 lines on purpose: one flat list of independent checks, each with its own message, read top to bottom.
+// Over ~60 lines on purpose: one flat list of independent checks, each with its own message, read
+// top to bottom.
 pub fn cell(summary: &SummaryRow, trials: &[TrialRow]) -> Result<(), String> {
     summary_alone(summary)?;
     if trials.len() != summary.trials {
@@ -89,7 +90,8 @@ pub fn cell(summary: &SummaryRow, trials: &[TrialRow]) -> Result<(), String> {
 
 /// The checks that need no trial rows: ranges, finite positive statistics, a consistent
 /// efficiency and interval.
-// Over ~60 lines on purpose: one flat list of independent checks, each with its own message, read top to bottom.
+// Over ~60 lines on purpose: one flat list of independent checks, each with its own message, read
+// top to bottom.
 pub fn summary_alone(row: &SummaryRow) -> Result<(), String> {
     limits::check("cores", row.cores, 1, limits::MAX_CORES).map_err(|e| e.to_string())?;
     limits::check("n", row.n, 1, limits::MAX_PARTICLES).map_err(|e| e.to_string())?;

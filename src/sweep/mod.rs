@@ -109,7 +109,8 @@ const BUSY_CHECK: Duration = Duration::from_millis(300);
 /// Runs a sweep: plan, measure, write. Returns the finished sweep, whose
 /// [`outcome`](Finished::outcome) is the error to end with when it was interrupted or a cell
 /// failed; errors here are those that stop it before or while it measures.
-// Over ~60 lines on purpose: the sweep's steps in the order they print (open, plan, busy check, estimate, measure, conclude), each a call; what is left is handing values between them.
+// Over ~60 lines on purpose: the sweep's steps in the order they print (open, plan, busy check,
+// estimate, measure, conclude), each a call; what is left is handing values between them.
 pub fn run(request: Request) -> anyhow::Result<Finished> {
     // From the start: a Ctrl-C during the plan or the estimate also ends the sweep as
     // interrupted (after the estimate), never as a killed "running" one.

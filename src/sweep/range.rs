@@ -160,7 +160,8 @@ pub fn parse(spec: &str, axis: Axis) -> Result<Vec<usize>, RangeError> {
 }
 
 /// Appends the values of one item to `out`.
-// Over ~60 lines on purpose: the grammar of one range item (`A`, `A..B`, `A..B:S`) with an error message per way it can be wrong.
+// Over ~60 lines on purpose: the grammar of one range item (`A`, `A..B`, `A..B:S`) with an error
+// message per way it can be wrong.
 fn expand_item(item: &str, axis: Axis, out: &mut Vec<usize>) -> Result<(), RangeError> {
     if item.is_empty() {
         return Err(RangeError::Empty);

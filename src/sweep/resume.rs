@@ -7,7 +7,8 @@
 //! back without it, and the cell runs again. Failed cells are finished too: their failure is a
 //! result (delete their rows by hand to retry them).
 //!
-//! A finished cell is believed only if it passes [`crate::results::validate::cell`] (finite positive
+//! A finished cell is believed only if it passes [`crate::results::validate::cell`] (finite
+//! positive
 //! times, statistics that are those of its trials) and the caller's own check (`--resume`:
 //! the cell is in the plan and has the sweep's number of trials); otherwise it is dropped,
 //! listed in [`Repaired::rejected`], and runs again.
@@ -57,7 +58,8 @@ pub struct Repaired {
 
 /// Repairs the contents of `trials.csv` and `summary.csv` (either may be empty: no file);
 /// `check` is the caller's own test of a finished cell (see the module docs).
-// Over ~60 lines on purpose: the repair is one pass over the rows whose steps (first row per cell, trials once per number, finished = complete and believed) are the module docs' list in order.
+// Over ~60 lines on purpose: the repair is one pass over the rows whose steps (first row per cell,
+// trials once per number, finished = complete and believed) are the module docs' list in order.
 pub fn repair(
     trials: &[u8],
     summary: &[u8],

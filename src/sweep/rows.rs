@@ -67,7 +67,8 @@ pub struct CellContext<'a> {
 
 /// The summary row of a cell, against `ctx`; a failed cell has no statistics, speedup or
 /// intervals.
-// Over ~60 lines on purpose: most of it is one struct literal, every column of summary.csv in order.
+// Over ~60 lines on purpose: most of it is one struct literal, every column of summary.csv in
+// order.
 pub fn summary_row(
     cell: &Cell,
     measured: &[Measured],

@@ -4,7 +4,8 @@
 //! A traced run ([`session::run_traced`]) drives the same step loop as an untraced one, with
 //! hooks that run each phase on the strategy's own executor wrapped in a [`TracingExecutor`],
 //! which reads a monotonic clock around every kernel call and records one [`KernelEvent`] per
-//! call — per chunk for the chunked strategies, per task for `rayon-spawn`, per leaf for `rayon-iter`,
+//! call — per chunk for the chunked strategies, per task for `rayon-spawn`, per leaf for
+//! `rayon-iter`,
 //! per block for `std-static` — never per particle. The wrapper changes neither the chunks
 //! nor the threads, and untraced runs never see it, so they pay nothing. The calling thread's
 //! serial work between passes (grid rebuild, divergence check) is recorded too.

@@ -16,9 +16,10 @@ pub const MAX_EVENTS: usize = 1_000_000;
 /// refusal message.
 pub const JSON_BYTES_PER_EVENT: usize = 170;
 
-/// The leaves per worker that the estimate assumes for `rayon-iter` (the one strategy whose
-/// splitting the runtime decides, [`Calls::Adaptive`]), which rayon decides at run time: a few per thread on an idle pool, more after steals (observed: 5 per
-/// core per pass at 2 cores, 100 to 165 at 8 cores on 2 hardware threads), never more than N.
+/// The leaves per worker that the estimate assumes for `rayon-iter`, the one strategy whose
+/// splitting rayon decides at run time ([`Calls::Adaptive`]): a few per thread on an idle
+/// pool, more after steals (observed: 5 per core per pass at 2 cores, 100 to 165 at 8 cores
+/// on 2 hardware threads), never more than N.
 /// A run that records more than [`MAX_EVENTS`] anyway is refused before it writes
 /// ([`check_recorded`]).
 pub const RAYON_ITER_LEAVES_PER_CORE: usize = 128;

@@ -98,7 +98,7 @@ struct Sleepers {
 /// that is slow to notice a pass — asleep, or descheduled because another process wants its
 /// core — simply skips it, instead of holding every pass up until the scheduler runs it
 /// again. A job must therefore *help until done*: any one call finishes whatever work nobody
-/// else has taken (the pool's job pulls chunks from a counter until none is left), so the
+/// else has taken (the pool's job pops chunks from a queue until none is left), so the
 /// work is complete once the dispatcher's call has returned and everyone who joined has left.
 ///
 /// **Waiting.** A waiting thread first watches an atomic hint, spinning briefly and then

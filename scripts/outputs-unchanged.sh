@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# Proves a refactor left every output byte-identical: runs the same deterministic commands
+# with the binary built at BASE (a git revision, default HEAD~1) and with the working tree's,
+# then diffs the two output trees.
+#
+# Usage: scripts/outputs-unchanged.sh [BASE]
+#   BASE_BIN=path  use this binary for BASE instead of building it (in target/outputs-base/).
+#
+# The commands: the committed report regenerated from the committed results (traces included),
+# two sweeps under the hidden --fake-timings/--fake-contention (one contended, one
+# oversubscribed cell) and their report, simulate --json/--dump on three strategies and from
+# an --init file, render to a GIF and to PNG frames, list, two errors. Left out of the diff:
+# what a run measures (simulate's wall and CPU times; the sweeps' are fake), dates, the commit in build lines, the
+# sweep's time estimate and its lock file's PID. Exit status 0 when the trees are identical.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BASE="${1:-HEAD~1}"
+work=$(mktemp -d)
+trap 'git worktree remove --force "$work/base-src" >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
+
+cargo build --release --quiet
+NEW="$PWD/target/release/bench-sph"
+if [ -z "${BASE_BIN:-}" ]; then
+    git worktree add --quiet --detach "$work/base-src" "$BASE"
+    CARGO_TARGET_DIR="$PWD/target/outputs-base" cargo build --release --quiet \
+        --manifest-path "$work/base-src/Cargo.toml"
+    BASE_BIN="$PWD/target/outputs-base/release/bench-sph"
+fi
+
+# Runs every command with binary $1 in directory $2 (relative paths only, so the trees compare).
+outputs() {
+    local bin="$work/bin/bench-sph" out=$2 repo=$PWD
+    # The same path for both binaries: meta.json and REPORT.md show the command line.
+    mkdir -p "$work/bin" && cp "$1" "$bin"
+    mkdir -p "$out" && cd "$out"
+    ln -s "$repo/results" results
+    mkdir report && cp -r "$repo"/report/trace-* report/
+    { "$bin" report results/paper results/grid results/all-pairs-small --out report; echo "rc=$?"; } > report.stdout 2>&1
+    { "$bin" sweep --preset seed --neighbors grid,all-pairs --n 200,300 --steps 5 --cores 1..3 \
+        --chunks 2,7 --trials 3 --warmup 0 --seed 7 --fake-timings 1.0:1.1,0.5:0.9,0.6,0.7:1.3,0.4 \
+        --fake-contention 0,0,0,0.6,0 --out sw1; echo "rc=$?"; } > sw1.stdout 2>&1
+    { "$bin" sweep --preset cpp --n 100 --steps 3 --cores 1,2 --chunks 3 --trials 2 --warmup 0 \
+        --strategies rayon-chunks,std-static --fake-timings 0.3,0.2 --out sw2; echo "rc=$?"; } > sw2.stdout 2>&1
+    { "$bin" report sw1 sw2 --out rep12; echo "rc=$?"; } > rep12.stdout 2>&1
+    local timed='s/"(wall_s|cpu_s|particle_steps_per_s)":[^,}]*/"\1":X/g'
+    for s in seq rayon-chunks crossbeam-pool; do
+        "$bin" simulate --n 300 --steps 20 --strategy "$s" --cores 2 --json --dump "dump-$s.csv" \
+            | sed -E "$timed" > "sim-$s.json"
+    done
+    "$bin" simulate --init dump-seq.csv --steps 5 --json | sed -E "$timed" > sim-init.json
+    "$bin" render --n 300 --steps 40 --every 10 --out anim.gif > render.stdout 2>&1
+    "$bin" render --n 300 --steps 20 --every 10 --frames frames > frames.stdout 2>&1
+    "$bin" list > list.txt
+    { "$bin" simulate --n 0; echo "rc=$?"; } > err1.txt 2>&1 || true
+    { "$bin" simulate --n 100 --steps 200000000000; echo "rc=$?"; } > err2.txt 2>&1 || true
+    rm -f sw1/sweep.lock sw2/sweep.lock results
+    # What a run measures, when it ran and which build ran it.
+    find . -name meta.json -exec sed -i -E \
+        's/"(started|finished)[a-z_]*": "[^"]*"/"\1": "X"/g; s/"(git_commit|git_dirty)": [^,]*/"\1": X/g' {} +
+    sed -i -E 's/\(build [0-9a-f]+(-dirty)?\)/(build X)/; s/commit [0-9a-f]{40}(, with uncommitted changes)?/commit X/g; s/[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:]+Z/TIME/g' */REPORT.md
+    sed -i -E 's/[0-9.]+ s in all, [0-9.]+ s of it simulating/T/; s/seq ≈ [0-9.]+ ms/seq ≈ X ms/; s/estimated time: about [0-9.]+ [a-z]+/estimated time: X/' ./*.stdout
+    cd "$repo"
+}
+
+outputs "$BASE_BIN" "$work/base"
+outputs "$NEW" "$work/new"
+if diff -r "$work/base" "$work/new"; then
+    echo "outputs unchanged ($BASE → working tree)"
+else
+    echo "outputs differ ($BASE → working tree): see the diff above" >&2
+    exit 1
+fi
