@@ -438,14 +438,8 @@ fn ctrl_c_keeps_the_finished_cells_and_exits_with_an_error_naming_resume() {
         .is_ok_and(|s| s.success());
     let out = child.wait_with_output().unwrap();
     if still_running && sent {
-        let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success());
-        assert!(
-            err.contains("Error: interrupted") && err.contains("--resume"),
-            "{err}"
-        );
-        let meta = std::fs::read_to_string(dir.join("meta.json")).unwrap();
-        assert!(meta.contains("\"status\": \"interrupted\""), "{meta}");
+        common::assert_interrupted(&dir, &common::text(&out.stderr));
     }
     let cells = rows(&dir.join("summary.csv")).len();
     assert_one_row_per_trial(&dir, 2, cells);

@@ -1,8 +1,7 @@
 //! Every strategy gives the sequential run's bits, whatever the cores and chunks, and a panic
 //! inside a kernel becomes an error of the run (never a hang) on every strategy.
 
-use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use bench_sph::run::run_timed;
 use bench_sph::scene::dam_break;
@@ -11,6 +10,8 @@ use bench_sph::sph::neighbors::NeighborMode;
 use bench_sph::sph::params::Preset;
 use bench_sph::sph::state::{FIELD_NAMES, State};
 use sph_strategies::{Config, StrategyName};
+
+mod common;
 
 const N: usize = 500;
 const STEPS: usize = 25;
@@ -92,35 +93,24 @@ fn more_cores_and_chunks_than_particles_still_match_the_sequential_run() {
 #[test]
 fn a_kernel_panic_on_a_worker_is_an_error_of_the_run_for_every_strategy() {
     for &strategy in StrategyName::ALL {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_bench-sph"))
-            .args([
-                "simulate",
-                "--strategy",
-                strategy.as_str(),
-                "--cores",
-                "2",
-                "--chunks",
-                "7",
-            ])
-            .args(["--n", "200", "--steps", "50", "--inject-panic-at", "150"])
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .expect("binary starts");
-        let started = Instant::now();
-        let status = loop {
-            if let Some(status) = child.try_wait().expect("wait") {
-                break status;
-            }
-            if started.elapsed() > Duration::from_secs(60) {
-                child.kill().ok();
-                panic!("{strategy}: still running after a kernel panic (hang)");
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        };
-        let mut err = String::new();
-        std::io::Read::read_to_string(&mut child.stderr.take().unwrap(), &mut err).unwrap();
-        assert!(!status.success(), "{strategy}: exited successfully");
+        let mut cmd = common::bench_sph();
+        cmd.args([
+            "simulate",
+            "--strategy",
+            strategy.as_str(),
+            "--cores",
+            "2",
+            "--chunks",
+            "7",
+        ])
+        .args(["--n", "200", "--steps", "50", "--inject-panic-at", "150"]);
+        // A hang is killed after a minute (a bound, not a timing) and then fails below.
+        let o = assert_cmd::Command::from_std(cmd)
+            .timeout(Duration::from_secs(60))
+            .output()
+            .expect("binary runs");
+        let err = common::text(&o.stderr);
+        assert!(!o.status.success(), "{strategy}: exited successfully");
         assert!(
             err.contains("Error: step 1 failed") && err.contains("injected fault at particle 150"),
             "{strategy}: {err}"

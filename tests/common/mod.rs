@@ -214,6 +214,17 @@ pub fn rows(path: &Path) -> Vec<Row> {
         .collect()
 }
 
+/// Checks that a sweep into `dir` stopped as interrupted: its standard error `err` says so and
+/// how to resume, and its `meta.json` records the status.
+pub fn assert_interrupted(dir: &Path, err: &str) {
+    assert!(
+        err.contains("Error: interrupted") && err.contains("--resume"),
+        "{err}"
+    );
+    let meta = std::fs::read_to_string(dir.join("meta.json")).unwrap();
+    assert!(meta.contains("\"status\": \"interrupted\""), "{meta}");
+}
+
 /// Fails the test if the command panicked.
 pub fn no_panic(o: &Output) {
     let err = text(&o.stderr);
