@@ -8,10 +8,11 @@
 #
 # The commands: the committed report regenerated from the committed results (traces included),
 # two sweeps under the hidden --fake-timings/--fake-contention (one contended, one
-# oversubscribed cell) and their report, simulate --json/--dump on three strategies and from
-# an --init file, render to a GIF and to PNG frames, list, two errors. Left out of the diff:
-# what a run measures (simulate's wall and CPU times; the sweeps' are fake), dates, the commit in build lines, the
-# sweep's time estimate and its lock file's PID. Exit status 0 when the trees are identical.
+# oversubscribed cell) and their report, a third interrupted and resumed, simulate
+# --json/--dump on three strategies and from an --init file, render to a GIF and to PNG
+# frames, list, two errors. Left out of the diff: what a run measures (simulate's wall and CPU
+# times; the sweeps' are fake), dates, the commit in build lines, the sweep's time estimate and
+# its lock file's PID. Exit status 0 when the trees are identical.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BASE="${1:-HEAD~1}"
@@ -30,6 +31,7 @@ fi
 # Runs every command with binary $1 in directory $2 (relative paths only, so the trees compare).
 outputs() {
     local bin="$work/bin/bench-sph" out=$2 repo=$PWD
+    set +e # commands that fail on purpose record their exit status instead
     # The same path for both binaries: meta.json and REPORT.md show the command line.
     mkdir -p "$work/bin" && cp "$1" "$bin"
     mkdir -p "$out" && cd "$out"
@@ -42,6 +44,11 @@ outputs() {
     { "$bin" sweep --preset cpp --n 100 --steps 3 --cores 1,2 --chunks 3 --trials 2 --warmup 0 \
         --strategies rayon-chunks,std-static --fake-timings 0.3,0.2 --out sw2; echo "rc=$?"; } > sw2.stdout 2>&1
     { "$bin" report sw1 sw2 --out rep12; echo "rc=$?"; } > rep12.stdout 2>&1
+    # A sweep stopped as if by Ctrl-C after 2 cells, then resumed (with its charts).
+    { "$bin" sweep --n 100 --steps 2 --cores 1,2 --chunks 2 --trials 2 --warmup 0 \
+        --strategies rayon-chunks,std-static --fake-timings 0.3,0.2 --stop-after-cells 2 \
+        --no-plots --out sw3; echo "rc=$?"; } > sw3.stdout 2>&1
+    { "$bin" sweep --resume sw3; echo "rc=$?"; } > sw3-resume.stdout 2>&1
     local timed='s/"(wall_s|cpu_s|particle_steps_per_s)":[^,}]*/"\1":X/g'
     for s in seq rayon-chunks crossbeam-pool; do
         "$bin" simulate --n 300 --steps 20 --strategy "$s" --cores 2 --json --dump "dump-$s.csv" \
@@ -51,15 +58,16 @@ outputs() {
     "$bin" render --n 300 --steps 40 --every 10 --out anim.gif > render.stdout 2>&1
     "$bin" render --n 300 --steps 20 --every 10 --frames frames > frames.stdout 2>&1
     "$bin" list > list.txt
-    { "$bin" simulate --n 0; echo "rc=$?"; } > err1.txt 2>&1 || true
-    { "$bin" simulate --n 100 --steps 200000000000; echo "rc=$?"; } > err2.txt 2>&1 || true
-    rm -f sw1/sweep.lock sw2/sweep.lock results
+    { "$bin" simulate --n 0; echo "rc=$?"; } > err1.txt 2>&1
+    { "$bin" simulate --n 100 --steps 200000000000; echo "rc=$?"; } > err2.txt 2>&1
+    rm -f sw1/sweep.lock sw2/sweep.lock sw3/sweep.lock results
     # What a run measures, when it ran and which build ran it.
     find . -name meta.json -exec sed -i -E \
         's/"(started|finished)[a-z_]*": "[^"]*"/"\1": "X"/g; s/"(git_commit|git_dirty)": [^,]*/"\1": X/g' {} +
     sed -i -E 's/\(build [0-9a-f]+(-dirty)?\)/(build X)/; s/commit [0-9a-f]{40}(, with uncommitted changes)?/commit X/g; s/[0-9]{4}-[0-9]{2}-[0-9]{2}T[0-9:]+Z/TIME/g' */REPORT.md
     sed -i -E 's/[0-9.]+ s in all, [0-9.]+ s of it simulating/T/; s/seq ≈ [0-9.]+ ms/seq ≈ X ms/; s/estimated time: about [0-9.]+ [a-z]+/estimated time: X/' ./*.stdout
     cd "$repo"
+    set -e
 }
 
 outputs "$BASE_BIN" "$work/base"
