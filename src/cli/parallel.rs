@@ -22,17 +22,23 @@ pub struct ParallelArgs {
 /// Gives `--strategy` the help text `help` (for `Command::mut_args`, which edits the option
 /// in place: `mut_arg` would move it last and so reorder the usage line and its errors).
 pub(super) fn strategy_help(help: &'static str) -> impl FnMut(Arg) -> Arg {
-    move |arg| match arg.get_id() == "strategy" {
-        true => arg.help(help),
-        false => arg,
+    move |arg| {
+        if arg.get_id() == "strategy" {
+            arg.help(help)
+        } else {
+            arg
+        }
     }
 }
 
 /// [`strategy_help`], and `--strategy` must be given: it has no default.
 pub(super) fn strategy_required(help: &'static str) -> impl FnMut(Arg) -> Arg {
-    move |arg| match arg.get_id() == "strategy" {
-        true => arg.help(help).required(true).default_value(None),
-        false => arg,
+    move |arg| {
+        if arg.get_id() == "strategy" {
+            arg.help(help).required(true).default_value(None)
+        } else {
+            arg
+        }
     }
 }
 
