@@ -7,6 +7,8 @@
 //! | `--chunks` | 1 ..= [`MAX_CHUNKS`] | a pass makes min(K, N) chunks, so more than N never changes anything |
 //! | `--n` | 1 ..= [`MAX_PARTICLES`], and within the machine's memory | see [`crate::scene::memory`] for the per-particle estimate |
 //! | `--steps` | 1 ..= [`MAX_STEPS`] | |
+//! | `--resolution` (`wcsph`) | 4 ..= 400 ([`crate::sph::wcsph::params::RESOLUTIONS`]) | below 4 the column has no interior; 400 is 320 000 fluid particles |
+//! | `--t-end` | 0 < t ≤ [`MAX_T_END_S`] s | the dam break is over (Martin & Moyce's data ends) within 2.5 s |
 //! | `--trials` | 1 ..= [`MAX_TRIALS`] | |
 //! | `--warmup` | 0 ..= [`MAX_WARMUP`] | |
 //! | a sweep's cells | at most [`MAX_CELLS`] | the product of its lists |
@@ -19,6 +21,8 @@ pub const MAX_CHUNKS: usize = 10_000_000;
 pub const MAX_PARTICLES: usize = 100_000_000;
 /// The most steps of one run.
 pub const MAX_STEPS: usize = 1_000_000_000;
+/// The longest simulated time `--t-end` accepts, s.
+pub const MAX_T_END_S: f64 = 100.0;
 /// The most timed trials per cell of a sweep.
 pub const MAX_TRIALS: usize = 1000;
 /// The most untimed warm-up runs per cell of a sweep.

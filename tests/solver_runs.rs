@@ -2,7 +2,7 @@
 //! and inside the walls, and a diverging run stops with an error naming step and particle.
 
 use bench_sph::run::{RunError, run_timed};
-use bench_sph::scene::dam_break;
+use bench_sph::scene::{Scene, dam_break};
 use bench_sph::solver::{Simulation, StepError};
 use bench_sph::sph::neighbors::NeighborMode;
 use bench_sph::sph::params::Preset;
@@ -15,12 +15,7 @@ const SEQ: Config = Config {
 };
 
 fn run(preset: Preset, n: usize, steps: usize, mode: NeighborMode) -> State {
-    let mut sim = Simulation::new(
-        preset.params(),
-        dam_break::domain(preset, n),
-        dam_break::initial_state(preset, n, 2019),
-        mode,
-    );
+    let mut sim = Scene::dam_break(preset, n, 2019).unwrap().simulate(mode);
     run_timed(&mut sim, StrategyName::Seq, &SEQ, steps).expect("run completes");
     sim.state
 }
@@ -43,7 +38,7 @@ fn max_relative_gap(a: &State, b: &State) -> Vec<(&'static str, f64)> {
 }
 
 #[test]
-fn grid_agrees_with_all_pairs_to_1e_9_after_10_steps_for_both_presets() {
+fn grid_agrees_with_all_pairs_to_1e_9_after_10_steps_for_every_preset() {
     for preset in Preset::ALL {
         let all_pairs = run(preset, 1000, 10, NeighborMode::AllPairs);
         let grid = run(preset, 1000, 10, NeighborMode::Grid);

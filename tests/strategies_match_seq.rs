@@ -4,7 +4,7 @@
 use std::time::Duration;
 
 use bench_sph::run::run_timed;
-use bench_sph::scene::dam_break;
+use bench_sph::scene::{Scene, dam_break};
 use bench_sph::solver::Simulation;
 use bench_sph::sph::neighbors::NeighborMode;
 use bench_sph::sph::params::Preset;
@@ -23,12 +23,7 @@ fn run(
     cores: usize,
     chunks: usize,
 ) -> State {
-    let mut sim = Simulation::new(
-        preset.params(),
-        dam_break::domain(preset, N),
-        dam_break::initial_state(preset, N, 7),
-        mode,
-    );
+    let mut sim = Scene::dam_break(preset, N, 7).unwrap().simulate(mode);
     run_timed(&mut sim, strategy, &Config { cores, chunks }, STEPS)
         .unwrap_or_else(|e| panic!("{strategy} cores={cores} chunks={chunks}: {e}"));
     sim.state

@@ -155,6 +155,24 @@ fn particles(s: &str) -> Result<usize, String> {
     count(s, "particles", limits::MAX_PARTICLES)
 }
 
+/// A `wcsph` resolution R = a/dx: within [`RESOLUTIONS`](crate::sph::wcsph::params::RESOLUTIONS).
+fn resolution(s: &str) -> Result<usize, String> {
+    let range = crate::sph::wcsph::params::RESOLUTIONS;
+    let v = positive(s)?;
+    limits::check("resolution", v, *range.start(), *range.end()).map_err(|e| e.to_string())
+}
+
+/// A simulated time in seconds: 0 < t ≤ [`limits::MAX_T_END_S`].
+fn t_end(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(t) if t > 0.0 && t <= limits::MAX_T_END_S => Ok(t),
+        _ => Err(format!(
+            "'{s}' is not a time in seconds above 0 and at most {}",
+            limits::MAX_T_END_S
+        )),
+    }
+}
+
 /// Timed trials per cell: 1 ..= [`limits::MAX_TRIALS`].
 fn trials(s: &str) -> Result<usize, String> {
     count(s, "trials", limits::MAX_TRIALS)
@@ -199,5 +217,10 @@ mod tests {
         assert!(cores("99999999999999999999999").is_err());
         assert!(particles("100000001").is_err());
         assert!(chunks("0").is_err() && steps("1000000001").is_err());
+        assert!(resolution("3").is_err() && resolution("401").is_err());
+        assert_eq!(resolution("40"), Ok(40));
+        assert!(t_end("0").is_err() && t_end("-1").is_err() && t_end("NaN").is_err());
+        assert!(t_end("inf").is_err() && t_end("100.5").is_err());
+        assert_eq!(t_end("0.77"), Ok(0.77));
     }
 }

@@ -69,8 +69,11 @@ pub struct RenderArgs {
 
 /// Runs `render`.
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
-    let (state, domain) = args.scene.initial_state()?;
-    let params = args.scene.preset.params();
+    let scene = args.scene.scene()?;
+    let crate::sph::physics::Physics::Mueller(params) = scene.physics else {
+        anyhow::bail!("render does not draw --preset wcsph yet");
+    };
+    let (state, domain) = (scene.state, scene.domain);
     let scale = Scale::new(args.color, &params, &state);
     let painter = Painter::new(domain, params.h, scale, args.width);
     let (width, height) = (painter.layout().width, painter.layout().height);
@@ -100,6 +103,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         total: (frames - 1) * args.every,
         every: args.every,
         warmup: 0,
+        until_s: None,
     };
     // All frames in one session: one thread pool for the whole animation.
     let outcome = run_steps(

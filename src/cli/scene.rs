@@ -8,10 +8,9 @@ use clap::parser::ValueSource;
 use clap::{ArgMatches, Args, FromArgMatches};
 
 use crate::io::init_csv;
-use crate::scene::{dam_break, memory};
+use crate::scene::{Scene, dam_break, memory, tank};
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
-use crate::sph::state::{Domain, State};
 
 /// Which scene to simulate, and with which neighbour search.
 #[derive(Debug, Clone)]
@@ -22,6 +21,8 @@ pub struct SceneArgs {
     pub preset_given: bool,
     /// Number of particles (`None`: 1000, or the row count of `--init`).
     pub n: Option<usize>,
+    /// `wcsph` only: the resolution R = a/dx.
+    pub resolution: Option<usize>,
     /// Neighbour search.
     pub neighbors: NeighborMode,
     /// Seed of the initial jitter.
@@ -36,9 +37,14 @@ struct SceneOptions {
     /// Constants and integration order to reproduce.
     #[arg(long, default_value = "seed", value_parser = super::values::preset())]
     preset: Preset,
-    /// Number of particles [default: 1000, or the row count of --init].
+    /// Number of particles [default: 1000, or the row count of --init]. With --preset wcsph,
+    /// the fluid particles: the resolution R with 2R² nearest N is used, and said.
     #[arg(long, value_parser = super::particles)]
     n: Option<usize>,
+    /// --preset wcsph only: particles across the water column's width a (4..=400; 2R² fluid
+    /// particles) [default: from --n, else 22].
+    #[arg(long, value_name = "R", value_parser = super::resolution, conflicts_with_all = ["n", "init"])]
+    resolution: Option<usize>,
     /// Neighbour search.
     #[arg(long, default_value = "all-pairs", value_parser = super::values::neighbors())]
     neighbors: NeighborMode,
@@ -58,6 +64,7 @@ impl FromArgMatches for SceneArgs {
             preset: o.preset,
             preset_given: matches.value_source("preset") == Some(ValueSource::CommandLine),
             n: o.n,
+            resolution: o.resolution,
             neighbors: o.neighbors,
             seed: o.seed,
             init: o.init,
@@ -90,23 +97,69 @@ pub(super) fn memory_available() -> Option<u64> {
 }
 
 impl SceneArgs {
+    /// The `wcsph` resolution these options ask for: `--resolution`, else the one nearest
+    /// `--n` (default 1000); `None` for the other presets.
+    pub fn wcsph_resolution(&self) -> Option<usize> {
+        (self.preset == Preset::Wcsph).then(|| {
+            self.resolution
+                .unwrap_or_else(|| tank::resolution_for(self.n.unwrap_or(1000)))
+        })
+    }
+
+    /// A line saying which resolution `wcsph` runs at and why, when it is not the one given
+    /// with `--resolution` (the commands print it on standard error).
+    pub fn resolution_note(&self) -> Option<String> {
+        let r = self.wcsph_resolution()?;
+        let asked = self.n.filter(|_| self.resolution.is_none())?;
+        let fluid = tank::dam_break_particles(r);
+        (asked != fluid).then(|| {
+            format!(
+                "note: --preset wcsph runs at resolution R = {r} ({fluid} fluid particles), \
+                 the nearest to --n {asked}"
+            )
+        })
+    }
+
     /// The initial state and its tank, from `--init` or the preset's dam break of `--n`
-    /// particles (default 1000) jittered with `--seed`. Refuses, before allocating the
-    /// simulation, a run larger than the machine's memory ([`memory::check`]), and an init
-    /// file dumped with another preset unless `--preset` was given.
-    pub fn initial_state(&self) -> anyhow::Result<(State, Domain)> {
+    /// particles (default 1000) jittered with `--seed` (for `wcsph`, at `--resolution`).
+    /// Refuses, before allocating the simulation, a run larger than the machine's memory
+    /// ([`memory::check`]), an init file dumped with another preset unless `--preset` was
+    /// given, and `--resolution` without `--preset wcsph`.
+    pub fn scene(&self) -> anyhow::Result<Scene> {
+        if self.resolution.is_some() && self.preset != Preset::Wcsph {
+            anyhow::bail!(
+                "--resolution applies to --preset wcsph only; --preset {} takes --n",
+                self.preset
+            );
+        }
+        if let (Some(path), Preset::Wcsph) = (&self.init, self.preset) {
+            anyhow::bail!(
+                "--init '{}' cannot start --preset wcsph: its walls and hydrostatic densities \
+                 come from --resolution",
+                path.display()
+            );
+        }
         let Some(path) = &self.init else {
-            let n = self.n.unwrap_or(1000);
+            let n = match self.wcsph_resolution() {
+                Some(r) => tank::dam_break_particles(r),
+                None => self.n.unwrap_or(1000),
+            };
             memory::check(self.preset, self.neighbors, n, memory_available())?;
-            let state = dam_break::try_initial_state(self.preset, n, self.seed)
-                .with_context(|| format!("no memory for {n} particles"))?;
-            return Ok((state, dam_break::domain(self.preset, n)));
+            return Scene::dam_break(self.preset, n, self.seed)
+                .with_context(|| format!("no memory for {n} particles"));
         };
         let rows = init_csv::read(path)?;
         let count = rows.state.len();
         if let Some(asked) = self.n.filter(|&asked| asked != count) {
             anyhow::bail!(
                 "--n {asked} conflicts with init file '{}', which holds {count} particles",
+                path.display()
+            );
+        }
+        if rows.dumped.is_some_and(|d| d.preset == Preset::Wcsph) {
+            anyhow::bail!(
+                "init file '{}' was dumped with --preset wcsph, whose runs start from \
+                 --resolution, not from a file",
                 path.display()
             );
         }
@@ -126,6 +179,10 @@ impl SceneArgs {
         memory::check(self.preset, self.neighbors, count, memory_available())?;
         let domain = dam_break::domain(self.preset, count);
         init_csv::check_walls(path, &rows, domain)?;
-        Ok((rows.state, domain))
+        Ok(Scene {
+            physics: self.preset.params().into(),
+            domain,
+            state: rows.state,
+        })
     }
 }

@@ -11,7 +11,8 @@ use crate::io::dump_csv::{self, DumpInfo};
 use crate::io::sink::Sink;
 use crate::output::console;
 use crate::run::fault::PanicAt;
-use crate::run::{RunError, run_timed, run_timed_with};
+use crate::limits;
+use crate::run::{RunError, Steps, run_timed_steps};
 use crate::solver::{Simulation, StepError};
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
@@ -25,6 +26,10 @@ pub struct SimulateArgs {
     /// Number of steps.
     #[arg(long, default_value_t = 1000, value_parser = super::steps)]
     pub steps: usize,
+    /// Run until this simulated time instead of a number of steps (s, 0 < T <= 100): stops
+    /// after the first step that reaches it (wcsph's time step adapts to the flow).
+    #[arg(long, value_name = "SECONDS", value_parser = super::t_end, conflicts_with = "steps")]
+    pub t_end: Option<f64>,
     /// How the passes run: strategy, worker threads, chunks.
     #[command(flatten)]
     pub parallel: super::parallel::ParallelArgs,
@@ -52,7 +57,13 @@ struct Report {
     seed: Option<u64>,
     init: Option<String>,
     n: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    resolution: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    walls: Option<usize>,
     steps: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    simulated_s: Option<f64>,
     wall_s: f64,
     cpu_s: f64,
     particle_steps_per_s: f64,
@@ -61,32 +72,30 @@ struct Report {
 
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
-    let (state, domain) = args.scene.initial_state()?;
-    let n = state.len();
+    let scene = args.scene.scene()?;
+    if let Some(note) = args.scene.resolution_note() {
+        console::warn(&note);
+    }
+    // Particles that move: particle-steps count these (wcsph's walls are fixed).
+    let n = scene.fluid();
+    let walls = scene.state.len() - n;
     // Open the dump before the run, so a bad path costs nothing. It is written to a
     // temporary file and renamed over FILE at the end: a failed or interrupted run leaves
     // FILE as it was.
     let mut dump = args.dump.as_deref().map(Sink::create).transpose()?;
     let config = args.parallel.config();
-    let mut sim = Simulation::new(
-        args.scene.preset.params(),
-        domain,
-        state,
-        args.scene.neighbors,
-    );
+    let mut sim = scene.simulate(args.scene.neighbors);
+    let steps = match args.t_end {
+        None => Steps::timed(args.steps),
+        Some(t) => Steps {
+            until_s: Some(t),
+            ..Steps::timed(limits::MAX_STEPS)
+        },
+    };
+    let strategy = args.parallel.strategy;
     let outcome = match args.inject_panic_at {
-        None => run_timed(&mut sim, args.parallel.strategy, &config, args.steps),
-        Some(particle) => {
-            let mut fault = PanicAt(particle);
-            run_timed_with(
-                &mut sim,
-                args.parallel.strategy,
-                &config,
-                args.steps,
-                0,
-                &mut fault,
-            )
-        }
+        None => run_timed_steps(&mut sim, strategy, &config, steps, &mut ()),
+        Some(particle) => run_timed_steps(&mut sim, strategy, &config, steps, &mut PanicAt(particle)),
     };
 
     let diverged = matches!(outcome, Err(RunError::Step(StepError::Diverged { .. })));
@@ -112,13 +121,18 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         strategy: info.name.to_owned(),
         cores: info.effective_cores(config.cores),
         chunks: info.effective_chunks(args.parallel.chunks),
-        seed: args.scene.init.is_none().then_some(args.scene.seed),
+        // wcsph has no jitter, so no seed.
+        seed: (args.scene.init.is_none() && args.scene.preset.is_mueller())
+            .then_some(args.scene.seed),
         init: args.scene.init.as_ref().map(|p| p.display().to_string()),
         n,
-        steps: args.steps,
+        resolution: args.scene.wcsph_resolution(),
+        walls: (walls > 0).then_some(walls),
+        steps: sim.steps_done,
+        simulated_s: args.t_end.map(|_| sim.time_s),
         wall_s: elapsed.wall_s,
         cpu_s: elapsed.cpu_s,
-        particle_steps_per_s: (n * args.steps) as f64 / elapsed.wall_s,
+        particle_steps_per_s: (n * sim.steps_done) as f64 / elapsed.wall_s,
         checksum: checksum_hex(&sim.state),
     };
     print_report(&report, args.json)
@@ -150,7 +164,12 @@ fn print_report(r: &Report, json: bool) -> anyhow::Result<()> {
         "preset {}, {} neighbours, strategy {} (cores {}, chunks {chunks})",
         r.preset, r.neighbors, r.strategy, r.cores
     ))?;
-    say(&format!("N = {} particles, {} steps", r.n, r.steps))?;
+    let walls = r.walls.map_or_else(String::new, |w| format!(" (+ {w} fixed wall particles)"));
+    let resolution = r.resolution.map_or_else(String::new, |r| format!(", resolution R = {r}"));
+    say(&format!("N = {} particles{walls}{resolution}, {} steps", r.n, r.steps))?;
+    if let Some(t) = r.simulated_s {
+        say(&format!("simulated time {t:.6} s"))?;
+    }
     say(&format!(
         "wall {:.3} s, CPU {:.3} s (user+sys), {:.3e} particle-steps/s",
         r.wall_s, r.cpu_s, r.particle_steps_per_s

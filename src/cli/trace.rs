@@ -81,28 +81,26 @@ struct Comparison {
 /// records, writes every file atomically (a failure leaves the directory as it was) and
 /// removes trace's own stale files.
 pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
-    let (state, domain) = args.scene.initial_state()?;
+    let scene = args.scene.scene()?;
+    if let Some(note) = args.scene.resolution_note() {
+        console::warn(&note);
+    }
     let strategy_config = args.parallel.config();
     let cores = strategy_config.cores;
     Plan {
         strategy: args.parallel.strategy,
-        n: state.len(),
+        // Every particle, walls included: the longest pass's length bounds its calls.
+        n: scene.state.len(),
         chunks: args.parallel.chunks,
         cores,
         steps: args.steps,
+        passes: Simulation::passes_of(&scene.physics).len(),
         neighbors: args.scene.neighbors,
     }
     .check()?;
     let (claimed, paths) = claim_out(args)?;
-    let config = trace_config(args, state.len(), cores);
-    let fresh = || {
-        Simulation::new(
-            args.scene.preset.params(),
-            domain,
-            state.clone(),
-            args.scene.neighbors,
-        )
-    };
+    let config = trace_config(args, scene.fluid(), cores);
+    let fresh = || scene.clone().simulate(args.scene.neighbors);
     let (sim, run, comparison) = record(args, &strategy_config, fresh)?;
 
     size::check_recorded(
@@ -172,7 +170,8 @@ fn trace_config(args: &TraceArgs, n: usize, cores: usize) -> TraceConfig {
         steps: args.steps,
         preset: args.scene.preset,
         neighbors: args.scene.neighbors,
-        seed: args.scene.init.is_none().then_some(args.scene.seed),
+        seed: (args.scene.init.is_none() && args.scene.preset.is_mueller())
+            .then_some(args.scene.seed),
         init: args.scene.init.as_ref().map(|p| p.display().to_string()),
     }
 }

@@ -20,6 +20,8 @@ enum PresetArg {
     Seed,
     /// The C++ original (`cerrno/mueller-sph` at e0821c49), evaluated in f64.
     Cpp,
+    /// Weakly compressible SPH in SI units, validated against Martin & Moyce (1952).
+    Wcsph,
 }
 
 impl From<PresetArg> for Preset {
@@ -27,6 +29,7 @@ impl From<PresetArg> for Preset {
         match arg {
             PresetArg::Seed => Preset::Seed,
             PresetArg::Cpp => Preset::Cpp,
+            PresetArg::Wcsph => Preset::Wcsph,
         }
     }
 }

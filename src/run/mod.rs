@@ -33,7 +33,7 @@ pub enum RunError {
 }
 
 /// How a run lays out its steps.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Steps {
     /// Steps to run (after the warm-up).
     pub total: usize,
@@ -43,6 +43,9 @@ pub struct Steps {
     /// the strategy's threads and leave the timed steps those of a run without warm-up. A
     /// copy that diverges only ends the warm-up; a kernel's panic is an error.
     pub warmup: usize,
+    /// Simulated time at which the run ends early, s: it stops after the first step that
+    /// reaches it (`total` then only caps the steps). `None`: run `total` steps.
+    pub until_s: Option<f64>,
 }
 
 impl Steps {
@@ -52,6 +55,7 @@ impl Steps {
             total,
             every: total,
             warmup: 0,
+            until_s: None,
         }
     }
 }
@@ -96,6 +100,7 @@ impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
             total,
             every,
             warmup,
+            until_s,
         } = self.steps;
         if warmup > 0 {
             match self.sim.clone().advance(exec, warmup) {
@@ -107,10 +112,14 @@ impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
         while done < total {
             let steps = every.max(1).min(total - done);
             let watch = Stopwatch::start();
-            self.sim.advance_with(exec, steps, self.hooks)?;
+            let ran = match until_s {
+                None => self.sim.advance_with(exec, steps, self.hooks).map(|()| steps),
+                Some(t) => self.sim.advance_until(exec, steps, t, self.hooks),
+            }?;
             let elapsed = watch.stop();
-            done += steps;
-            if self.observer.segment(self.sim, elapsed).is_break() {
+            done += ran;
+            let reached = until_s.is_some_and(|t| self.sim.time_s >= t);
+            if self.observer.segment(self.sim, elapsed).is_break() || reached {
                 break;
             }
         }
@@ -153,6 +162,22 @@ pub fn run_timed_with<H: StepHooks + Send>(
     let steps = Steps {
         warmup,
         ..Steps::timed(steps)
+    };
+    run_timed_steps(sim, strategy, config, steps, hooks)
+}
+
+/// Runs `steps` of `sim` with `strategy` as one timed segment (`steps.every` is ignored),
+/// each phase and check through `hooks`, and returns the time they took (zero for none).
+pub fn run_timed_steps<H: StepHooks + Send>(
+    sim: &mut Simulation,
+    strategy: StrategyName,
+    config: &Config,
+    steps: Steps,
+    hooks: &mut H,
+) -> Result<Elapsed, RunError> {
+    let steps = Steps {
+        every: steps.total,
+        ..steps
     };
     let mut last = LastSegment(None);
     run_steps(sim, strategy, config, steps, hooks, &mut last)?;
@@ -237,9 +262,8 @@ mod tests {
             run_timed(&mut whole, strategy, &CONFIG, 7).unwrap();
             let mut cut = sim(60);
             let steps = Steps {
-                total: 7,
                 every: 3,
-                warmup: 0,
+                ..Steps::timed(7)
             };
             let mut observer = seen(usize::MAX);
             run_steps(&mut cut, strategy, &CONFIG, steps, &mut (), &mut observer).unwrap();
@@ -254,12 +278,32 @@ mod tests {
     }
 
     #[test]
+    fn a_run_until_a_time_stops_after_the_first_step_that_reaches_it() {
+        let mut s = sim(40);
+        let dt = s.last_dt();
+        let steps = Steps {
+            until_s: Some(10.5 * dt),
+            ..Steps::timed(1000)
+        };
+        run_timed_steps(&mut s, StrategyName::Seq, &CONFIG, steps, &mut ()).unwrap();
+        assert_eq!(s.steps_done, 11);
+        assert!(s.time_s >= 10.5 * dt && s.time_s < 11.5 * dt);
+        // The step cap still holds.
+        let mut capped = sim(40);
+        let steps = Steps {
+            until_s: Some(1.0),
+            ..Steps::timed(4)
+        };
+        run_timed_steps(&mut capped, StrategyName::Seq, &CONFIG, steps, &mut ()).unwrap();
+        assert_eq!(capped.steps_done, 4);
+    }
+
+    #[test]
     fn an_observer_that_breaks_ends_the_run_there_without_an_error() {
         let mut s = sim(40);
         let steps = Steps {
-            total: usize::MAX,
             every: 2,
-            warmup: 0,
+            ..Steps::timed(usize::MAX)
         };
         let mut observer = seen(3);
         run_steps(

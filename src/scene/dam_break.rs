@@ -43,6 +43,9 @@ pub struct Layout {
 
 impl Layout {
     /// The preset's layout.
+    ///
+    /// # Panics
+    /// For [`Preset::Wcsph`], whose scene is [`crate::scene::tank`].
     pub fn of(preset: Preset) -> Layout {
         match preset {
             Preset::Seed => Layout {
@@ -57,6 +60,7 @@ impl Layout {
                 rows: 54,
                 base_columns: 19,
             },
+            Preset::Wcsph => panic!("the wcsph preset's scene is scene::tank"),
         }
     }
 

@@ -15,10 +15,13 @@
 use std::mem::size_of;
 
 use crate::limits::MAX_PARTICLES;
-use crate::scene::dam_break;
-use crate::sph::neighbors::{NeighborMode, SLOTS};
+use crate::scene::{dam_break, tank};
+use crate::solver::SPEED_BLOCK;
+use crate::sph::neighbors::{NeighborMode, SLOTS, WCSPH_SLOTS};
 use crate::sph::params::Preset;
+use crate::sph::physics::Physics;
 use crate::sph::state::FIELD_NAMES;
+use crate::sph::wcsph::params::WcParams;
 
 /// Why a run was refused.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -48,18 +51,36 @@ pub enum MemoryError {
 
 /// Bytes the arrays of a run of `n` particles of `preset` with `neighbors` search hold (see
 /// the module docs). Saturates instead of overflowing, so any `n` gives an answer.
+///
+/// For `wcsph`, `n` is mapped to its resolution as the commands map it, and the count is of
+/// fluid and wall particles: lists of [`WCSPH_SLOTS`] for every particle, and a density rate
+/// and a 1/256 share of a speed block per fluid particle.
 pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
+    let (physics, domain, n, lists_of, fluid_scratch) = match preset {
+        Preset::Wcsph => {
+            let r = tank::resolution_for(n);
+            let fluid = tank::dam_break_particles(r);
+            let physics = Physics::from(WcParams::new(r, fluid));
+            let total = fluid + tank::wall_particles(r);
+            let scratch = 8 * (fluid as u64 + fluid.div_ceil(SPEED_BLOCK) as u64);
+            (physics, tank::domain(), total, WCSPH_SLOTS, scratch)
+        }
+        _ => {
+            let physics = Physics::from(preset.params());
+            (physics, dam_break::domain(preset, n), n, SLOTS, 0)
+        }
+    };
     let n64 = n as u64;
-    let per_particle = FIELD_NAMES.len() * size_of::<f64>() + (1 + SLOTS) * size_of::<u32>();
-    let mut bytes = n64.saturating_mul(per_particle as u64);
+    let per_particle = FIELD_NAMES.len() * size_of::<f64>() + (1 + lists_of) * size_of::<u32>();
+    let mut bytes = n64.saturating_mul(per_particle as u64).saturating_add(fluid_scratch);
     if neighbors == NeighborMode::Grid {
         let grid_per_particle = 2 * size_of::<u32>() + 2 * size_of::<f64>();
-        let params = preset.params();
-        let domain = dam_break::domain(preset, n);
+        let bounds = physics.search_bounds(domain);
+        let h = physics.search_radius();
         // As `Grid::new` sizes it: floor(extent / h) + 1 cells along each axis, and one start
         // more than there are cells. Float-to-int casts saturate.
-        let cols = (domain.width / params.h) as u64 + 1;
-        let rows = (domain.height / params.h) as u64 + 1;
+        let cols = (bounds.width() / h) as u64 + 1;
+        let rows = (bounds.height() / h) as u64 + 1;
         let starts = cols.saturating_mul(rows).saturating_add(1);
         bytes = bytes
             .saturating_add(n64.saturating_mul(grid_per_particle as u64))
@@ -144,21 +165,20 @@ pub fn human_bytes(bytes: u64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solver::Simulation;
 
     #[test]
     fn the_estimate_is_what_a_simulation_allocates() {
         for preset in Preset::ALL {
             for mode in NeighborMode::ALL {
                 for n in [1, 1000, 5000] {
-                    let state = dam_break::initial_state(preset, n, 1);
-                    let domain = dam_break::domain(preset, n);
-                    let state_bytes: usize = state
+                    let scene = crate::scene::Scene::dam_break(preset, n, 1).unwrap();
+                    let state_bytes: usize = scene
+                        .state
                         .fields()
                         .iter()
                         .map(|f| std::mem::size_of_val(*f))
                         .sum();
-                    let sim = Simulation::new(preset.params(), domain, state, mode);
+                    let sim = scene.simulate(mode);
                     let held = (state_bytes + sim.neighbor_heap_bytes()) as u64;
                     assert_eq!(estimate(preset, mode, n), held, "{preset} {mode} {n}");
                 }

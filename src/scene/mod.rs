@@ -1,6 +1,63 @@
 //! Initial states: the presets' dam-break layouts and the domain they live in, and the memory
-//! a run of them needs.
+//! a run of them needs. [`Scene`] is the one way a command turns a preset and a size into a
+//! simulation.
 
 pub mod dam_break;
 pub mod memory;
 pub mod splitmix;
+pub mod tank;
+
+use std::collections::TryReserveError;
+
+use crate::solver::Simulation;
+use crate::sph::neighbors::NeighborMode;
+use crate::sph::params::Preset;
+use crate::sph::physics::Physics;
+use crate::sph::state::{Domain, State};
+
+/// A preset's initial state, ready to simulate.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// The model and its constants.
+    pub physics: Physics,
+    /// The tank.
+    pub domain: Domain,
+    /// The particles (for `wcsph`, the fluid then the walls).
+    pub state: State,
+}
+
+impl Scene {
+    /// The dam break of `preset` for `n` particles: Müller's presets place `n` jittered by
+    /// `seed`; `wcsph` takes the resolution whose fluid count is nearest `n`
+    /// ([`tank::resolution_for`]) and has no jitter.
+    pub fn dam_break(preset: Preset, n: usize, seed: u64) -> Result<Scene, TryReserveError> {
+        match preset {
+            Preset::Wcsph => Scene::tank(tank::Fill::DamBreak, tank::resolution_for(n)),
+            _ => Ok(Scene {
+                physics: preset.params().into(),
+                domain: dam_break::domain(preset, n),
+                state: dam_break::try_initial_state(preset, n, seed)?,
+            }),
+        }
+    }
+
+    /// The `wcsph` tank holding `fill` at resolution R.
+    pub fn tank(fill: tank::Fill, resolution: usize) -> Result<Scene, TryReserveError> {
+        let (prm, state) = tank::build(fill, resolution)?;
+        Ok(Scene {
+            physics: prm.into(),
+            domain: tank::domain(),
+            state,
+        })
+    }
+
+    /// Particles that move (the rest are walls).
+    pub fn fluid(&self) -> usize {
+        self.physics.fluid(self.state.len())
+    }
+
+    /// The simulation of this scene with neighbour search `mode`.
+    pub fn simulate(self, mode: NeighborMode) -> Simulation {
+        Simulation::new(self.physics, self.domain, self.state, mode)
+    }
+}

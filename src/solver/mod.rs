@@ -1,18 +1,23 @@
-//! One step = three passes over all particles, each handed to a strategy's executor, plus the
-//! grid rebuild before them and the divergence check after them. How each pass is cut into
-//! kernel calls lives in `schedule`; the one step loop ([`Simulation::advance_with`]) and the
-//! [`StepHooks`] through which a caller wraps each phase's executor (tracing, fault injection)
-//! or the check, in `step`.
+//! One step = the model's passes over the particles, each handed to a strategy's executor,
+//! plus the grid rebuild before them and the divergence check after them: three passes for
+//! Müller's model (density, forces, integrate), six for WCSPH (max speed, neighbours, walls,
+//! momentum, continuity, integrate). How each pass is cut into kernel calls lives in `schedule`, one
+//! file per model; the one step loop ([`Simulation::advance_with`]) and the [`StepHooks`]
+//! through which a caller wraps each phase's executor (tracing, fault injection) or the
+//! check, in `step`.
 
 mod schedule;
 mod step;
 
+pub use schedule::wcsph::SPEED_BLOCK;
 pub use step::{Phase, PhaseJob, StepHooks};
 
 use sph_strategies::{Executor, KernelPanic};
 
-use crate::sph::neighbors::{self, AnyNeighbors, NeighborLists, NeighborMode, Neighbors};
-use crate::sph::params::Params;
+use crate::sph::neighbors::{
+    self, AnyNeighbors, NeighborLists, NeighborMode, Neighbors, WCSPH_SLOTS,
+};
+use crate::sph::physics::Physics;
 use crate::sph::state::{Domain, Positions, State};
 
 /// Why a step failed.
@@ -41,32 +46,68 @@ pub enum StepError {
 /// A running simulation: constants, walls, particles and the neighbour search.
 #[derive(Debug, Clone)]
 pub struct Simulation {
-    /// The preset's constants.
-    pub params: Params,
-    /// The walls.
+    /// The model and its constants.
+    pub physics: Physics,
+    /// The walls (for WCSPH, the inner faces of the walls' particle layers).
     pub domain: Domain,
-    /// The particles.
+    /// The particles (for WCSPH, the fluid then the walls' fixed particles).
     pub state: State,
     /// Steps completed so far.
     pub steps_done: usize,
+    /// Simulated time: the sum of the steps' time steps, s.
+    pub time_s: f64,
     neighbors: AnyNeighbors,
     lists: NeighborLists,
+    wcsph: schedule::wcsph::Scratch,
 }
 
 /// One pass of a step, for benchmarks and traces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Pass {
-    /// Density and pressure (and each particle's neighbour list).
+    /// Müller: density and pressure (and each particle's neighbour list).
     Density,
-    /// Pressure, viscosity and gravity forces.
+    /// Müller: pressure, viscosity and gravity forces.
     Forces,
-    /// Symplectic Euler and the walls.
+    /// Both: each particle's own update (Müller: symplectic Euler and the walls; WCSPH: kick,
+    /// density, drift).
     Integrate,
+    /// WCSPH: the largest fluid speed, a reduction, and from it the time step.
+    MaxSpeed,
+    /// WCSPH: every particle's neighbour list.
+    Neighbors,
+    /// WCSPH: the walls' pressure and density from the fluid.
+    Walls,
+    /// WCSPH: each fluid particle's acceleration (and its neighbour list).
+    Momentum,
+    /// WCSPH: each fluid particle's density rate.
+    Continuity,
 }
 
 impl Pass {
-    /// The three passes in step order.
-    pub const ALL: [Pass; 3] = [Pass::Density, Pass::Forces, Pass::Integrate];
+    /// Müller's three passes in step order.
+    pub const MUELLER: [Pass; 3] = [Pass::Density, Pass::Forces, Pass::Integrate];
+
+    /// The WCSPH step's six passes in step order.
+    pub const WCSPH: [Pass; 6] = [
+        Pass::MaxSpeed,
+        Pass::Neighbors,
+        Pass::Walls,
+        Pass::Momentum,
+        Pass::Continuity,
+        Pass::Integrate,
+    ];
+
+    /// Every pass: Müller's, then those only WCSPH has.
+    pub const ALL: [Pass; 8] = [
+        Pass::Density,
+        Pass::Forces,
+        Pass::Integrate,
+        Pass::MaxSpeed,
+        Pass::Neighbors,
+        Pass::Walls,
+        Pass::Momentum,
+        Pass::Continuity,
+    ];
 
     /// Lower-case name, as in bench ids and traces.
     pub fn as_str(self) -> &'static str {
@@ -74,6 +115,11 @@ impl Pass {
             Pass::Density => "density",
             Pass::Forces => "forces",
             Pass::Integrate => "integrate",
+            Pass::MaxSpeed => "max speed",
+            Pass::Neighbors => "neighbours",
+            Pass::Walls => "walls",
+            Pass::Momentum => "momentum",
+            Pass::Continuity => "continuity",
         }
     }
 }
@@ -91,16 +137,58 @@ macro_rules! with_search {
 
 impl Simulation {
     /// A simulation of `state` inside `domain` with the given constants and neighbour search.
-    pub fn new(params: Params, domain: Domain, state: State, mode: NeighborMode) -> Self {
-        let neighbors = neighbors::build(mode, domain, params.h, state.len());
-        let lists = NeighborLists::new(state.len());
+    pub fn new(
+        physics: impl Into<Physics>,
+        domain: Domain,
+        state: State,
+        mode: NeighborMode,
+    ) -> Self {
+        let physics = physics.into();
+        let (fluid, state_len) = (physics.fluid(state.len()), state.len());
+        let bounds = physics.search_bounds(domain);
+        let neighbors = neighbors::build(mode, bounds, physics.search_radius(), state.len());
+        let wcsph = match physics {
+            Physics::Mueller(_) => schedule::wcsph::Scratch::new(0),
+            Physics::Wcsph(_) => schedule::wcsph::Scratch::new(fluid),
+        };
         Simulation {
-            params,
+            physics,
             domain,
             state,
             steps_done: 0,
+            time_s: 0.0,
             neighbors,
-            lists,
+            lists: match physics {
+                Physics::Mueller(_) => NeighborLists::new(fluid),
+                Physics::Wcsph(_) => NeighborLists::with_slots(state_len, WCSPH_SLOTS),
+            },
+            wcsph,
+        }
+    }
+
+    /// The model's passes, in step order.
+    pub fn passes(&self) -> &'static [Pass] {
+        Self::passes_of(&self.physics)
+    }
+
+    /// The passes of `physics`' model, in step order.
+    pub fn passes_of(physics: &Physics) -> &'static [Pass] {
+        match physics {
+            Physics::Mueller(_) => &Pass::MUELLER,
+            Physics::Wcsph(_) => &Pass::WCSPH,
+        }
+    }
+
+    /// Particles that move: the first `fluid()` of the state (the rest are walls).
+    pub fn fluid(&self) -> usize {
+        self.physics.fluid(self.state.len())
+    }
+
+    /// The time step of the last step (WCSPH's adapts to the flow), s.
+    pub fn last_dt(&self) -> f64 {
+        match self.physics {
+            Physics::Mueller(p) => p.dt,
+            Physics::Wcsph(_) => self.wcsph.dt,
         }
     }
 
@@ -120,24 +208,52 @@ impl Simulation {
         run.expect("a sequential grid rebuild cannot panic");
     }
 
-    /// Runs one pass over all particles on `exec`. The density pass needs an up-to-date search
-    /// ([`Simulation::rebuild_neighbors`]); the force pass needs this step's densities.
+    /// Runs one pass of the model on `exec`, passes in [`Simulation::passes`] order: each
+    /// needs an up-to-date search ([`Simulation::rebuild_neighbors`]) and what the passes
+    /// before it in the step wrote.
+    ///
+    /// # Panics
+    /// If `pass` is not one of the model's passes.
     pub fn run_pass<E: Executor>(&mut self, exec: &E, pass: Pass) -> Result<(), KernelPanic> {
-        let (s, prm, lists) = (&mut self.state, &self.params, &mut self.lists);
-        match pass {
-            Pass::Density => {
-                with_search!(&self.neighbors, nb => schedule::density(exec, nb, lists, s, prm))
+        use schedule::{mueller, wcsph};
+        let (s, lists, nb) = (&mut self.state, &mut self.lists, &self.neighbors);
+        match (&self.physics, pass) {
+            (Physics::Mueller(prm), Pass::Density) => {
+                with_search!(nb, nb => mueller::density(exec, nb, lists, s, prm))
             }
-            Pass::Forces => {
-                with_search!(&self.neighbors, nb => schedule::forces(exec, nb, lists, s, prm))
+            (Physics::Mueller(prm), Pass::Forces) => {
+                with_search!(nb, nb => mueller::forces(exec, nb, lists, s, prm))
             }
-            Pass::Integrate => schedule::integrate(exec, s, prm, self.domain),
+            (Physics::Mueller(prm), Pass::Integrate) => {
+                mueller::integrate(exec, s, prm, self.domain)
+            }
+            (Physics::Wcsph(prm), Pass::MaxSpeed) => wcsph::max_speed(exec, s, &mut self.wcsph, prm),
+            (Physics::Wcsph(prm), Pass::Neighbors) => {
+                with_search!(nb, nb => wcsph::neighbors(exec, nb, lists, s, prm))
+            }
+            (Physics::Wcsph(prm), Pass::Walls) => {
+                with_search!(nb, nb => wcsph::walls(exec, nb, lists, s, prm))
+            }
+            (Physics::Wcsph(prm), Pass::Momentum) => {
+                with_search!(nb, nb => wcsph::momentum(exec, nb, lists, s, prm))
+            }
+            (Physics::Wcsph(prm), Pass::Continuity) => {
+                with_search!(nb, nb => wcsph::continuity(exec, nb, lists, s, &mut self.wcsph, prm))
+            }
+            (Physics::Wcsph(prm), Pass::Integrate) => wcsph::integrate(exec, s, &self.wcsph, prm),
+            (physics, pass) => panic!(
+                "the {} preset has no {} pass",
+                physics.preset(),
+                pass.as_str()
+            ),
         }
     }
 
-    /// Bytes held by the neighbour search and lists, for memory reports.
+    /// Bytes held by the neighbour search, lists and the model's scratch arrays, for memory
+    /// reports.
     pub fn neighbor_heap_bytes(&self) -> usize {
         self.lists.heap_bytes()
+            + self.wcsph.heap_bytes()
             + match &self.neighbors {
                 AnyNeighbors::AllPairs(_) => 0,
                 AnyNeighbors::Grid(g) => g.heap_bytes(),

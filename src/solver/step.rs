@@ -23,12 +23,17 @@ pub enum Phase {
 }
 
 impl Phase {
-    /// Every phase in step order.
-    pub const ALL: [Phase; 4] = [
+    /// Every phase: the rebuild, then every pass ([`Pass::ALL`]).
+    pub const ALL: [Phase; 9] = [
         Phase::Rebuild,
         Phase::Pass(Pass::Density),
         Phase::Pass(Pass::Forces),
         Phase::Pass(Pass::Integrate),
+        Phase::Pass(Pass::MaxSpeed),
+        Phase::Pass(Pass::Neighbors),
+        Phase::Pass(Pass::Walls),
+        Phase::Pass(Pass::Momentum),
+        Phase::Pass(Pass::Continuity),
     ];
 
     /// Name, as in trace.json, stats.csv and the timeline's legend: `grid rebuild` or the
@@ -110,13 +115,15 @@ impl Simulation {
     ) -> Result<(), StepError> {
         for _ in 0..steps {
             let step = self.steps_done + 1;
-            for phase in Phase::ALL {
+            let passes = self.passes().iter().map(|&p| Phase::Pass(p));
+            for phase in std::iter::once(Phase::Rebuild).chain(passes) {
                 let job = Job { sim: self, phase };
                 hooks
                     .phase(exec, phase, step, job)
                     .map_err(|source| StepError::Kernel { step, source })?;
             }
             self.steps_done = step;
+            self.time_s += self.last_dt();
             if let Some((field, particle)) = hooks.check(step, || self.first_divergence()) {
                 return Err(StepError::Diverged {
                     step,
@@ -128,12 +135,33 @@ impl Simulation {
         Ok(())
     }
 
+    /// Runs steps on `exec`, each phase and check through `hooks`, until the simulated time
+    /// reaches `t_end` (s) or `max_steps` have run; returns the steps run. Stops at the first
+    /// failing step, as [`Simulation::advance_with`].
+    pub fn advance_until<E: Executor, H: StepHooks>(
+        &mut self,
+        exec: &E,
+        max_steps: usize,
+        t_end: f64,
+        hooks: &mut H,
+    ) -> Result<usize, StepError> {
+        let mut ran = 0;
+        while ran < max_steps && self.time_s < t_end {
+            self.advance_with(exec, 1, hooks)?;
+            ran += 1;
+        }
+        Ok(ran)
+    }
+
     /// The first non-finite field and particle, if any.
     fn first_divergence(&self) -> Option<(&'static str, usize)> {
-        // Any non-finite density, pressure, force or position makes the particle's own
-        // velocity non-finite in the same step, so checking velocities (2 arrays rather than
-        // 8) catches every divergence; the full scan then names the first field.
-        if self.state.velocities_finite() {
+        // In Müller's model any non-finite density, pressure, force or position makes the
+        // particle's own velocity non-finite in the same step; in WCSPH a non-finite density
+        // or pressure may reach the velocities only a step later, and a non-finite pressure
+        // comes from a non-finite density. So checking velocities and densities (3 arrays
+        // rather than 8) catches every divergence in the step it happens; the full scan then
+        // names the first field.
+        if self.state.velocities_finite() && self.state.densities_finite() {
             return None;
         }
         self.state.first_non_finite()

@@ -13,25 +13,42 @@ pub enum Preset {
     Seed,
     /// The C++ original (`cerrno/mueller-sph` at e0821c49), evaluated in f64.
     Cpp,
+    /// Weakly compressible SPH in SI units, validated against Martin & Moyce (1952) (see
+    /// [`crate::sph::wcsph`]).
+    Wcsph,
 }
 
 impl Preset {
     /// Every preset, default first.
-    pub const ALL: [Preset; 2] = [Preset::Seed, Preset::Cpp];
+    pub const ALL: [Preset; 3] = [Preset::Seed, Preset::Cpp, Preset::Wcsph];
+
+    /// The presets of Müller's pixel-unit model, whose constants are a [`Params`].
+    pub const MUELLER: [Preset; 2] = [Preset::Seed, Preset::Cpp];
 
     /// The name used on the command line and in CSV files.
     pub fn as_str(self) -> &'static str {
         match self {
             Preset::Seed => "seed",
             Preset::Cpp => "cpp",
+            Preset::Wcsph => "wcsph",
         }
     }
 
-    /// The preset's constants.
+    /// Whether this is one of Müller's pixel-unit presets ([`Preset::MUELLER`]).
+    pub fn is_mueller(self) -> bool {
+        self != Preset::Wcsph
+    }
+
+    /// The constants of a Müller preset.
+    ///
+    /// # Panics
+    /// For [`Preset::Wcsph`], whose constants depend on its resolution
+    /// ([`crate::sph::wcsph::params::WcParams`]; [`crate::scene::Scene`] builds either).
     pub fn params(self) -> Params {
         match self {
-            Preset::Seed => Params::new(self, 12000.0 * -9.8, 0.0009, -1.0),
-            Preset::Cpp => Params::new(self, -117600.0, 0.0008, -0.5),
+            Preset::Seed => Params::new(Integrator::Seed, 12000.0 * -9.8, 0.0009, -1.0),
+            Preset::Cpp => Params::new(Integrator::Cpp, -117600.0, 0.0008, -0.5),
+            Preset::Wcsph => panic!("the wcsph preset has no Müller constants"),
         }
     }
 }
@@ -81,7 +98,7 @@ pub struct Params {
     pub eps: f64,
     /// Factor applied to a velocity component at a wall.
     pub bound_damping: f64,
-    /// Velocity update grouping.
+    /// Velocity update grouping (and with it, the preset).
     pub integrator: Integrator,
     /// MASS · POLY6, as the sources' left-to-right `mass * poly6 * ...` computes it.
     pub mass_poly6: f64,
@@ -90,7 +107,15 @@ pub struct Params {
 }
 
 impl Params {
-    fn new(preset: Preset, gravity_y: f64, dt: f64, bound_damping: f64) -> Self {
+    /// The preset these constants belong to.
+    pub fn preset(&self) -> Preset {
+        match self.integrator {
+            Integrator::Seed => Preset::Seed,
+            Integrator::Cpp => Preset::Cpp,
+        }
+    }
+
+    fn new(integrator: Integrator, gravity_y: f64, dt: f64, bound_damping: f64) -> Self {
         let h: f64 = 16.0;
         let h6 = h * h * h * h * h * h;
         let h9 = h6 * h * h * h;
@@ -111,10 +136,7 @@ impl Params {
             visc_lap: 45.0 / (PI * h6),
             eps: h,
             bound_damping,
-            integrator: match preset {
-                Preset::Seed => Integrator::Seed,
-                Preset::Cpp => Integrator::Cpp,
-            },
+            integrator,
             mass_poly6: mass * poly6,
             visc_mass: visc * mass,
         }

@@ -108,6 +108,11 @@ impl State {
         first_non_finite(&self.vx).is_none() && first_non_finite(&self.vy).is_none()
     }
 
+    /// Whether every density is finite.
+    pub fn densities_finite(&self) -> bool {
+        first_non_finite(&self.rho).is_none()
+    }
+
     /// The first non-finite value, as (field name, particle index), scanning field by field.
     pub fn first_non_finite(&self) -> Option<(&'static str, usize)> {
         FIELD_NAMES

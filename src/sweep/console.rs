@@ -3,10 +3,13 @@
 use std::collections::HashMap;
 use std::fmt::Write as _;
 
-use super::plan::{Cell, LabelStyle, Plan};
+use super::plan::{self, Cell, LabelStyle, Plan};
 use super::range::{Axis, compact};
 use crate::output::console::plural;
+use crate::results::params::SweepParams;
 use crate::results::rows::{Contended, Status, SummaryRow, fastest};
+use crate::scene::tank;
+use crate::sph::params::Preset;
 
 /// A duration for people: `0.25 ms`, `12 ms`, `4.2 s`, `42 s`, `3 min 20 s`, `1 h 05 min`.
 pub fn duration(seconds: f64) -> String {
@@ -61,6 +64,29 @@ pub fn oversubscription_warning(plan: &Plan, hardware_threads: usize) -> Option<
             compact(&cores, Axis::Cores),
             hardware_threads,
             plural(count, "cell", "cells"),
+        )
+    })
+}
+
+/// The note printed when a `wcsph` group runs at a particle count other than its `--n`:
+/// which resolution each such `--n` maps to.
+pub fn resolution_note(params: &SweepParams) -> Option<String> {
+    if !params.presets.contains(&Preset::Wcsph) {
+        return None;
+    }
+    let mapped: Vec<String> = params
+        .n
+        .iter()
+        .filter(|&&n| plan::particles(Preset::Wcsph, n) != n)
+        .map(|&n| {
+            let r = tank::resolution_for(n);
+            format!("--n {n} → R = {r} ({} fluid particles)", tank::dam_break_particles(r))
+        })
+        .collect();
+    (!mapped.is_empty()).then(|| {
+        format!(
+            "note: wcsph runs at the resolution R whose 2R² fluid particles are nearest --n: {}",
+            mapped.join(", ")
         )
     })
 }

@@ -567,6 +567,9 @@ fn print_plan(
         ));
     }
     print(&text);
+    if let Some(note) = console::resolution_note(params) {
+        console_warn(&note);
+    }
     if let Some(warning) = console::oversubscription_warning(plan, hardware_threads) {
         console_warn(&warning);
     }

@@ -1,7 +1,9 @@
 //! What a sweep measures: groups of cells, in the order they run.
 //!
 //! A **group** is one (preset, neighbours, N, steps): the same initial state and the same
-//! final checksum for every strategy. Each group starts with its **reference cell**, `seq` at
+//! final checksum for every strategy. For `wcsph`, N is the fluid-particle count 2R² of the
+//! resolution R nearest each `--n` ([`tank::resolution_for`]); `--n` values that share a
+//! resolution make one group. Each group starts with its **reference cell**, `seq` at
 //! 1 core, measured whatever `--strategies` says: its mean is the denominator of speedup and
 //! its first run's checksum the one every other run of the group must reproduce. Then, for each
 //! other strategy in registry order and each cores value, one cell per chunks value for the
@@ -11,6 +13,8 @@ use sph_strategies::StrategyName;
 
 pub use crate::results::key::{Cell, Group, LabelStyle};
 use crate::results::params::SweepParams;
+use crate::scene::tank;
+use crate::sph::params::Preset;
 
 /// Every cell of a sweep, grouped, in the order they run.
 #[derive(Debug, Clone, PartialEq)]
@@ -28,12 +32,15 @@ impl Plan {
         for &preset in &params.presets {
             for &neighbors in &params.neighbors {
                 for &n in &params.n {
-                    groups.push(Group {
+                    let group = Group {
                         preset,
                         neighbors,
-                        n,
+                        n: particles(preset, n),
                         steps: params.steps,
-                    });
+                    };
+                    if !groups.contains(&group) {
+                        groups.push(group);
+                    }
                 }
             }
         }
@@ -61,6 +68,15 @@ impl Plan {
             }
         }
         Plan { groups, cells }
+    }
+}
+
+/// The particles a group of `preset` has for `--n` `n`: `n`, or for `wcsph` the fluid
+/// particles of the nearest resolution.
+pub fn particles(preset: Preset, n: usize) -> usize {
+    match preset {
+        Preset::Wcsph => tank::dam_break_particles(tank::resolution_for(n)),
+        _ => n,
     }
 }
 

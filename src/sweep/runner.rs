@@ -28,9 +28,7 @@ use crate::checksum::checksum_hex;
 use crate::contention::Threshold;
 use crate::results::rows::{Status, SummaryRow};
 use crate::run::run_timed;
-use crate::scene::dam_break;
-use crate::solver::Simulation;
-use crate::sph::state::{Domain, State};
+use crate::scene::Scene;
 
 /// Set by Ctrl-C; checked before every run and every cell.
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
@@ -174,17 +172,14 @@ impl Reference {
 /// The initial state of a group, built once and cloned for every run.
 struct GroupInput {
     group: Group,
-    state: State,
-    domain: Domain,
+    scene: Scene,
 }
 
 impl GroupInput {
     fn new(group: Group, seed: u64) -> GroupInput {
-        GroupInput {
-            group,
-            state: dam_break::initial_state(group.preset, group.n, seed),
-            domain: dam_break::domain(group.preset, group.n),
-        }
+        let scene = Scene::dam_break(group.preset, group.n, seed)
+            .unwrap_or_else(|e| panic!("no memory for {} particles: {e}", group.n));
+        GroupInput { group, scene }
     }
 
     /// One whole run of `cell` from the initial state: its times and final checksum.
@@ -194,13 +189,7 @@ impl GroupInput {
 
     /// `steps` steps of `cell` from the initial state.
     fn run_steps(&self, cell: &Cell, steps: usize) -> Result<Measured, String> {
-        let g = self.group;
-        let mut sim = Simulation::new(
-            g.preset.params(),
-            self.domain,
-            self.state.clone(),
-            g.neighbors,
-        );
+        let mut sim = self.scene.clone().simulate(self.group.neighbors);
         let load1 = crate::contention::load1();
         let elapsed = run_timed(&mut sim, cell.strategy, &cell.config(), steps)
             .map_err(|e| one_line(&format!("{:#}", anyhow::Error::new(e))))?;

@@ -24,6 +24,7 @@ use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Instant;
 
 pub use crate::solver::Phase;
+use crate::solver::Pass;
 
 /// One kernel call: which worker ran which chunk of which phase of which step, and when.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -109,6 +110,24 @@ pub struct Trace {
     pub workers: usize,
     /// Duration of the step loop in nanoseconds; every event lies within `0..=wall_ns`.
     pub wall_ns: u64,
+}
+
+impl Trace {
+    /// The phases this trace's rows and legends show, in step order: the grid's rebuild when
+    /// it ran kernel calls, then the passes of the traced model (WCSPH's when any of its own
+    /// passes ran, else Müller's), each even if it ran none.
+    pub fn phases(&self) -> Vec<Phase> {
+        let ran = |p: Phase| self.kernels.iter().any(|e| e.phase == p);
+        let wcsph = Pass::WCSPH
+            .iter()
+            .any(|&p| !Pass::MUELLER.contains(&p) && ran(Phase::Pass(p)));
+        let passes: &[Pass] = if wcsph { &Pass::WCSPH } else { &Pass::MUELLER };
+        ran(Phase::Rebuild)
+            .then_some(Phase::Rebuild)
+            .into_iter()
+            .chain(passes.iter().map(|&p| Phase::Pass(p)))
+            .collect()
+    }
 }
 
 type Buffer = Arc<Mutex<Vec<KernelEvent>>>;

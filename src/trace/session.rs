@@ -32,13 +32,20 @@ pub struct TracedRun {
 /// The kernel calls one worker is expected to make (from [`Plan::kernel_calls`], counting the
 /// grid rebuild's calls whichever search runs), used only to preallocate its event buffer
 /// (buffers still grow if it is short).
-fn capacity_hint(strategy: StrategyName, config: &Config, n: usize, steps: usize) -> usize {
+fn capacity_hint(
+    strategy: StrategyName,
+    config: &Config,
+    n: usize,
+    steps: usize,
+    passes: usize,
+) -> usize {
     let total = Plan {
         strategy,
         n,
         chunks: config.chunks,
         cores: config.cores,
         steps,
+        passes,
         neighbors: NeighborMode::Grid,
     }
     .kernel_calls();
@@ -106,7 +113,7 @@ pub fn run_traced(
     warmup: usize,
 ) -> Result<TracedRun, RunError> {
     let workers = strategy.info().effective_cores(config.cores);
-    let per_worker = capacity_hint(strategy, config, sim.state.len(), steps);
+    let per_worker = capacity_hint(strategy, config, sim.state.len(), steps, sim.passes().len());
     let recorder = Recorder::new(workers, per_worker, 2 * steps);
     let mut hooks = Tracing {
         recorder: &recorder,

@@ -37,6 +37,8 @@ pub struct Plan {
     pub cores: usize,
     /// Recorded steps.
     pub steps: usize,
+    /// The model's passes per step (3 for Müller's presets, 6 for `wcsph`).
+    pub passes: usize,
     /// Neighbour search: the grid's rebuild adds two kernel calls per step and chunk.
     pub neighbors: NeighborMode,
 }
@@ -112,11 +114,11 @@ impl Plan {
             .unwrap_or_else(|| RAYON_ITER_LEAVES_PER_CORE.saturating_mul(self.cores).min(n))
     }
 
-    /// Passes that call kernels per step: the three passes, and the grid rebuild's two.
+    /// Passes that call kernels per step: the model's passes, and the grid rebuild's two.
     pub fn kernel_passes_per_step(&self) -> usize {
         match self.neighbors {
-            NeighborMode::AllPairs => 3,
-            NeighborMode::Grid => 5,
+            NeighborMode::AllPairs => self.passes,
+            NeighborMode::Grid => self.passes + 2,
         }
     }
 
@@ -157,6 +159,7 @@ mod tests {
             chunks: 45,
             cores: 2,
             steps,
+            passes: 3,
             neighbors: NeighborMode::AllPairs,
         }
     }

@@ -124,10 +124,10 @@ pub fn compute(trace: &Trace) -> Stats {
     for w in &mut workers {
         w.idle_pct = idle_pct(w.busy_ns, trace.wall_ns);
     }
-    let passes = Phase::ALL
-        .iter()
-        .filter(|&&p| p != Phase::Rebuild || trace.kernels.iter().any(|e| e.phase == p))
-        .map(|&p| pass_stats(trace, p))
+    let passes = trace
+        .phases()
+        .into_iter()
+        .map(|p| pass_stats(trace, p))
         .collect();
     let busy_ns = workers.iter().map(|w| w.busy_ns).sum();
     let total = TotalStats {

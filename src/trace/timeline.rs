@@ -56,6 +56,11 @@ fn phase_color(phase: Phase, dark: bool) -> RGBColor {
         Phase::Pass(Pass::Density) => (RGBColor(66, 146, 214), RGBColor(31, 96, 160)),
         Phase::Pass(Pass::Forces) => (RGBColor(255, 150, 50), RGBColor(204, 102, 0)),
         Phase::Pass(Pass::Integrate) => (RGBColor(60, 180, 60), RGBColor(25, 120, 25)),
+        Phase::Pass(Pass::MaxSpeed) => (RGBColor(150, 150, 150), RGBColor(90, 90, 90)),
+        Phase::Pass(Pass::Neighbors) => (RGBColor(170, 130, 210), RGBColor(118, 78, 160)),
+        Phase::Pass(Pass::Walls) => (RGBColor(140, 100, 70), RGBColor(96, 64, 40)),
+        Phase::Pass(Pass::Momentum) => (RGBColor(255, 150, 50), RGBColor(204, 102, 0)),
+        Phase::Pass(Pass::Continuity) => (RGBColor(66, 146, 214), RGBColor(31, 96, 160)),
     };
     if dark { darker } else { light }
 }
@@ -378,11 +383,10 @@ where
         TextStyle::from((font::FAMILY, 24).into_font()).color(&BLACK),
     ))?;
     let style = TextStyle::from((font::FAMILY, 16).into_font()).color(&BLACK);
-    let has_rebuild = trace.kernels.iter().any(|e| e.phase == Phase::Rebuild);
-    let swatches = Phase::ALL
-        .iter()
-        .filter(|&&p| p != Phase::Rebuild || has_rebuild)
-        .map(|&p| (p.as_str(), phase_color(p, false)))
+    let swatches = trace
+        .phases()
+        .into_iter()
+        .map(|p| (p.as_str(), phase_color(p, false)))
         .chain([SerialWork::Rebuild, SerialWork::Check].map(|s| (s.as_str(), serial_color(s))));
     let mut x = 20;
     let y = 54;
@@ -419,6 +423,14 @@ mod tests {
     use crate::sph::params::Preset;
     use crate::trace::recorder::{KernelEvent, SerialEvent, ThreadInfo};
 
+    /// The phases of a step of Müller's model.
+    const MUELLER_PHASES: [Phase; 4] = [
+        Phase::Rebuild,
+        Phase::Pass(Pass::Density),
+        Phase::Pass(Pass::Forces),
+        Phase::Pass(Pass::Integrate),
+    ];
+
     /// Two steps on two workers: per step a grid rebuild, then density, forces and integrate
     /// calls of 100 µs each, with the caller's rebuild and check between them.
     fn trace() -> Trace {
@@ -432,7 +444,7 @@ mod tests {
                 start_ns: t,
                 end_ns: t + 50_000,
             });
-            for (k, phase) in Phase::ALL.into_iter().enumerate() {
+            for (k, &phase) in MUELLER_PHASES.iter().enumerate() {
                 for worker in 0..2 {
                     let start_ns = t + 100_000 + k as u64 * 200_000 + worker as u64 * 20_000;
                     kernels.push(KernelEvent {
@@ -512,7 +524,7 @@ mod tests {
         };
         // Every phase shows, in the shade its place in a worker's alternation gives it (4
         // calls a step: the rebuild and forces light, density and integrate dark).
-        for (phase, dark) in Phase::ALL.into_iter().zip([false, true, false, true]) {
+        for (&phase, dark) in MUELLER_PHASES.iter().zip([false, true, false, true]) {
             let n = colour_count(phase_color(phase, dark));
             assert!(n > 100, "{phase:?} dark={dark}: {n} pixels");
         }

@@ -120,6 +120,7 @@ impl Stepper {
             total: usize::MAX,
             every: self.every,
             warmup: 0,
+            until_s: None,
         };
         let spawned = std::thread::Builder::new()
             .name("viewer steps".into())

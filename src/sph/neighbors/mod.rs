@@ -10,7 +10,7 @@ pub mod list;
 
 pub use all_pairs::AllPairs;
 pub use grid::Grid;
-pub use list::{NeighborLists, SLOTS, SlotsMut};
+pub use list::{NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS};
 
 use serde::Serialize;
 use sph_strategies::{Executor, KernelPanic};
@@ -23,7 +23,8 @@ use crate::sph::state::{Domain, Positions};
 pub enum NeighborMode {
     /// Every particle against every particle, O(N²) per pass: the sources' loops.
     AllPairs,
-    /// A uniform cell list with cell size H, rebuilt every step by counting sort: O(N).
+    /// A uniform cell list with cell size the search radius, rebuilt every step by counting
+    /// sort: O(N).
     Grid,
 }
 
@@ -71,11 +72,46 @@ pub fn distance_squared(xi: f64, yi: f64, xj: f64, yj: f64) -> f64 {
     dx * dx + dy * dy
 }
 
-/// Builds the search for `mode` over `domain` with kernel radius `h`.
-pub fn build(mode: NeighborMode, domain: Domain, h: f64, n: usize) -> AnyNeighbors {
+/// The rectangle a grid covers (positions outside it fall into its edge cells).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bounds {
+    /// Left edge.
+    pub min_x: f64,
+    /// Lower edge.
+    pub min_y: f64,
+    /// Right edge.
+    pub max_x: f64,
+    /// Upper edge.
+    pub max_y: f64,
+}
+
+impl Bounds {
+    /// The domain's walls: [0, width] × [0, height].
+    pub fn of(domain: Domain) -> Bounds {
+        Bounds {
+            min_x: 0.0,
+            min_y: 0.0,
+            max_x: domain.width,
+            max_y: domain.height,
+        }
+    }
+
+    /// Extent along x.
+    pub fn width(&self) -> f64 {
+        self.max_x - self.min_x
+    }
+
+    /// Extent along y.
+    pub fn height(&self) -> f64 {
+        self.max_y - self.min_y
+    }
+}
+
+/// Builds the search for `mode` over `bounds` with search radius `radius` (the cell edge).
+pub fn build(mode: NeighborMode, bounds: Bounds, radius: f64, n: usize) -> AnyNeighbors {
     match mode {
         NeighborMode::AllPairs => AnyNeighbors::AllPairs(AllPairs),
-        NeighborMode::Grid => AnyNeighbors::Grid(Grid::new(domain, h, n)),
+        NeighborMode::Grid => AnyNeighbors::Grid(Grid::new(bounds, radius, n)),
     }
 }
 

@@ -1,10 +1,9 @@
-//! Each pass as one `for_each_chunk` call: which arrays it writes (cut in lockstep into the
-//! strategy's chunks), which it only reads, and the per-particle function it applies.
+//! The passes of Müller's step (the `seed` and `cpp` presets).
 
 use glam::DVec2;
 use sph_strategies::{Executor, KernelPanic};
 
-use crate::sph::neighbors::{NeighborLists, Neighbors, SlotsMut};
+use crate::sph::neighbors::{NeighborLists, Neighbors};
 use crate::sph::params::Params;
 use crate::sph::passes::{self, ForceInputs};
 use crate::sph::state::{Domain, Positions, State};
@@ -18,12 +17,8 @@ pub fn density<E: Executor, N: Neighbors>(
     prm: &Params,
 ) -> Result<(), KernelPanic> {
     let pos = Positions { x: &s.x, y: &s.y };
-    let out = (
-        &mut s.rho[..],
-        &mut s.p[..],
-        &mut lists.count[..],
-        SlotsMut(&mut lists.slots[..]),
-    );
+    let (count, slots) = lists.split_mut();
+    let out = (&mut s.rho[..], &mut s.p[..], count, slots);
     exec.for_each_chunk(out, |first, (rho, p, count, mut slots)| {
         for (k, ((rho, p), count)) in rho.iter_mut().zip(p).zip(count).enumerate() {
             (*rho, *p, *count) =

@@ -1,0 +1,192 @@
+//! The weakly compressible step's passes (see [`crate::sph::wcsph`]). Fluid particles are
+//! `0..fluid`, walls the rest; each pass writes its own arrays over one of the two ranges.
+
+use glam::DVec2;
+use sph_strategies::{Executor, KernelPanic};
+
+use crate::sph::neighbors::{NeighborLists, Neighbors};
+use crate::sph::state::{Positions, State};
+use crate::sph::wcsph::params::WcParams;
+use crate::sph::wcsph::passes::{self, ContinuityInputs, Fields};
+
+/// Fluid particles per block of the largest-speed reduction.
+pub const SPEED_BLOCK: usize = 256;
+
+/// What the WCSPH step keeps besides the particle state.
+#[derive(Debug, Clone)]
+pub struct Scratch {
+    /// dρ/dt of every fluid particle, from the continuity pass, kg/(m³ s).
+    pub drho: Vec<f64>,
+    /// Largest squared fluid speed per block of [`SPEED_BLOCK`] particles, m²/s².
+    pub block_max: Vec<f64>,
+    /// This step's time step, s.
+    pub dt: f64,
+}
+
+impl Scratch {
+    /// Room for `fluid` fluid particles.
+    pub fn new(fluid: usize) -> Scratch {
+        Scratch {
+            drho: vec![0.0; fluid],
+            block_max: vec![0.0; fluid.div_ceil(SPEED_BLOCK)],
+            dt: 0.0,
+        }
+    }
+
+    /// Heap bytes held (capacity).
+    pub fn heap_bytes(&self) -> usize {
+        8 * (self.drho.capacity() + self.block_max.capacity())
+    }
+}
+
+/// Writes each block's largest squared speed (a parallel pass over blocks), then sets
+/// `scratch.dt` from their maximum (`max` is exact, so the grouping cannot change the bits).
+pub fn max_speed<E: Executor>(
+    exec: &E,
+    s: &State,
+    scratch: &mut Scratch,
+    prm: &WcParams,
+) -> Result<(), KernelPanic> {
+    let (vx, vy) = (&s.vx[..prm.fluid], &s.vy[..prm.fluid]);
+    exec.for_each_chunk(&mut scratch.block_max[..], |first, maxima| {
+        for (k, m) in maxima.iter_mut().enumerate() {
+            let lo = (first + k) * SPEED_BLOCK;
+            let hi = (lo + SPEED_BLOCK).min(vx.len());
+            *m = passes::max_speed_squared(&vx[lo..hi], &vy[lo..hi]);
+        }
+    })?;
+    let v_max = scratch.block_max.iter().fold(0.0, |m: f64, &b| m.max(b)).sqrt();
+    scratch.dt = prm.time_step(v_max);
+    Ok(())
+}
+
+fn fields(s: &State) -> Fields<'_> {
+    Fields {
+        pos: Positions { x: &s.x, y: &s.y },
+        vx: &s.vx,
+        vy: &s.vy,
+        rho: &s.rho,
+        p: &s.p,
+    }
+}
+
+/// Writes every particle's neighbour list (walls: fluid neighbours only); reads positions.
+pub fn neighbors<E: Executor, N: Neighbors>(
+    exec: &E,
+    nb: &N,
+    lists: &mut NeighborLists,
+    s: &State,
+    prm: &WcParams,
+) -> Result<(), KernelPanic> {
+    let pos = Positions { x: &s.x, y: &s.y };
+    exec.for_each_chunk(lists.split_mut(), |first, (count, mut slots)| {
+        for (k, c) in count.iter_mut().enumerate() {
+            *c = passes::neighbors(first + k, pos, nb, prm, slots.particle(k));
+        }
+    })
+}
+
+/// Writes the walls' rho and p; reads the fluid's positions, rho and p and the lists.
+pub fn walls<E: Executor, N: Neighbors>(
+    exec: &E,
+    nb: &N,
+    lists: &NeighborLists,
+    s: &mut State,
+    prm: &WcParams,
+) -> Result<(), KernelPanic> {
+    let (fluid_rho, wall_rho) = s.rho.split_at_mut(prm.fluid);
+    let (fluid_p, wall_p) = s.p.split_at_mut(prm.fluid);
+    let f = Fields {
+        pos: Positions { x: &s.x, y: &s.y },
+        vx: &s.vx,
+        vy: &s.vy,
+        rho: fluid_rho,
+        p: fluid_p,
+    };
+    exec.for_each_chunk((wall_rho, wall_p), |first, (rho, p)| {
+        for (k, (rho, p)) in rho.iter_mut().zip(p).enumerate() {
+            let w = prm.fluid + first + k;
+            (*rho, *p) = passes::wall_state(w, &f, lists.of(w), nb, prm);
+        }
+    })
+}
+
+/// Writes the fluid's acceleration (into fx, fy); reads every field and the lists.
+pub fn momentum<E: Executor, N: Neighbors>(
+    exec: &E,
+    nb: &N,
+    lists: &NeighborLists,
+    s: &mut State,
+    prm: &WcParams,
+) -> Result<(), KernelPanic> {
+    let f = Fields {
+        pos: Positions { x: &s.x, y: &s.y },
+        vx: &s.vx,
+        vy: &s.vy,
+        rho: &s.rho,
+        p: &s.p,
+    };
+    let out = (&mut s.fx[..prm.fluid], &mut s.fy[..prm.fluid]);
+    exec.for_each_chunk(out, |first, (ax, ay)| {
+        for (k, (ax, ay)) in ax.iter_mut().zip(ay).enumerate() {
+            let a = passes::acceleration(first + k, &f, lists.of(first + k), nb, prm);
+            (*ax, *ay) = (a.x, a.y);
+        }
+    })
+}
+
+/// Writes the fluid's dρ/dt; reads every field, the accelerations and the lists.
+pub fn continuity<E: Executor, N: Neighbors>(
+    exec: &E,
+    nb: &N,
+    lists: &NeighborLists,
+    s: &State,
+    scratch: &mut Scratch,
+    prm: &WcParams,
+) -> Result<(), KernelPanic> {
+    let input = ContinuityInputs {
+        fields: fields(s),
+        ax: &s.fx,
+        ay: &s.fy,
+        dt: scratch.dt,
+    };
+    exec.for_each_chunk(&mut scratch.drho[..], |first, drho| {
+        for (k, d) in drho.iter_mut().enumerate() {
+            let a = first + k;
+            *d = passes::density_rate(a, &input, lists.of(a), nb, prm);
+        }
+    })
+}
+
+/// Writes the fluid's positions, velocities, rho and p (each particle only its own).
+pub fn integrate<E: Executor>(
+    exec: &E,
+    s: &mut State,
+    scratch: &Scratch,
+    prm: &WcParams,
+) -> Result<(), KernelPanic> {
+    let (ax, ay, drho, dt) = (&s.fx, &s.fy, &scratch.drho, scratch.dt);
+    let n = prm.fluid;
+    let out = (
+        (&mut s.x[..n], &mut s.y[..n]),
+        (&mut s.vx[..n], &mut s.vy[..n]),
+        &mut s.rho[..n],
+        &mut s.p[..n],
+    );
+    exec.for_each_chunk(out, |first, ((x, y), (vx, vy), rho, p)| {
+        let fields = x.iter_mut().zip(y).zip(vx).zip(vy).zip(rho).zip(p);
+        for (k, (((((x, y), vx), vy), rho), p)) in fields.enumerate() {
+            let i = first + k;
+            let (xn, vn, rn, pn) = passes::integrate(
+                DVec2::new(*x, *y),
+                DVec2::new(*vx, *vy),
+                DVec2::new(ax[i], ay[i]),
+                *rho,
+                drho[i],
+                dt,
+                prm,
+            );
+            (*x, *y, *vx, *vy, *rho, *p) = (xn.x, xn.y, vn.x, vn.y, rn, pn);
+        }
+    })
+}
