@@ -10,7 +10,10 @@
 #                             every strategy, chunks 10..200 in steps of 10
 #   results/grid/             grid search at N = 1000, 10 000, 100 000, 100 steps
 #   results/all-pairs-small/  all-pairs at N = 1000, 3000, 100 steps (chart 6 beside the grid)
+#   results/wcsph/            the validated workload: wcsph, grid, R = 40 (3200 fluid
+#                             particles), 200 steps, every strategy
 #   report/                   charts, REPORT.md and two traces (rayon-chunks, rayon-spawn)
+#   report/validation/        the wcsph dam break against Martin & Moyce (1952), R = 40
 # Run it on a quiet machine: nothing else should compete for the cores while it measures.
 set -euo pipefail
 
@@ -33,6 +36,8 @@ BIN=target/release/bench-sph
 "$BIN" sweep --preset seed --neighbors all-pairs --n 1000,3000 --steps 100 \
     --strategies rayon-chunks --cores "$CORES" --chunks 50 \
     --out results/all-pairs-small --force --no-plots
+"$BIN" sweep --preset wcsph --neighbors grid --n 3200 --steps 200 \
+    --cores "$CORES" --chunks 10,50,200 --out results/wcsph --force --no-plots
 
 mkdir -p report
 "$BIN" trace --strategy rayon-chunks --cores 2 --chunks 45 --n 1000 \
@@ -42,11 +47,13 @@ mkdir -p report
 
 # The report finds the traces under report/ itself. --force: report/ also holds the
 # animation (dambreak.gif), which the report leaves untouched.
-"$BIN" report results/paper results/grid results/all-pairs-small --out report --force
+"$BIN" report results/paper results/grid results/all-pairs-small results/wcsph \
+    --out report --force
+"$BIN" validate --resolution 40 --out report/validation --force
 
 # A study measured while other work used the machine is not one to commit.
 contended=$(cat results/paper/summary.csv results/grid/summary.csv \
-    results/all-pairs-small/summary.csv | awk -F, '$NF == "true" {n++} END {print n + 0}')
+    results/all-pairs-small/summary.csv results/wcsph/summary.csv | awk -F, '$NF == "true" {n++} END {print n + 0}')
 if [ "$contended" -gt 0 ]; then
     echo "warning: $contended contended cells (see report/REPORT.md): rerun on a quiet machine" >&2
     exit 1

@@ -9,9 +9,9 @@ use serde::Serialize;
 use crate::checksum::checksum_hex;
 use crate::io::dump_csv::{self, DumpInfo};
 use crate::io::sink::Sink;
+use crate::limits;
 use crate::output::console;
 use crate::run::fault::PanicAt;
-use crate::limits;
 use crate::run::{RunError, Steps, run_timed_steps};
 use crate::solver::{Simulation, StepError};
 use crate::sph::neighbors::NeighborMode;
@@ -95,7 +95,9 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let strategy = args.parallel.strategy;
     let outcome = match args.inject_panic_at {
         None => run_timed_steps(&mut sim, strategy, &config, steps, &mut ()),
-        Some(particle) => run_timed_steps(&mut sim, strategy, &config, steps, &mut PanicAt(particle)),
+        Some(particle) => {
+            run_timed_steps(&mut sim, strategy, &config, steps, &mut PanicAt(particle))
+        }
     };
 
     let diverged = matches!(outcome, Err(RunError::Step(StepError::Diverged { .. })));
@@ -164,9 +166,16 @@ fn print_report(r: &Report, json: bool) -> anyhow::Result<()> {
         "preset {}, {} neighbours, strategy {} (cores {}, chunks {chunks})",
         r.preset, r.neighbors, r.strategy, r.cores
     ))?;
-    let walls = r.walls.map_or_else(String::new, |w| format!(" (+ {w} fixed wall particles)"));
-    let resolution = r.resolution.map_or_else(String::new, |r| format!(", resolution R = {r}"));
-    say(&format!("N = {} particles{walls}{resolution}, {} steps", r.n, r.steps))?;
+    let walls = r
+        .walls
+        .map_or_else(String::new, |w| format!(" (+ {w} fixed wall particles)"));
+    let resolution = r
+        .resolution
+        .map_or_else(String::new, |r| format!(", resolution R = {r}"));
+    say(&format!(
+        "N = {} particles{walls}{resolution}, {} steps",
+        r.n, r.steps
+    ))?;
     if let Some(t) = r.simulated_s {
         say(&format!("simulated time {t:.6} s"))?;
     }

@@ -113,7 +113,10 @@ impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
             let steps = every.max(1).min(total - done);
             let watch = Stopwatch::start();
             let ran = match until_s {
-                None => self.sim.advance_with(exec, steps, self.hooks).map(|()| steps),
+                None => self
+                    .sim
+                    .advance_with(exec, steps, self.hooks)
+                    .map(|()| steps),
                 Some(t) => self.sim.advance_until(exec, steps, t, self.hooks),
             }?;
             let elapsed = watch.stop();

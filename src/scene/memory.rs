@@ -72,7 +72,9 @@ pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
     };
     let n64 = n as u64;
     let per_particle = FIELD_NAMES.len() * size_of::<f64>() + (1 + lists_of) * size_of::<u32>();
-    let mut bytes = n64.saturating_mul(per_particle as u64).saturating_add(fluid_scratch);
+    let mut bytes = n64
+        .saturating_mul(per_particle as u64)
+        .saturating_add(fluid_scratch);
     if neighbors == NeighborMode::Grid {
         let grid_per_particle = 2 * size_of::<u32>() + 2 * size_of::<f64>();
         let bounds = physics.search_bounds(domain);

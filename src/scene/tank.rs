@@ -63,7 +63,11 @@ pub fn resolution_for(n: usize) -> usize {
     let below = ((n as f64 / 2.0).sqrt().floor() as usize).clamp(*range.start(), *range.end());
     let above = (below + 1).min(*range.end());
     let gap = |r: usize| dam_break_particles(r).abs_diff(n);
-    if gap(above) < gap(below) { above } else { below }
+    if gap(above) < gap(below) {
+        above
+    } else {
+        below
+    }
 }
 
 /// Wall particles at resolution R.
@@ -153,7 +157,10 @@ mod tests {
         for k in prm.fluid..s.len() {
             let (x, y) = (s.x[k], s.y[k]);
             let outside = x < 0.0 || x > d.width || y < 0.0;
-            assert!(outside, "wall particle {k} at ({x}, {y}) is inside the tank");
+            assert!(
+                outside,
+                "wall particle {k} at ({x}, {y}) is inside the tank"
+            );
             assert!(x > -prm.support - prm.dx && x < d.width + prm.support + prm.dx);
             assert!(y > -prm.support - prm.dx && y < d.height);
         }
@@ -166,7 +173,11 @@ mod tests {
         for k in 0..prm.fluid {
             let depth = 1.0 - s.y[k];
             let expected = prm.rho0 * 9.81 * depth;
-            assert!((s.p[k] - expected).abs() < 1e-3 * expected, "{k}: {}", s.p[k]);
+            assert!(
+                (s.p[k] - expected).abs() < 1e-3 * expected,
+                "{k}: {}",
+                s.p[k]
+            );
         }
     }
 

@@ -227,7 +227,9 @@ impl Simulation {
             (Physics::Mueller(prm), Pass::Integrate) => {
                 mueller::integrate(exec, s, prm, self.domain)
             }
-            (Physics::Wcsph(prm), Pass::MaxSpeed) => wcsph::max_speed(exec, s, &mut self.wcsph, prm),
+            (Physics::Wcsph(prm), Pass::MaxSpeed) => {
+                wcsph::max_speed(exec, s, &mut self.wcsph, prm)
+            }
             (Physics::Wcsph(prm), Pass::Neighbors) => {
                 with_search!(nb, nb => wcsph::neighbors(exec, nb, lists, s, prm))
             }

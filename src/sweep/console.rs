@@ -80,7 +80,10 @@ pub fn resolution_note(params: &SweepParams) -> Option<String> {
         .filter(|&&n| plan::particles(Preset::Wcsph, n) != n)
         .map(|&n| {
             let r = tank::resolution_for(n);
-            format!("--n {n} → R = {r} ({} fluid particles)", tank::dam_break_particles(r))
+            format!(
+                "--n {n} → R = {r} ({} fluid particles)",
+                tank::dam_break_particles(r)
+            )
         })
         .collect();
     (!mapped.is_empty()).then(|| {

@@ -23,8 +23,8 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::time::Instant;
 
-pub use crate::solver::Phase;
 use crate::solver::Pass;
+pub use crate::solver::Phase;
 
 /// One kernel call: which worker ran which chunk of which phase of which step, and when.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -55,7 +55,11 @@ pub fn max_speed<E: Executor>(
             *m = passes::max_speed_squared(&vx[lo..hi], &vy[lo..hi]);
         }
     })?;
-    let v_max = scratch.block_max.iter().fold(0.0, |m: f64, &b| m.max(b)).sqrt();
+    let v_max = scratch
+        .block_max
+        .iter()
+        .fold(0.0, |m: f64, &b| m.max(b))
+        .sqrt();
     scratch.dt = prm.time_step(v_max);
     Ok(())
 }

@@ -16,6 +16,11 @@ use crate::sph::state::Positions;
 /// have about 10, `wcsph` up to about 45 next to a wall).
 const INLINE_HITS: usize = 96;
 
+/// The most hits put in order by [`rank_sort`]: its cost grows with the square of the hits,
+/// so more (`wcsph` has about 20–45) are sorted by comparison instead. Either gives the one
+/// increasing order of distinct indices.
+const RANK_SORT_MAX: usize = 24;
+
 /// A cell list over a fixed domain.
 #[derive(Debug, Clone)]
 pub struct Grid {
@@ -165,7 +170,8 @@ impl Neighbors for Grid {
         let (cx, cy) = self.shape.coords(xi, yi);
         let (c0, c1) = (cx.saturating_sub(1), (cx + 1).min(self.shape.cols - 1));
         // Hits are collected without branching (every candidate is written, the count only
-        // advances on a hit), then put in index order by a branch-free rank sort; a row that
+        // advances on a hit), then put in index order by a branch-free rank sort (a
+        // comparison sort past RANK_SORT_MAX hits); a row that
         // would overflow the stack buffer goes to a vector, sorted once. The squared distance
         // is recomputed when a hit is visited (same formula, same bits) so that only indices
         // are moved.
@@ -191,10 +197,13 @@ impl Neighbors for Grid {
                 }));
             }
         }
-        let mut ranked = [0u32; INLINE_HITS];
-        let hits = if spilled.is_empty() {
+        let mut ranked = [0u32; RANK_SORT_MAX];
+        let hits = if spilled.is_empty() && len <= RANK_SORT_MAX {
             rank_sort(&hits[..len], &mut ranked[..len]);
             &ranked[..len]
+        } else if spilled.is_empty() {
+            hits[..len].sort_unstable();
+            &hits[..len]
         } else {
             spilled.extend_from_slice(&hits[..len]);
             spilled.sort_unstable();

@@ -37,6 +37,10 @@ pub struct WcParams {
     pub tait_b: f64,
     /// Artificial viscosity α (Monaghan), fluid–fluid pairs only.
     pub alpha: f64,
+    /// −α c0 h, m²/s: the artificial viscosity's numerator factor.
+    pub viscosity: f64,
+    /// 0.01 h², m²: keeps μ finite as r → 0.
+    pub viscosity_eps_sq: f64,
     /// Density diffusion δ (Molteni–Colagrossi), fluid–fluid pairs only.
     pub delta: f64,
     /// Wendland C2 normalisation 7 / (4π h²), 1/m².
@@ -61,6 +65,7 @@ impl WcParams {
         let g = 9.81;
         let c0 = 10.0 * (2.0 * g * (2.0 * COLUMN_WIDTH)).sqrt();
         let h2 = h * h;
+        let alpha = 0.02;
         WcParams {
             resolution,
             dx,
@@ -72,7 +77,9 @@ impl WcParams {
             gravity: DVec2::new(0.0, -g),
             c0,
             tait_b: rho0 * c0 * c0 / 7.0,
-            alpha: 0.02,
+            alpha,
+            viscosity: -alpha * c0 * h,
+            viscosity_eps_sq: 0.01 * h2,
             delta: 0.1,
             kernel_norm: 7.0 / (4.0 * PI * h2),
             gradient_norm: 35.0 / (4.0 * PI * h2 * h2),
@@ -163,7 +170,10 @@ mod tests {
             let dw_dr = (prm.kernel((r + e) * (r + e)) - prm.kernel((r - e) * (r - e))) / (2.0 * e);
             // ∇W = g r_ab, so dW/dr = g r.
             let g_r = prm.gradient_factor(r * r) * r;
-            assert!((dw_dr - g_r).abs() < 1e-6 * dw_dr.abs(), "q {q}: {dw_dr} vs {g_r}");
+            assert!(
+                (dw_dr - g_r).abs() < 1e-6 * dw_dr.abs(),
+                "q {q}: {dw_dr} vs {g_r}"
+            );
         }
         assert_eq!(prm.gradient_factor(prm.support_sq), 0.0);
     }

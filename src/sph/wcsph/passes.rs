@@ -162,8 +162,8 @@ fn momentum_term(me: &Me, own: f64, b: usize, r2: f64, f: &Fields<'_>, prm: &WcP
         let v_ab = me.v - DVec2::new(f.vx[b], f.vy[b]);
         let vr = v_ab.dot(r_ab);
         if vr < 0.0 {
-            let mu = prm.h * vr / (r2 + 0.01 * prm.h * prm.h);
-            scalar += -prm.alpha * prm.c0 * mu / (0.5 * (me.rho + rho_b));
+            // Π = −α c0 μ / ρ̄ with μ = h v·r / (r² + 0.01 h²), as one division.
+            scalar += prm.viscosity * vr / ((r2 + prm.viscosity_eps_sq) * (0.5 * (me.rho + rho_b)));
         }
     }
     (scalar * prm.gradient_factor(r2)) * r_ab
