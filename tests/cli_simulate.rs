@@ -388,3 +388,60 @@ fn ctrl_c_during_a_dumping_run_keeps_the_earlier_file_and_leaves_no_temporary() 
     assert_eq!(std::fs::read_to_string(&dump).unwrap(), "keep");
     assert_eq!(temporaries(), 0, "a temporary file was left behind");
 }
+
+#[test]
+fn wcsph_reports_its_resolution_walls_and_simulated_time() {
+    let o = run(&[
+        "simulate",
+        "--preset",
+        "wcsph",
+        "--resolution",
+        "6",
+        "--neighbors",
+        "grid",
+        "--t-end",
+        "0.01",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("one JSON object");
+    assert_eq!(v["preset"], "wcsph");
+    assert_eq!((v["n"].as_u64(), v["resolution"].as_u64()), (Some(72), Some(6)));
+    assert!(v["walls"].as_u64().unwrap() > 0);
+    // No jitter, so no seed.
+    assert!(v["seed"].is_null());
+    let t = v["simulated_s"].as_f64().unwrap();
+    let steps = v["steps"].as_u64().unwrap();
+    assert!(t >= 0.01 && steps > 1, "{t} s after {steps} steps");
+}
+
+#[test]
+fn wcsph_maps_n_to_the_nearest_resolution_and_says_so() {
+    let o = run(&["simulate", "--preset", "wcsph", "--n", "100", "--steps", "2"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_holds_all("stderr", &stderr(&o), &["resolution R = 7", "98 fluid particles"]);
+    assert_holds_all("stdout", &stdout(&o), &["N = 98 particles", "resolution R = 7"]);
+}
+
+#[test]
+fn wcsph_options_that_do_not_fit_are_clear_errors() {
+    fails_with(
+        &["simulate", "--resolution", "10", "--steps", "1"],
+        &["--resolution applies to --preset wcsph only"],
+    );
+    fails_with(
+        &["simulate", "--preset", "wcsph", "--resolution", "3"],
+        &["resolution"],
+    );
+    fails_with(&["simulate", "--t-end", "0"], &["above 0"]);
+    fails_with(
+        &["simulate", "--steps", "5", "--t-end", "1"],
+        &["cannot be used with"],
+    );
+    let (dir, _) = scratch("unused");
+    let init = write(dir.path(), "init.csv", "x,y\n100,100\n");
+    fails_with(
+        &["simulate", "--preset", "wcsph", "--init", &init],
+        &["cannot start --preset wcsph"],
+    );
+}
