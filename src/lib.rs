@@ -35,5 +35,6 @@ pub mod solver;
 pub mod sph;
 pub mod sweep;
 pub mod trace;
+pub mod validate;
 #[cfg(feature = "viewer")]
 pub mod viewer;

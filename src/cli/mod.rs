@@ -10,6 +10,7 @@ mod scene;
 mod simulate;
 mod sweep;
 mod trace;
+mod validate;
 mod values;
 #[cfg(feature = "viewer")]
 mod view;
@@ -23,6 +24,7 @@ pub use report::ReportArgs;
 pub use simulate::SimulateArgs;
 pub use sweep::SweepArgs;
 pub use trace::TraceArgs;
+pub use validate::ValidateArgs;
 
 /// bench-sph: which parallel strategy wins for a 2D SPH fluid, by how much and why.
 #[derive(Debug, Parser)]
@@ -88,6 +90,20 @@ pub enum Command {
         bench-sph trace --strategy rayon-chunks --cores 2 --chunks 45 --steps 300 --compare 5 --out /tmp/t  # tracing's cost"
     )]
     Trace(TraceArgs),
+    /// Check the wcsph dam break against Martin & Moyce (1952): surge front and column height,
+    /// three verdicts; writes surge_front.csv, column_height.csv and validation.png.
+    #[command(
+        after_help = "Runs the square column (n² = 2) to T = t·√(2g/a) = 3.4 with the grid search, \
+        samples every 0.01 s, and checks: H(τ) within 6 % for τ <= 2; the front's slope dZ/dT over \
+        T in [1.5, 2.8] within 5 %; Z within 10 % for T in [0.8, 3.0] with the simulated front shifted \
+        right by 0.175 (the experiment's gate delays its early front). Exits non-zero if a verdict \
+        fails (the files are still written).\n\n\
+        Examples:\n  \
+        bench-sph validate                               # R = 40, into validation/\n  \
+        bench-sph validate --resolution 20 --out /tmp/v --json\n  \
+        bench-sph validate --strategy crossbeam-pool --cores 2"
+    )]
+    Validate(ValidateArgs),
     /// Watch the dam break live in a window (cargo feature `viewer`).
     #[cfg(feature = "viewer")]
     #[command(
@@ -115,6 +131,7 @@ pub fn run() -> anyhow::Result<()> {
         Command::Sweep(args) => sweep::run(&args),
         Command::Report(args) => report::run(&args),
         Command::Trace(args) => trace::run(&args),
+        Command::Validate(args) => validate::run(&args),
         #[cfg(feature = "viewer")]
         Command::View(args) => view::run(&args),
     }

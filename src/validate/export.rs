@@ -1,0 +1,155 @@
+//! The validation's CSV files, and how `validate --out` recognises its own files.
+//!
+//! - `surge_front.csv`: `t_s,T,Z`, one row per sample;
+//! - `column_height.csv`: `t_s,tau,H`, one row per sample;
+//! - `validation.png`: the chart ([`super::chart`]).
+//!
+//! Numbers are written in the shortest form that parses back to the same bits.
+
+use std::io::Write;
+use std::path::Path;
+
+use anyhow::Context;
+use serde::Serialize;
+
+use super::probe::{Sample, Scales};
+use crate::output::sniff::{PNG_SIGNATURE, starts_with};
+
+/// The front's samples.
+pub const SURGE_FRONT_CSV: &str = "surge_front.csv";
+/// The column's samples.
+pub const COLUMN_HEIGHT_CSV: &str = "column_height.csv";
+/// The chart.
+pub const VALIDATION_PNG: &str = "validation.png";
+/// `surge_front.csv`'s header.
+pub const SURGE_FRONT_HEADER: &str = "t_s,T,Z";
+/// `column_height.csv`'s header.
+pub const COLUMN_HEIGHT_HEADER: &str = "t_s,tau,H";
+
+#[derive(Serialize)]
+struct FrontRow {
+    t_s: f64,
+    #[serde(rename = "T")]
+    front_time: f64,
+    #[serde(rename = "Z")]
+    front: f64,
+}
+
+#[derive(Serialize)]
+struct ColumnRow {
+    t_s: f64,
+    tau: f64,
+    #[serde(rename = "H")]
+    height: f64,
+}
+
+/// Writes `surge_front.csv`: per sample, t (s), T = t √(2g/a) and Z = x_front / a.
+pub fn write_surge_front(
+    samples: &[Sample],
+    scales: &Scales,
+    out: impl Write,
+) -> anyhow::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    for s in samples {
+        w.serialize(FrontRow {
+            t_s: s.t_s,
+            front_time: scales.front_time(s.t_s),
+            front: s.front_m / scales.a,
+        })?;
+    }
+    w.flush().context("cannot write the surge front")
+}
+
+/// Writes `column_height.csv`: per sample, t (s), τ = t √(g/a) and H = h / (2a).
+pub fn write_column_height(
+    samples: &[Sample],
+    scales: &Scales,
+    out: impl Write,
+) -> anyhow::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    for s in samples {
+        w.serialize(ColumnRow {
+            t_s: s.t_s,
+            tau: scales.column_time(s.t_s),
+            height: s.column_m / (2.0 * scales.a),
+        })?;
+    }
+    w.flush().context("cannot write the column height")
+}
+
+/// Whether `path` is a file an earlier `validate` wrote, judged by name and content: the two
+/// CSVs by their headers, the chart by its PNG signature.
+pub fn owns(path: &Path) -> bool {
+    if !path.is_file() {
+        return false;
+    }
+    let header = |h: &str| starts_with(path, format!("{h}\n").as_bytes());
+    match path.file_name().and_then(|n| n.to_str()) {
+        Some(SURGE_FRONT_CSV) => header(SURGE_FRONT_HEADER),
+        Some(COLUMN_HEIGHT_CSV) => header(COLUMN_HEIGHT_HEADER),
+        Some(VALIDATION_PNG) => starts_with(path, &PNG_SIGNATURE),
+        _ => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SCALES: Scales = Scales {
+        a: 1.0,
+        g: 2.0,
+        dx: 0.1,
+    };
+
+    fn samples() -> Vec<Sample> {
+        vec![
+            Sample {
+                t_s: 0.0,
+                front_m: 0.95,
+                column_m: 1.95,
+            },
+            Sample {
+                t_s: 0.25,
+                front_m: 1.5,
+                column_m: 1.0,
+            },
+        ]
+    }
+
+    #[test]
+    fn the_surge_front_is_t_s_t_and_z() {
+        let mut out = Vec::new();
+        write_surge_front(&samples(), &SCALES, &mut out).unwrap();
+        // T = t √(2g/a) = 2t.
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            "t_s,T,Z\n0.0,0.0,0.95\n0.25,0.5,1.5\n"
+        );
+    }
+
+    #[test]
+    fn the_column_height_is_t_s_tau_and_h() {
+        let mut out = Vec::new();
+        write_column_height(&samples(), &SCALES, &mut out).unwrap();
+        // τ = t √(g/a) = t √2, H = h / 2.
+        let tau = 0.25 * 2f64.sqrt();
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            format!("t_s,tau,H\n0.0,0.0,0.975\n0.25,{tau},0.5\n")
+        );
+    }
+
+    #[test]
+    fn only_files_with_validate_s_names_and_contents_are_owned() {
+        let tmp = tempfile::tempdir().unwrap();
+        let p = |name: &str| tmp.path().join(name);
+        std::fs::write(p(SURGE_FRONT_CSV), "t_s,T,Z\n0.0,0.0,0.95\n").unwrap();
+        std::fs::write(p(COLUMN_HEIGHT_CSV), "x,y\n").unwrap();
+        std::fs::write(p(VALIDATION_PNG), PNG_SIGNATURE).unwrap();
+        std::fs::write(p("notes.txt"), "").unwrap();
+        assert!(owns(&p(SURGE_FRONT_CSV)) && owns(&p(VALIDATION_PNG)));
+        assert!(!owns(&p(COLUMN_HEIGHT_CSV)) && !owns(&p("notes.txt")));
+        assert!(!owns(&p("missing.csv")));
+    }
+}
