@@ -1,9 +1,11 @@
-//! bench-sph: a 2D SPH dam-break solver (Müller 2003, as ported by the seed paper) behind
-//! interchangeable parallel strategies, and the tools to measure them.
+//! bench-sph: a 2D SPH dam-break solver (Müller 2003, as ported by the seed paper, and a
+//! weakly compressible SPH validated against experiment) behind interchangeable parallel
+//! strategies, and the tools to measure them.
 //!
 //! - [`sph`]: the pure physics (constants, state, neighbour search, per-particle passes);
-//! - [`solver`]: one step as three passes run by a strategy's executor;
+//! - [`solver`]: one step as the model's passes run by a strategy's executor;
 //! - [`scene`]: initial dam-break states; [`io`]: CSV in and out;
+//! - [`validate`]: the `wcsph` dam break against Martin & Moyce (1952) (`bench-sph validate`);
 //! - [`run`]: a run in one strategy session: the step loop timed (in segments, with an
 //!   observer between them), warm-up, fault injection; [`clock`], [`checksum`]: what a run
 //!   reports; [`contention`]: what the rest of the machine did meanwhile;

@@ -406,7 +406,10 @@ fn wcsph_reports_its_resolution_walls_and_simulated_time() {
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).expect("one JSON object");
     assert_eq!(v["preset"], "wcsph");
-    assert_eq!((v["n"].as_u64(), v["resolution"].as_u64()), (Some(72), Some(6)));
+    assert_eq!(
+        (v["n"].as_u64(), v["resolution"].as_u64()),
+        (Some(72), Some(6))
+    );
     assert!(v["walls"].as_u64().unwrap() > 0);
     // No jitter, so no seed.
     assert!(v["seed"].is_null());
@@ -417,10 +420,20 @@ fn wcsph_reports_its_resolution_walls_and_simulated_time() {
 
 #[test]
 fn wcsph_maps_n_to_the_nearest_resolution_and_says_so() {
-    let o = run(&["simulate", "--preset", "wcsph", "--n", "100", "--steps", "2"]);
+    let o = run(&[
+        "simulate", "--preset", "wcsph", "--n", "100", "--steps", "2",
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_holds_all("stderr", &stderr(&o), &["resolution R = 7", "98 fluid particles"]);
-    assert_holds_all("stdout", &stdout(&o), &["N = 98 particles", "resolution R = 7"]);
+    assert_holds_all(
+        "stderr",
+        &stderr(&o),
+        &["resolution R = 7", "98 fluid particles"],
+    );
+    assert_holds_all(
+        "stdout",
+        &stdout(&o),
+        &["N = 98 particles", "resolution R = 7"],
+    );
 }
 
 #[test]
