@@ -341,3 +341,123 @@ fn a_render_larger_than_the_available_memory_is_refused_before_anything_is_writt
     );
     assert!(names(dir.path()).is_empty());
 }
+
+/// `render --preset wcsph --resolution 8` (128 fluid particles) with `more` arguments, in `dir`.
+fn wcsph_render(dir: &Path, more: &[&str]) -> String {
+    let base = [
+        "render",
+        "--preset",
+        "wcsph",
+        "--resolution",
+        "8",
+        "--width",
+        "400",
+    ];
+    succeeds(dir, &[&base[..], more].concat())
+}
+
+#[test]
+fn wcsph_renders_three_frames_to_a_gif_of_the_reported_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = wcsph_render(
+        dir.path(),
+        &["--steps", "40", "--every", "20", "--out", "w.gif"],
+    );
+    assert!(out.contains("3 frames"), "{out}");
+    assert!(out.contains("steps 0 to 40, one every 20"), "{out}");
+    assert!(out.contains("simulated time 0 to 0.0"), "{out}");
+    let (width, height) = reported_size(&out);
+    assert_eq!(width, 400);
+    let gif = decode_gif(&dir.path().join("w.gif"));
+    assert_eq!(gif.size, (400, height as u16));
+    assert_eq!(gif.frames.len(), 3);
+    // The tank with its walls, 5.75 m × 2.875 m at R = 8, sets the height.
+    assert!(height > 200 && height < 400, "{height}");
+}
+
+#[test]
+fn wcsph_renders_png_frames_coloured_by_speed_with_grey_walls() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = wcsph_render(
+        dir.path(),
+        &["--steps", "40", "--every", "20", "--frames", "f"],
+    );
+    let size = reported_size(&out);
+    assert_eq!(
+        names(&dir.path().join("f")),
+        ["frame_00000.png", "frame_00001.png", "frame_00002.png"]
+    );
+    let decode = |name: &str| {
+        let file =
+            std::io::BufReader::new(std::fs::File::open(dir.path().join("f").join(name)).unwrap());
+        let mut reader = png::Decoder::new(file).read_info().expect("a PNG");
+        let info = reader.info();
+        assert_eq!((info.width, info.height), size, "{name}");
+        let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+        reader.next_frame(&mut pixels).unwrap();
+        pixels
+    };
+    // Viridis' lowest colour: the fluid at rest (and the legend bar's first columns).
+    let still = |pixels: &[u8]| pixels.chunks_exact(3).filter(|p| *p == [68, 1, 84]).count();
+    let first = decode("frame_00000.png");
+    let last = decode("frame_00002.png");
+    assert!(
+        first.chunks_exact(3).any(|p| p == [168, 168, 168]),
+        "the wall particles are grey"
+    );
+    // At rest the whole fluid is the lowest colour; 40 steps later it falls, faster.
+    let (at_rest, falling) = (still(&first), still(&last));
+    assert!(
+        at_rest > 1000 && falling < at_rest / 2,
+        "{at_rest} → {falling}"
+    );
+}
+
+#[test]
+fn wcsph_renders_until_a_simulated_time_and_the_frame_count_follows() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = wcsph_render(
+        dir.path(),
+        &["--t-end", "0.01", "--every", "4", "--out", "t.gif"],
+    );
+    // R = 8: dt = 0.25 h / (c0 + v) ≈ 0.65 ms, so about 16 steps reach 10 ms: frames at 0, 4,
+    // …, and at the step that reaches it.
+    let frames: usize = out.split_whitespace().next().unwrap().parse().unwrap();
+    let steps: usize = out
+        .split_once("steps 0 to ")
+        .and_then(|(_, rest)| rest.split(',').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((15..40).contains(&steps), "{out}");
+    assert_eq!(frames, steps.div_ceil(4) + 1, "{out}");
+    assert_eq!(decode_gif(&dir.path().join("t.gif")).frames.len(), frames);
+    let simulated: f64 = out
+        .split_once("simulated time 0 to ")
+        .and_then(|(_, rest)| rest.split_whitespace().next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((0.01..0.0107).contains(&simulated), "{out}");
+}
+
+#[test]
+fn t_end_renders_the_mueller_presets_at_their_fixed_time_step() {
+    let dir = tempfile::tempdir().unwrap();
+    // seed: dt = 0.0009 s, so the 10th step is the first past 0.0085 s: frames at 0, 5, 10.
+    let out = succeeds(
+        dir.path(),
+        &[
+            "render", "--n", "30", "--t-end", "0.0085", "--every", "5", "--out", "m.gif",
+        ],
+    );
+    assert!(out.contains("3 frames"), "{out}");
+    assert!(out.contains("steps 0 to 10,"), "{out}");
+    assert_eq!(decode_gif(&dir.path().join("m.gif")).frames.len(), 3);
+    fails_with_in(
+        dir.path(),
+        &["render", "--t-end", "1", "--steps", "10"],
+        &["--t-end", "--steps", "cannot be used with"],
+    );
+    fails_with_in(dir.path(), &["render", "--t-end", "0"], &["--t-end"]);
+}

@@ -2,7 +2,12 @@
 //!
 //! Frame 0 is the initial state; then one frame every `--every` steps, so `--steps S
 //! --every K` gives `floor(S / K) + 1` frames and runs `floor(S / K) · K` steps (steps past
-//! the last frame would not be seen, so they are not run).
+//! the last frame would not be seen, so they are not run). With `--t-end T` instead, frames
+//! come every `--every` steps until the first step whose simulated time reaches T, which
+//! gets the last frame: as many frames as that takes (`wcsph`'s time step adapts).
+//!
+//! Müller's presets are drawn in their pixel units, as the seed program showed them; `wcsph`
+//! in metres, its wall particles included (see [`crate::render::frame`]).
 
 use std::io::IsTerminal;
 use std::ops::ControlFlow;
@@ -13,12 +18,14 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::simulate::say;
 use crate::clock::Elapsed;
-use crate::render::frame::{Caption, MAX_WIDTH, MIN_WIDTH, Painter};
+use crate::limits;
+use crate::output::console;
+use crate::render::frame::{Caption, MAX_WIDTH, MIN_WIDTH, Painter, View};
 use crate::render::output::Output;
 use crate::render::scale::{ColorBy, Scale};
 use crate::run::{Observer, Steps, run_steps};
 use crate::solver::Simulation;
-use crate::sph::params::Preset;
+use crate::sph::physics::Physics;
 
 /// Where the GIF goes when neither `--out` nor `--frames` is given.
 const DEFAULT_OUT: &str = "dambreak.gif";
@@ -38,6 +45,10 @@ pub struct RenderArgs {
     /// Number of steps to show (frames at steps 0, K, 2K, … up to this).
     #[arg(long, default_value_t = 1000, value_parser = super::steps)]
     pub steps: usize,
+    /// Show this much simulated time instead of a number of steps (s, 0 < T <= 100): frames
+    /// every K steps, the last one after the first step that reaches T.
+    #[arg(long, value_name = "SECONDS", value_parser = super::t_end, conflicts_with = "steps")]
+    pub t_end: Option<f64>,
     /// One frame every K steps.
     #[arg(long, value_name = "K", default_value_t = 10, value_parser = super::positive)]
     pub every: usize,
@@ -70,40 +81,48 @@ pub struct RenderArgs {
 /// Runs `render`.
 pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     let scene = args.scene.scene()?;
-    let crate::sph::physics::Physics::Mueller(params) = scene.physics else {
-        anyhow::bail!("render does not draw --preset wcsph yet");
-    };
-    let (state, domain) = (scene.state, scene.domain);
-    let scale = Scale::new(args.color, &params, &state);
-    let painter = Painter::new(domain, params.h, scale, args.width);
+    if let Some(note) = args.scene.resolution_note() {
+        console::warn(&note);
+    }
+    let scale = Scale::new(args.color, &scene.physics, &scene.state);
+    let painter = Painter::new(View::of(&scene.physics, scene.domain), scale, args.width);
     let (width, height) = (painter.layout().width, painter.layout().height);
 
     // Open the output before simulating, so a bad path costs nothing.
     let mut output = open_output(args, &painter)?;
 
-    let frames = args.steps / args.every + 1;
-    let n = state.len();
+    let steps = match args.t_end {
+        None => Steps {
+            total: args.steps / args.every * args.every,
+            every: args.every,
+            warmup: 0,
+            until_s: None,
+        },
+        Some(t) => Steps {
+            total: limits::MAX_STEPS,
+            every: args.every,
+            warmup: 0,
+            until_s: Some(t),
+        },
+    };
+    // Particles that move: what a step costs (wcsph's walls are fixed).
+    let fluid = scene.fluid();
+    let bar = progress_bar(args, &scene.physics, fluid);
     let config = args.parallel.config();
-    let mut sim = Simulation::new(params, domain, state, args.scene.neighbors);
-    let bar = progress_bar(frames, n * args.steps);
+    let mut sim = scene.simulate(args.scene.neighbors);
     let started = std::time::Instant::now();
 
-    output.push(&painter.draw(&sim.state, &Caption::at(0, n, args.scene.preset)))?;
+    output.push(&painter.draw(&sim.state, &Caption::of(&sim)))?;
     bar.inc(1);
     let mut drawn = Frames {
         painter: &painter,
-        preset: args.scene.preset,
         output: &mut output,
         bar: &bar,
+        t_end: args.t_end,
+        frames: 1,
         shown: 0,
         simulating_s: 0.0,
         failed: None,
-    };
-    let steps = Steps {
-        total: (frames - 1) * args.every,
-        every: args.every,
-        warmup: 0,
-        until_s: None,
     };
     // All frames in one session: one thread pool for the whole animation.
     let outcome = run_steps(
@@ -114,7 +133,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         &mut (),
         &mut drawn,
     );
-    let (shown, simulating_s) = (drawn.shown, drawn.simulating_s);
+    let (frames, shown, simulating_s) = (drawn.frames, drawn.shown, drawn.simulating_s);
     if let Some(err) = drawn.failed {
         return Err(err);
     }
@@ -124,8 +143,13 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     if let Err(err) = outcome {
         anyhow::bail!("{err} (the frames up to step {shown} are in {place})");
     }
+    // Müller's captions count steps of a fixed dt; wcsph's time is worth saying.
+    let time = match (sim.physics, args.t_end) {
+        (Physics::Mueller(_), None) => String::new(),
+        _ => format!(", simulated time 0 to {:.4} s", Caption::of(&sim).time_s),
+    };
     say(&format!(
-        "{frames} frames of {width} × {height} px (steps 0 to {}, one every {}) written to {place}",
+        "{frames} frames of {width} × {height} px (steps 0 to {}, one every {}{time}) written to {place}",
         sim.steps_done, args.every
     ))?;
     say(&format!(
@@ -150,9 +174,12 @@ fn open_output(args: &RenderArgs, painter: &Painter) -> anyhow::Result<Output> {
 /// the steps took.
 struct Frames<'a> {
     painter: &'a Painter,
-    preset: Preset,
     output: &'a mut Output,
     bar: &'a ProgressBar,
+    /// `--t-end`: the bar then counts simulated time, ms, rather than frames.
+    t_end: Option<f64>,
+    /// Frames written so far.
+    frames: usize,
     /// The step of the last frame written.
     shown: usize,
     /// Wall time of the steps so far, s.
@@ -164,29 +191,51 @@ struct Frames<'a> {
 impl Observer for Frames<'_> {
     fn segment(&mut self, sim: &Simulation, elapsed: Elapsed) -> ControlFlow<()> {
         self.simulating_s += elapsed.wall_s;
-        let frame = self.painter.draw(
-            &sim.state,
-            &Caption::at(sim.steps_done, sim.state.len(), self.preset),
-        );
+        let frame = self.painter.draw(&sim.state, &Caption::of(sim));
         if let Err(err) = self.output.push(&frame) {
             self.failed = Some(err);
             return ControlFlow::Break(());
         }
+        self.frames += 1;
         self.shown = sim.steps_done;
-        self.bar.inc(1);
+        match self.t_end {
+            None => self.bar.inc(1),
+            Some(t) => self.bar.set_position(milliseconds(sim.time_s.min(t))),
+        }
         ControlFlow::Continue(())
     }
 }
 
-/// A bar counting frames on stderr; hidden when stderr is not a terminal or the render is tiny.
-fn progress_bar(frames: usize, particle_steps: usize) -> ProgressBar {
-    if particle_steps < PROGRESS_FROM_PARTICLE_STEPS || !std::io::stderr().is_terminal() {
+/// A bar on stderr counting frames, or with `--t-end` simulated milliseconds; hidden when
+/// stderr is not a terminal or the render is tiny (estimated from the first time step for
+/// `--t-end`: wcsph's shrinks by at most a tenth as the flow speeds up).
+fn progress_bar(args: &RenderArgs, physics: &Physics, fluid: usize) -> ProgressBar {
+    let steps = match (args.t_end, physics) {
+        (None, _) => args.steps,
+        (Some(t), Physics::Mueller(p)) => (t / p.dt) as usize,
+        (Some(t), Physics::Wcsph(p)) => (t / p.time_step(0.0)) as usize,
+    };
+    if fluid.saturating_mul(steps) < PROGRESS_FROM_PARTICLE_STEPS
+        || !std::io::stderr().is_terminal()
+    {
         return ProgressBar::hidden();
     }
-    let bar = ProgressBar::with_draw_target(Some(frames as u64), ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {elapsed} (eta {eta})")
-            .expect("the template is valid"),
-    );
+    let (len, template) = match args.t_end {
+        None => (
+            (args.steps / args.every + 1) as u64,
+            "{bar:40} {pos}/{len} frames, {elapsed} (eta {eta})",
+        ),
+        Some(t) => (
+            milliseconds(t),
+            "{bar:40} {pos}/{len} ms simulated, {elapsed} (eta {eta})",
+        ),
+    };
+    let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::stderr());
+    bar.set_style(ProgressStyle::with_template(template).expect("the template is valid"));
     bar
+}
+
+/// `seconds` in whole milliseconds, for the progress bar.
+fn milliseconds(seconds: f64) -> u64 {
+    (seconds * 1000.0).round() as u64
 }

@@ -19,7 +19,8 @@ const TARGET_FPS: usize = 60;
 
 /// Opens the window and runs until it is closed.
 pub fn run(settings: Settings) -> anyhow::Result<()> {
-    let mut scene = Scene::new(settings);
+    let n = settings.n;
+    let mut scene = Scene::new(settings).with_context(|| format!("no memory for {n} particles"))?;
     let first = scene.draw();
     let options = WindowOptions {
         resize: true,

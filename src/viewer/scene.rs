@@ -1,17 +1,18 @@
 //! What the viewer shows and how keys change it, without a window: a simulation, the painter
 //! for its tank, and the settings the keys cycle through.
 
+use std::collections::TryReserveError;
+
 use sph_strategies::{Config, StrategyName};
 
-use crate::render::frame::{Caption, Painter};
+use crate::render::frame::{Caption, Painter, View};
 use crate::render::image::Image;
 use crate::render::scale::{ColorBy, Scale};
 use crate::render::text;
-use crate::scene::dam_break;
-use crate::solver::Simulation;
+use crate::scene::Scene as DamBreak;
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
-use crate::sph::state::State;
+use crate::sph::physics::Physics;
 use crate::viewer::stepper::Stepper;
 
 /// Fewest and most particles `+`/`-` reach.
@@ -22,7 +23,8 @@ pub const N_RANGE: (usize, usize) = (10, 1_000_000);
 pub struct Settings {
     /// Constants and integration order.
     pub preset: Preset,
-    /// Number of particles (`+` doubles, `-` halves).
+    /// Number of particles (`+` doubles, `-` halves); for `wcsph`, the fluid particles: the
+    /// resolution whose dam break has the nearest count is used.
     pub n: usize,
     /// Seed of the initial jitter.
     pub seed: u64,
@@ -61,6 +63,7 @@ pub enum Action {
 pub struct Scene {
     settings: Settings,
     sim: Stepper,
+    looks: Looks,
     painter: Painter,
     paused: bool,
     /// Steps per second of the last advance, wall clock.
@@ -70,17 +73,18 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// The dam break of `settings`, at step 0, running.
-    pub fn new(settings: Settings) -> Scene {
-        let (sim, painter) = build(&settings);
-        Scene {
+    /// The dam break of `settings`, at step 0, running; an error if there is no memory for it.
+    pub fn new(settings: Settings) -> Result<Scene, TryReserveError> {
+        let (sim, looks) = build(&settings)?;
+        Ok(Scene {
+            painter: looks.painter(&settings),
             settings,
             sim,
-            painter,
+            looks,
             paused: false,
             rate: None,
             failure: None,
-        }
+        })
     }
 
     /// The settings now.
@@ -118,13 +122,22 @@ impl Scene {
                     ColorBy::Speed => ColorBy::Density,
                     ColorBy::Density => ColorBy::Speed,
                 };
-                self.painter = painter(s, &dam_break::initial_state(s.preset, s.n, s.seed));
+                self.painter = self.looks.painter(s);
                 return;
             }
         }
         if action != Action::TogglePause {
-            (self.sim, self.painter) = build(&self.settings);
-            (self.rate, self.failure) = (None, None);
+            match build(&self.settings) {
+                Ok((sim, looks)) => {
+                    self.painter = looks.painter(&self.settings);
+                    (self.sim, self.looks) = (sim, looks);
+                    (self.rate, self.failure) = (None, None);
+                }
+                Err(err) => {
+                    let n = self.settings.n;
+                    self.failure = Some(format!("no memory for N = {n} ({err}): press -"));
+                }
+            }
         }
     }
 
@@ -143,7 +156,12 @@ impl Scene {
     /// The frame on screen: the rendered state with two status lines below it.
     pub fn draw(&self) -> Image {
         let (state, step) = self.sim.shown();
-        let caption = Caption::at(step, state.len(), self.settings.preset);
+        let caption = Caption::new(
+            &self.looks.physics,
+            step,
+            self.sim.shown_time_s(),
+            state.len(),
+        );
         let frame = self.painter.draw(state, &caption);
         let em = self.painter.layout().font_px;
         let line = (1.5 * em).round() as u32;
@@ -164,7 +182,7 @@ impl Scene {
             s.strategy, s.neighbors
         );
         let keys = "space pause · r reset · +/- N · s strategy · c colour · q quit";
-        let x = f64::from(self.painter.layout().tank.x0);
+        let x = f64::from(self.painter.layout().text_x);
         let first = f64::from(frame.height) + f64::from(line) * 0.8;
         text::draw(&mut img, &status, (x, first), em, [0; 3]);
         text::draw(&mut img, keys, (x, first + f64::from(line)), em, [96; 3]);
@@ -172,20 +190,38 @@ impl Scene {
     }
 }
 
-/// A fresh simulation, stepping on `s`'s strategy, and its painter.
-fn build(s: &Settings) -> (Stepper, Painter) {
-    let state = dam_break::initial_state(s.preset, s.n, s.seed);
-    let painter = painter(s, &state);
-    let domain = dam_break::domain(s.preset, s.n);
-    let sim = Simulation::new(s.preset.params(), domain, state, s.neighbors);
-    (Stepper::new(sim, s.strategy, s.config, s.every), painter)
+/// How a scene is drawn: its model, its view and the colour scales `c` switches between,
+/// fixed by the initial state.
+struct Looks {
+    physics: Physics,
+    view: View,
+    speed: Scale,
+    density: Scale,
 }
 
-/// The painter for `s`, whose colour scale is fixed by the `initial` state.
-fn painter(s: &Settings, initial: &State) -> Painter {
-    let params = s.preset.params();
-    let scale = Scale::new(s.color, &params, initial);
-    Painter::new(dam_break::domain(s.preset, s.n), params.h, scale, s.width)
+impl Looks {
+    /// The painter for `s`'s colour and width.
+    fn painter(&self, s: &Settings) -> Painter {
+        let scale = match s.color {
+            ColorBy::Speed => self.speed,
+            ColorBy::Density => self.density,
+        };
+        Painter::new(self.view, scale, s.width)
+    }
+}
+
+/// A fresh dam break of `s` (through [`DamBreak::dam_break`], as the commands build it),
+/// stepping on `s`'s strategy, and how to draw it.
+fn build(s: &Settings) -> Result<(Stepper, Looks), TryReserveError> {
+    let scene = DamBreak::dam_break(s.preset, s.n, s.seed)?;
+    let looks = Looks {
+        physics: scene.physics,
+        view: View::of(&scene.physics, scene.domain),
+        speed: Scale::new(ColorBy::Speed, &scene.physics, &scene.state),
+        density: Scale::new(ColorBy::Density, &scene.physics, &scene.state),
+    };
+    let sim = scene.simulate(s.neighbors);
+    Ok((Stepper::new(sim, s.strategy, s.config, s.every), looks))
 }
 
 #[cfg(test)]
@@ -211,7 +247,7 @@ mod tests {
 
     #[test]
     fn a_running_scene_advances_and_a_paused_one_does_not() {
-        let mut scene = Scene::new(settings());
+        let mut scene = Scene::new(settings()).unwrap();
         scene.advance();
         assert_eq!(scene.steps_done(), 3);
         scene.apply(Action::TogglePause);
@@ -224,7 +260,7 @@ mod tests {
 
     #[test]
     fn reset_and_particle_keys_rebuild_the_scene_from_step_zero() {
-        let mut scene = Scene::new(settings());
+        let mut scene = Scene::new(settings()).unwrap();
         scene.advance();
         scene.apply(Action::Reset);
         assert_eq!((scene.steps_done(), scene.settings().n), (0, 100));
@@ -238,7 +274,7 @@ mod tests {
 
     #[test]
     fn the_strategy_key_visits_every_strategy_and_comes_back() {
-        let mut scene = Scene::new(settings());
+        let mut scene = Scene::new(settings()).unwrap();
         let mut seen = vec![scene.settings().strategy];
         for _ in 1..StrategyName::ALL.len() {
             scene.apply(Action::NextStrategy);
@@ -256,7 +292,7 @@ mod tests {
 
     #[test]
     fn the_screen_is_the_frame_with_two_status_lines_below() {
-        let scene = Scene::new(settings());
+        let scene = Scene::new(settings()).unwrap();
         let img = scene.draw();
         let frame = scene.painter.layout();
         assert_eq!(img.width, frame.width);
@@ -266,5 +302,28 @@ mod tests {
             .filter(|&(x, y)| img.pixel(x, y)[0] < 128)
             .count();
         assert!(inked > 100, "{inked}");
+    }
+
+    #[test]
+    fn a_wcsph_scene_runs_and_draws_its_time_and_walls() {
+        let wcsph = Settings {
+            preset: Preset::Wcsph,
+            n: 128,
+            ..settings()
+        };
+        let mut scene = Scene::new(wcsph).unwrap();
+        scene.advance();
+        assert_eq!(scene.steps_done(), 3);
+        assert!(scene.sim.shown_time_s() > 0.0);
+        let img = scene.draw();
+        let grey = crate::render::frame::WALL_PARTICLE;
+        assert!(
+            img.pixels.chunks_exact(3).any(|p| p == grey),
+            "wall particles"
+        );
+        scene.apply(Action::NextColor);
+        scene.apply(Action::MoreParticles);
+        assert_eq!((scene.steps_done(), scene.settings().n), (0, 256));
+        scene.draw();
     }
 }

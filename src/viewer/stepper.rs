@@ -19,8 +19,9 @@ use crate::run::{Observer, RunError, Steps, run_steps};
 use crate::solver::Simulation;
 use crate::sph::state::State;
 
-/// What the observer hands back after each segment: the state, its step, the wall time, s.
-type Segment = (State, usize, f64);
+/// What the observer hands back after each segment: the state, its step, the simulated time
+/// and the wall time of the segment, s.
+type Segment = (State, usize, f64, f64);
 
 /// A session in progress on its own thread, which gives the simulation back when it ends.
 struct Session {
@@ -38,8 +39,8 @@ pub struct Stepper {
     /// The simulation while no session holds it.
     idle: Option<Simulation>,
     session: Option<Session>,
-    /// The state after the last segment, and its step.
-    shown: (State, usize),
+    /// The state after the last segment, its step and its simulated time, s.
+    shown: (State, usize, f64),
 }
 
 /// The run's observer: sends each segment's state and waits for the next request.
@@ -50,7 +51,12 @@ struct Relay {
 
 impl Observer for Relay {
     fn segment(&mut self, sim: &Simulation, elapsed: Elapsed) -> ControlFlow<()> {
-        let segment = (sim.state.clone(), sim.steps_done, elapsed.wall_s);
+        let segment = (
+            sim.state.clone(),
+            sim.steps_done,
+            sim.time_s,
+            elapsed.wall_s,
+        );
         if self.done.send(segment).is_ok() && self.ask.recv().is_ok() {
             ControlFlow::Continue(())
         } else {
@@ -66,7 +72,7 @@ impl Stepper {
             strategy,
             config,
             every,
-            shown: (sim.state.clone(), sim.steps_done),
+            shown: (sim.state.clone(), sim.steps_done, sim.time_s),
             idle: Some(sim),
             session: None,
         }
@@ -75,6 +81,11 @@ impl Stepper {
     /// The state after the last step, and the steps done.
     pub fn shown(&self) -> (&State, usize) {
         (&self.shown.0, self.shown.1)
+    }
+
+    /// The simulated time of the state shown, s.
+    pub fn shown_time_s(&self) -> f64 {
+        self.shown.2
     }
 
     /// Runs the next `every` steps and returns their wall time, s. After an error the state
@@ -93,8 +104,8 @@ impl Stepper {
             _ => None,
         };
         match segment {
-            Some((state, steps_done, wall_s)) => {
-                self.shown = (state, steps_done);
+            Some((state, steps_done, time_s, wall_s)) => {
+                self.shown = (state, steps_done, time_s);
                 Ok(wall_s)
             }
             None => self.end(),
@@ -162,7 +173,7 @@ impl Stepper {
             .thread
             .join()
             .unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        self.shown = (sim.state.clone(), sim.steps_done);
+        self.shown = (sim.state.clone(), sim.steps_done, sim.time_s);
         self.idle = Some(sim);
         result.map(|()| 0.0)
     }
