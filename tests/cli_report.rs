@@ -253,3 +253,57 @@ fn a_sweep_without_no_plots_writes_its_charts_and_report() {
         assert_eq!(png_size(&dir.join(name)), (WIDTH, HEIGHT), "{name}");
     }
 }
+
+#[test]
+fn a_toy_and_a_wcsph_sweep_get_a_ranking_comparison_and_one_preset_alone_does_not() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = |name: &str| tmp.path().join(name);
+    // Cells in plan order: seq, rayon-chunks at 1 and 2 cores, std-static at 1 and 2 cores,
+    // three trials each. At 2 cores rayon-chunks wins the toy workload and std-static wcsph,
+    // both well beyond the trial spread.
+    let (fast, slow) = ("0.5,0.51,0.49", "0.7,0.71,0.69");
+    let one_core = "1.0,1.02,0.98";
+    for (name, preset, n, rayon, static_) in [
+        ("toy", "seed", 200, fast, slow),
+        ("wcsph", "wcsph", 128, slow, fast),
+    ] {
+        let timings = [one_core, one_core, rayon, one_core, static_].join(",");
+        let o = sweep_into(
+            &dir(name),
+            &format!(
+                "--preset {preset} --neighbors grid --n {n} --steps 3 --trials 3 --warmup 0 \
+                 --cores 1..2 --chunks 4 --strategies rayon-chunks,std-static --no-plots \
+                 --fake-timings {timings}"
+            ),
+        );
+        assert!(
+            o.status.success(),
+            "{}\n{}",
+            text(&o.stdout),
+            text(&o.stderr)
+        );
+    }
+    let path = |name: &str| dir(name).to_str().unwrap().to_owned();
+    report(&[&path("toy"), &path("wcsph"), "--out", &path("both")]);
+    let md = std::fs::read_to_string(dir("both").join("REPORT.md")).unwrap();
+    assert_holds_all(
+        "REPORT.md",
+        &md,
+        &[
+            "## Toy vs real workload: does the ranking hold?",
+            "### wcsph preset, grid, N = 128, 3 steps against seed preset, grid, N = 200, 3 steps",
+            "| rayon-chunks | 1 · 2.00×",
+            "At 2 cores, the winner changes: **rayon-chunks** is fastest on the toy workload \
+             and **std-static** on wcsph",
+            "Moved up on wcsph, with the 95 % intervals apart on both workloads: std-static \
+             (past rayon-chunks); moved down: rayon-chunks.",
+            "## wcsph preset, grid, N = 128, 3 steps",
+        ],
+    );
+    for alone in ["toy", "wcsph"] {
+        let out = format!("{alone}-alone");
+        report(&[&path(alone), "--out", &path(&out)]);
+        let md = std::fs::read_to_string(dir(&out).join("REPORT.md")).unwrap();
+        assert!(!md.contains("Toy vs real workload"), "{md}");
+    }
+}

@@ -81,6 +81,9 @@ pub fn render(input: &Input<'_>) -> String {
     }
     banners(&mut md, input.sweeps, &rows);
     machine(&mut md, input.sweeps);
+    md.push_str(&super::workloads::markdown(
+        super::workloads::section(&rows).as_ref(),
+    ));
     for g in series::groups(&rows) {
         group(&mut md, &rows, &g, input);
     }

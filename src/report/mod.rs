@@ -19,6 +19,9 @@
 //! and per preset, where both neighbour searches were measured:
 //! 6. all-pairs against grid, seconds per step against N.
 //!
+//! Where the rows hold both the toy workload (`seed`/`cpp`) and `wcsph`, REPORT.md compares
+//! the strategy ranking of the two ([`workloads`]) before the groups' sections.
+//!
 //! A chart that does not apply (no chunked strategy, a single core count, one neighbour
 //! search) is not drawn; `REPORT.md` says so. Failed cells enter no chart or table; the report
 //! lists them with their reason.
@@ -31,6 +34,7 @@ pub mod paper;
 pub mod plan;
 pub mod series;
 pub mod traces;
+pub mod workloads;
 
 use std::path::{Path, PathBuf};
 
