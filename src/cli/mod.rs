@@ -42,7 +42,8 @@ pub enum Command {
     #[command(after_help = "Examples:\n  \
         bench-sph simulate                               # the paper's run: seed preset, N = 1000, 1000 steps\n  \
         bench-sph simulate --neighbors grid --n 100000 --steps 10\n  \
-        bench-sph simulate --steps 100 --dump final.csv --json")]
+        bench-sph simulate --steps 100 --dump final.csv --json\n  \
+        bench-sph simulate --preset wcsph --resolution 40 --neighbors grid --t-end 0.5  # SI units, 0.5 s")]
     Simulate(SimulateArgs),
     /// List the parallel strategies, one per line: name, then what it does.
     List,
@@ -52,7 +53,8 @@ pub enum Command {
         Examples:\n  \
         bench-sph render                                 # seed preset, N = 1000, 1000 steps -> dambreak.gif\n  \
         bench-sph render --every 15 --color density --out density.gif\n  \
-        bench-sph render --n 100 --steps 200 --frames frames/  # PNG frames instead"
+        bench-sph render --n 100 --steps 200 --frames frames/  # PNG frames instead\n  \
+        bench-sph render --preset wcsph --resolution 40 --neighbors grid --t-end 1 --every 40 --out wcsph.gif"
     )]
     Render(RenderArgs),
     /// Measure every strategy over a cores × chunks grid: trials.csv, summary.csv, meta.json.
