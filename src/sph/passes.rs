@@ -7,7 +7,7 @@ use glam::DVec2;
 
 use super::neighbors::{Neighbors, distance_squared};
 use super::params::{Integrator, Params};
-use super::state::{Domain, Positions};
+use super::state::{Domain, Fields, Positions};
 
 /// Density (Müller 2003 eq. 3 with the poly6 kernel, eq. 20; self term included) and
 /// pressure `GAS_CONST · (rho − REST_DENS)` (eq. 12) of particle `i`, plus the number of its
@@ -38,22 +38,7 @@ pub fn density_pressure(
     (rho, prm.gas_const * (rho - prm.rest_density), count as u32)
 }
 
-/// Read-only inputs of the force pass.
-#[derive(Debug, Clone, Copy)]
-pub struct ForceInputs<'a> {
-    /// Positions.
-    pub pos: Positions<'a>,
-    /// Velocity x of every particle.
-    pub vx: &'a [f64],
-    /// Velocity y of every particle.
-    pub vy: &'a [f64],
-    /// Density of every particle, from this step's first pass.
-    pub rho: &'a [f64],
-    /// Pressure of every particle, from this step's first pass.
-    pub p: &'a [f64],
-}
-
-/// Force on particle `i`: pressure (Müller 2003 eq. 10 with the spiky gradient, eq. 21) plus
+/// Force on particle `i` from this step's densities and pressures in `input`: pressure (Müller 2003 eq. 10 with the spiky gradient, eq. 21) plus
 /// viscosity (eq. 14 with the viscosity Laplacian, eq. 22) over j ≠ i with `r < H`, in index
 /// order, plus `G · rho_i`.
 ///
@@ -65,7 +50,7 @@ pub struct ForceInputs<'a> {
 #[inline]
 pub fn force(
     i: usize,
-    input: &ForceInputs<'_>,
+    input: &Fields<'_>,
     neighbors: Option<&[u32]>,
     nb: &impl Neighbors,
     prm: &Params,
@@ -108,7 +93,7 @@ fn add_pair_force(
     me: &Particle,
     j: usize,
     r2: f64,
-    input: &ForceInputs<'_>,
+    input: &Fields<'_>,
     prm: &Params,
 ) {
     // r2 < HSQ can still round to r = H: the sources decide on r.

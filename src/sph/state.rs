@@ -147,6 +147,39 @@ fn first_non_finite(values: &[f64]) -> Option<usize> {
     })
 }
 
+/// Read-only fields of every particle, as the passes that sum over neighbours see them.
+#[derive(Debug, Clone, Copy)]
+pub struct Fields<'a> {
+    /// Positions.
+    pub pos: Positions<'a>,
+    /// Velocity x of every particle.
+    pub vx: &'a [f64],
+    /// Velocity y of every particle.
+    pub vy: &'a [f64],
+    /// Density of every particle.
+    pub rho: &'a [f64],
+    /// Pressure of every particle.
+    pub p: &'a [f64],
+}
+
+impl<'a> Fields<'a> {
+    /// The fields of these arrays (one entry per particle each).
+    pub fn new(
+        (x, y): (&'a [f64], &'a [f64]),
+        (vx, vy): (&'a [f64], &'a [f64]),
+        rho: &'a [f64],
+        p: &'a [f64],
+    ) -> Fields<'a> {
+        Fields {
+            pos: Positions { x, y },
+            vx,
+            vy,
+            rho,
+            p,
+        }
+    }
+}
+
 /// Read-only positions, as the neighbour searches and passes see them.
 #[derive(Debug, Clone, Copy)]
 pub struct Positions<'a> {

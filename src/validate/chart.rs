@@ -239,12 +239,7 @@ fn draw_panel(area: &Area<'_>, panel: &Panel) -> DrawResult {
 mod tests {
     use super::*;
     use crate::output::sniff::PNG_SIGNATURE;
-
-    fn pts(v: &[(f64, f64)]) -> Vec<Point> {
-        v.iter()
-            .map(|&(time, value)| Point { time, value })
-            .collect()
-    }
+    use crate::validate::verdict::pts;
 
     #[test]
     fn the_plan_keeps_the_experiment_inside_the_axes_and_shifts_the_front() {

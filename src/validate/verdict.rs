@@ -253,15 +253,17 @@ pub fn slope(points: &[Point]) -> f64 {
     if sxx == 0.0 { f64::NAN } else { sxy / sxx }
 }
 
+/// Points from (time, value) pairs, for tests.
+#[cfg(test)]
+pub(crate) fn pts(v: &[(f64, f64)]) -> Vec<Point> {
+    v.iter()
+        .map(|&(time, value)| Point { time, value })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn pts(v: &[(f64, f64)]) -> Vec<Point> {
-        v.iter()
-            .map(|&(time, value)| Point { time, value })
-            .collect()
-    }
 
     #[test]
     fn interpolation_is_linear_between_samples_and_none_outside_them() {

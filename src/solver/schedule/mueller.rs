@@ -5,8 +5,8 @@ use sph_strategies::{Executor, KernelPanic};
 
 use crate::sph::neighbors::{NeighborLists, Neighbors};
 use crate::sph::params::Params;
-use crate::sph::passes::{self, ForceInputs};
-use crate::sph::state::{Domain, Positions, State};
+use crate::sph::passes;
+use crate::sph::state::{Domain, Fields, Positions, State};
 
 /// Writes rho, p and the neighbour lists; reads positions.
 pub fn density<E: Executor, N: Neighbors>(
@@ -35,14 +35,7 @@ pub fn forces<E: Executor, N: Neighbors>(
     s: &mut State,
     prm: &Params,
 ) -> Result<(), KernelPanic> {
-    let pos = Positions { x: &s.x, y: &s.y };
-    let input = ForceInputs {
-        pos,
-        vx: &s.vx,
-        vy: &s.vy,
-        rho: &s.rho,
-        p: &s.p,
-    };
+    let input = Fields::new((&s.x, &s.y), (&s.vx, &s.vy), &s.rho, &s.p);
     exec.for_each_chunk((&mut s.fx[..], &mut s.fy[..]), |first, (fx, fy)| {
         for (k, (fx, fy)) in fx.iter_mut().zip(fy).enumerate() {
             let i = first + k;

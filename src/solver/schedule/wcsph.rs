@@ -5,9 +5,9 @@ use glam::DVec2;
 use sph_strategies::{Executor, KernelPanic};
 
 use crate::sph::neighbors::{NeighborLists, Neighbors};
-use crate::sph::state::{Positions, State};
+use crate::sph::state::{Fields, Positions, State};
 use crate::sph::wcsph::params::WcParams;
-use crate::sph::wcsph::passes::{self, ContinuityInputs, Fields};
+use crate::sph::wcsph::passes::{self, ContinuityInputs};
 
 /// Fluid particles per block of the largest-speed reduction.
 pub const SPEED_BLOCK: usize = 256;
@@ -64,16 +64,6 @@ pub fn max_speed<E: Executor>(
     Ok(())
 }
 
-fn fields(s: &State) -> Fields<'_> {
-    Fields {
-        pos: Positions { x: &s.x, y: &s.y },
-        vx: &s.vx,
-        vy: &s.vy,
-        rho: &s.rho,
-        p: &s.p,
-    }
-}
-
 /// Writes every particle's neighbour list (walls: fluid neighbours only); reads positions.
 pub fn neighbors<E: Executor, N: Neighbors>(
     exec: &E,
@@ -100,13 +90,7 @@ pub fn walls<E: Executor, N: Neighbors>(
 ) -> Result<(), KernelPanic> {
     let (fluid_rho, wall_rho) = s.rho.split_at_mut(prm.fluid);
     let (fluid_p, wall_p) = s.p.split_at_mut(prm.fluid);
-    let f = Fields {
-        pos: Positions { x: &s.x, y: &s.y },
-        vx: &s.vx,
-        vy: &s.vy,
-        rho: fluid_rho,
-        p: fluid_p,
-    };
+    let f = Fields::new((&s.x, &s.y), (&s.vx, &s.vy), fluid_rho, fluid_p);
     exec.for_each_chunk((wall_rho, wall_p), |first, (rho, p)| {
         for (k, (rho, p)) in rho.iter_mut().zip(p).enumerate() {
             let w = prm.fluid + first + k;
@@ -123,13 +107,7 @@ pub fn momentum<E: Executor, N: Neighbors>(
     s: &mut State,
     prm: &WcParams,
 ) -> Result<(), KernelPanic> {
-    let f = Fields {
-        pos: Positions { x: &s.x, y: &s.y },
-        vx: &s.vx,
-        vy: &s.vy,
-        rho: &s.rho,
-        p: &s.p,
-    };
+    let f = Fields::new((&s.x, &s.y), (&s.vx, &s.vy), &s.rho, &s.p);
     let out = (&mut s.fx[..prm.fluid], &mut s.fy[..prm.fluid]);
     exec.for_each_chunk(out, |first, (ax, ay)| {
         for (k, (ax, ay)) in ax.iter_mut().zip(ay).enumerate() {
@@ -149,7 +127,7 @@ pub fn continuity<E: Executor, N: Neighbors>(
     prm: &WcParams,
 ) -> Result<(), KernelPanic> {
     let input = ContinuityInputs {
-        fields: fields(s),
+        fields: Fields::new((&s.x, &s.y), (&s.vx, &s.vy), &s.rho, &s.p),
         ax: &s.fx,
         ay: &s.fy,
         dt: scratch.dt,

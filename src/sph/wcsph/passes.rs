@@ -9,7 +9,7 @@ use glam::DVec2;
 
 use super::params::WcParams;
 use crate::sph::neighbors::{Neighbors, distance_squared};
-use crate::sph::state::Positions;
+use crate::sph::state::{Fields, Positions};
 
 /// The largest squared speed among the given velocities (0 for none), m²/s². `max` is exact
 /// whatever the order, so blocks may be reduced in any grouping.
@@ -18,21 +18,6 @@ pub fn max_speed_squared(vx: &[f64], vy: &[f64]) -> f64 {
     vx.iter()
         .zip(vy)
         .fold(0.0, |m: f64, (&x, &y)| m.max(x * x + y * y))
-}
-
-/// Read-only fields of every particle (fluid, then walls).
-#[derive(Debug, Clone, Copy)]
-pub struct Fields<'a> {
-    /// Positions, m.
-    pub pos: Positions<'a>,
-    /// Velocity x, m/s (zero for walls).
-    pub vx: &'a [f64],
-    /// Velocity y, m/s.
-    pub vy: &'a [f64],
-    /// Density, kg/m³ (walls: from this step's wall pass).
-    pub rho: &'a [f64],
-    /// Pressure, Pa (walls: from this step's wall pass).
-    pub p: &'a [f64],
 }
 
 /// Particle `i`'s neighbours within the kernel support, in index order: for a fluid particle
