@@ -8,7 +8,7 @@
 //! | `--n` | 1 ..= [`MAX_PARTICLES`], and within the machine's memory | see [`crate::scene::memory`] for the per-particle estimate |
 //! | `--steps` | 1 ..= [`MAX_STEPS`] | |
 //! | `--resolution` (`wcsph`) | 4 ..= 400 ([`crate::sph::wcsph::params::RESOLUTIONS`]) | below 4 the column has no interior; 400 is 320 000 fluid particles |
-//! | `--t-end` | 0 < t ≤ [`MAX_T_END_S`] s | the dam break is over (Martin & Moyce's data ends) within 2.5 s |
+//! | `--t-end` | 0 < t ≤ [`MAX_T_END_S`] s | far beyond the dam breaks (Martin & Moyce's data ends at 0.77 s; `wcsph`'s fluid splashes over the 2.5a walls after about 1.3 s, which ends the run with an error) |
 //! | `--trials` | 1 ..= [`MAX_TRIALS`] | |
 //! | `--warmup` | 0 ..= [`MAX_WARMUP`] | |
 //! | a sweep's cells | at most [`MAX_CELLS`] | the product of its lists |

@@ -1,15 +1,18 @@
 //! `bench-sph validate` driven through the built binary: at resolution 20 every verdict
 //! passes, the two CSVs hold a sample every 0.01 s from 0 to the end (T ≥ 3.4), the chart is
 //! a PNG and `--json` parses with every verdict passing; crossbeam-pool on 2 cores writes the
-//! same bytes as seq; a directory holding a file validate did not write is refused; bad input
-//! is an error, never a panic. No test asserts a duration.
+//! same bytes as seq; a failed verdict exits non-zero after writing its files; a directory
+//! holding a file validate did not write is refused; bad input is an error, never a panic. No
+//! test asserts a duration.
 
 use std::path::Path;
 
 use serde_json::Value;
 
 mod common;
-use common::{fails_with, names, scratch, stdout, succeeds};
+use common::{
+    assert_holds_all, fails_with, names, no_panic, run, scratch, stderr, stdout, succeeds,
+};
 
 /// The t_s column of a validation CSV whose header must be `header`.
 fn times(path: &Path, header: &str) -> Vec<f64> {
@@ -126,4 +129,23 @@ fn a_resolution_outside_4_to_400_is_refused_without_a_panic() {
     let o = fails_with(&["validate", "--resolution", "3"], &["--resolution"]);
     assert!(stdout(&o).is_empty());
     fails_with(&["validate", "--resolution", "x"], &["--resolution"]);
+}
+
+#[test]
+fn a_failing_verdict_exits_non_zero_after_writing_its_files() {
+    let (_tmp, out) = scratch("coarse");
+    let o = run(&[
+        "validate",
+        "--resolution",
+        "4",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert_holds_all("stderr", &stderr(&o), &["Error: validation failed"]);
+    assert_holds_all("stdout", &stdout(&o), &["FAIL"]);
+    no_panic(&o);
+    for file in ["surge_front.csv", "column_height.csv", "validation.png"] {
+        assert!(out.join(file).is_file(), "{file} was written");
+    }
 }

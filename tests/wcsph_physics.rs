@@ -93,3 +93,17 @@ fn a_non_finite_density_stops_the_run_in_the_step_it_appears() {
     let err = sim.advance(&SeqExecutor, 3).unwrap_err();
     assert!(matches!(err, StepError::Diverged { step: 1, .. }), "{err}");
 }
+
+#[test]
+fn fluid_that_splashes_out_of_the_open_tank_ends_the_run_with_an_error() {
+    let mut sim = Scene::tank(Fill::DamBreak, 6)
+        .unwrap()
+        .simulate(NeighborMode::Grid);
+    let err = sim
+        .advance_until(&SeqExecutor, usize::MAX, 3.0, &mut ())
+        .unwrap_err();
+    assert!(matches!(err, StepError::Unphysical { .. }), "{err}");
+    assert!(err.to_string().contains("left the tank"), "{err}");
+    // It happened after the surge hit the far wall, not before.
+    assert!(sim.time_s > 0.8, "at {} s", sim.time_s);
+}

@@ -100,7 +100,12 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         }
     };
 
-    let diverged = matches!(outcome, Err(RunError::Step(StepError::Diverged { .. })));
+    let diverged = matches!(
+        outcome,
+        Err(RunError::Step(
+            StepError::Diverged { .. } | StepError::Unphysical { .. }
+        ))
+    );
     if let Some(out) = dump.take().filter(|_| outcome.is_ok() || diverged) {
         write_dump(out, &sim, args.scene.preset)?;
     }

@@ -9,7 +9,7 @@
 //! - The Karp–Flatt serial fraction is given only where the speedup is above 1 on at least 2
 //!   cores, as a measurement at that core count, never extrapolated.
 //!
-//! - Across workloads ([`rank_shift`]: the toy Müller model against wcsph at one core count),
+//! - Across workloads ([`super::rank_shift`]: the toy Müller model against wcsph at one core count),
 //!   a winner is named only when its interval overlaps no other's on both; a strategy has
 //!   moved up or down only when it passed another whose intervals are apart on both
 //!   workloads; any other change of place is said to be not resolved.
@@ -19,6 +19,7 @@
 
 use super::numbers::{interval, percent, secs, times};
 use super::paper;
+use super::rank_shift::RankShift;
 use super::series::{self, Best, Group};
 use crate::results::rows::SummaryRow;
 use crate::results::stats::Interval;
@@ -61,34 +62,6 @@ pub enum Finding {
     /// How the strategy ranking changes from the toy workload to wcsph at one core count
     /// (boxed: it is the largest finding by far).
     RankShift(Box<RankShift>),
-}
-
-/// The ranking of the toy workload (a Müller preset) against the real one (`wcsph`) at one
-/// core count, from each strategy's best cell there (see [`rank_shift`]).
-#[derive(Debug, Clone, PartialEq)]
-pub struct RankShift {
-    /// Worker threads.
-    pub cores: usize,
-    /// Some cell involved had more threads than the machine.
-    pub oversubscribed: bool,
-    /// Contended cells left out (both workloads).
-    pub contended: usize,
-    /// Who is fastest on the toy workload (`None`: every cell contended).
-    pub toy: Option<Verdict>,
-    /// Who is fastest on wcsph.
-    pub real: Option<Verdict>,
-    /// Strategies that passed others on wcsph with the intervals apart on both workloads,
-    /// each with those it passed (in toy order).
-    pub up: Vec<(StrategyName, Vec<StrategyName>)>,
-    /// Strategies passed that way (in toy order).
-    pub down: Vec<StrategyName>,
-    /// Pairs that swap places with overlapping (or missing) intervals on at least one
-    /// workload: (ahead on the toy workload, ahead on wcsph).
-    pub unresolved: Vec<(StrategyName, StrategyName)>,
-    /// Without swaps: whether every neighbouring pair's intervals are apart on both.
-    pub order_resolved: bool,
-    /// Strategies with a trusted cell on only one workload: (toy only, wcsph only).
-    pub one_sided: (Vec<StrategyName>, Vec<StrategyName>),
 }
 
 /// The verdict at one core count, with what its sentence needs.
@@ -215,7 +188,7 @@ pub fn verdict(trusted: &[Entry]) -> Option<Verdict> {
 }
 
 /// The cells of `at` measured without contention, fastest first (the first of equal means).
-fn trusted(at: &[Entry]) -> Vec<Entry> {
+pub(super) fn trusted(at: &[Entry]) -> Vec<Entry> {
     let mut trusted: Vec<Entry> = at.iter().filter(|(_, b)| !b.contended).cloned().collect();
     trusted.sort_by(|a, b| a.1.mean_s.total_cmp(&b.1.mean_s));
     trusted
@@ -235,71 +208,10 @@ fn at_cores(cores: usize, at: &[Entry], seq_trusted: bool) -> Option<AtCores> {
 }
 
 /// Whether two cells' 95 % intervals are apart (both known and not overlapping).
-fn apart(a: &Best, b: &Best) -> bool {
+pub(super) fn apart(a: &Best, b: &Best) -> bool {
     match (a.mean_ci, b.mean_ci) {
         (Some(x), Some(y)) => !x.overlaps(&y),
         _ => false,
-    }
-}
-
-/// How the ranking at `cores` changes from the toy workload's best cells `toy` to wcsph's
-/// `real` (one entry per strategy; contended cells are left out and counted).
-pub fn rank_shift(cores: usize, toy: &[Entry], real: &[Entry]) -> RankShift {
-    let (t, r) = (trusted(toy), trusted(real));
-    let has = |v: &[Entry], s: StrategyName| v.iter().any(|(x, _)| *x == s);
-    // Both orders restricted to the strategies trusted on both workloads.
-    let common = |v: &[Entry], other: &[Entry]| -> Vec<Entry> {
-        v.iter().filter(|(s, _)| has(other, *s)).cloned().collect()
-    };
-    let (ct, cr) = (common(&t, &r), common(&r, &t));
-    let place = |v: &[Entry], s: StrategyName| v.iter().position(|(x, _)| *x == s);
-    fn cell(v: &[Entry], s: StrategyName) -> Option<&Best> {
-        v.iter().find(|(x, _)| *x == s).map(|e| &e.1)
-    }
-    let (mut up, mut down, mut unresolved) = (Vec::new(), Vec::new(), Vec::new());
-    for (i, (a, ta)) in ct.iter().enumerate() {
-        for (b, tb) in &ct[i + 1..] {
-            // a is ahead of b on the toy workload; did b pass a on wcsph?
-            if place(&cr, *b) > place(&cr, *a) {
-                continue;
-            }
-            let (Some(ra), Some(rb)) = (cell(&cr, *a), cell(&cr, *b)) else {
-                continue;
-            };
-            if apart(ta, tb) && apart(ra, rb) {
-                match up
-                    .iter_mut()
-                    .find(|(s, _): &&mut (StrategyName, Vec<_>)| s == b)
-                {
-                    Some((_, past)) => past.push(*a),
-                    None => up.push((*b, vec![*a])),
-                }
-                if !down.contains(a) {
-                    down.push(*a);
-                }
-            } else {
-                unresolved.push((*a, *b));
-            }
-        }
-    }
-    let neighbours_apart = |v: &[Entry]| v.windows(2).all(|w| apart(&w[0].1, &w[1].1));
-    let only = |v: &[Entry], other: &[Entry]| -> Vec<StrategyName> {
-        v.iter()
-            .map(|(s, _)| *s)
-            .filter(|s| !has(other, *s))
-            .collect()
-    };
-    RankShift {
-        cores,
-        oversubscribed: toy.iter().chain(real).any(|(_, b)| b.oversubscribed),
-        contended: (toy.len() - t.len()) + (real.len() - r.len()),
-        toy: verdict(&t),
-        real: verdict(&r),
-        order_resolved: neighbours_apart(&ct) && neighbours_apart(&cr),
-        one_sided: (only(&t, &r), only(&r, &t)),
-        up,
-        down,
-        unresolved,
     }
 }
 
@@ -518,106 +430,8 @@ impl AtCores {
     }
 }
 
-impl RankShift {
-    /// The winner on both workloads, what moved, and what the intervals do not resolve.
-    fn sentence(&self) -> String {
-        let mut out = format!(
-            "At {}{}, {}.",
-            series::cores_label(self.cores),
-            if self.oversubscribed {
-                " (⚠ oversubscribed: more threads than the machine has)"
-            } else {
-                ""
-            },
-            self.winner()
-        );
-        if !self.up.is_empty() {
-            let up: Vec<String> = self
-                .up
-                .iter()
-                .map(|(s, past)| format!("{s} (past {})", names(past)))
-                .collect();
-            out.push_str(&format!(
-                " Moved up on wcsph, with the 95 % intervals apart on both workloads: {}; \
-                 moved down: {}.",
-                up.join(", "),
-                names(&self.down)
-            ));
-        }
-        let not_resolved = "the 95 % intervals overlapping (or missing) on at least one workload";
-        match self.unresolved.len() {
-            0 => {}
-            // Past three swaps a list reads worse than the table beside it.
-            k @ 4.. => out.push_str(&format!(
-                " {k} changes of place (see the table) are not resolved, {not_resolved}."
-            )),
-            _ => {
-                let swaps: Vec<String> = self
-                    .unresolved
-                    .iter()
-                    .map(|(a, b)| format!("{b} now ahead of {a}"))
-                    .collect();
-                out.push_str(&format!(
-                    " Not resolved, {not_resolved}: {}.",
-                    and_list(&swaps)
-                ));
-            }
-        }
-        if self.up.is_empty() && self.unresolved.is_empty() {
-            out.push_str(if self.order_resolved {
-                " Every strategy measured on both keeps its place, with the 95 % intervals \
-                 apart on both workloads."
-            } else {
-                " Ranked by mean, every strategy measured on both keeps its place, though the \
-                 95 % intervals do not resolve every place."
-            });
-        }
-        let (toy_only, real_only) = &self.one_sided;
-        for (only, on) in [(toy_only, "the toy workload"), (real_only, "wcsph")] {
-            if !only.is_empty() {
-                out.push_str(&format!(
-                    " Measured without contention on {on} only: {}.",
-                    names(only)
-                ));
-            }
-        }
-        match self.contended {
-            0 => {}
-            1 => out.push_str(" ⚠ 1 contended cell is left out of this comparison."),
-            k => out.push_str(&format!(
-                " ⚠ {k} contended cells are left out of this comparison."
-            )),
-        }
-        out
-    }
-
-    /// Whether the winner is the same, as far as the intervals tell.
-    fn winner(&self) -> String {
-        let fastest = |v: &Option<Verdict>| match v {
-            Some(Verdict::Fastest { winner, .. }) => Some(winner.0),
-            _ => None,
-        };
-        match (fastest(&self.toy), fastest(&self.real)) {
-            (Some(a), Some(b)) if a == b => format!(
-                "the winner is the same: **{a}** is fastest on both workloads, its 95 % \
-                 interval apart from every other strategy's on each"
-            ),
-            (Some(a), Some(b)) => format!(
-                "the winner changes: **{a}** is fastest on the toy workload and **{b}** on \
-                 wcsph, each with its 95 % interval apart from every other strategy's"
-            ),
-            _ => format!(
-                "whether the winner is the same is not resolved: on the toy workload {}; on \
-                 wcsph {}",
-                verdict_phrase(self.toy.as_ref()),
-                verdict_phrase(self.real.as_ref())
-            ),
-        }
-    }
-}
-
 /// A verdict in a few words, strategies by name only (the table beside it has the numbers).
-fn verdict_phrase(v: Option<&Verdict>) -> String {
+pub(super) fn verdict_phrase(v: Option<&Verdict>) -> String {
     match v {
         None => "no cell was measured without contention".to_owned(),
         Some(Verdict::Only((s, _))) => format!("only {s} was measured"),
@@ -634,12 +448,12 @@ fn verdict_phrase(v: Option<&Verdict>) -> String {
 }
 
 /// Strategy names as `a`, `a and b`, `a, b and c`.
-fn names(strategies: &[StrategyName]) -> String {
+pub(super) fn names(strategies: &[StrategyName]) -> String {
     and_list(&strategies.iter().map(|s| s.to_string()).collect::<Vec<_>>())
 }
 
 /// A cell as findings name it: `rayon-chunks with 45 chunks (0.412 s [0.40, 0.42])`.
-fn describe((s, b): &Entry) -> String {
+pub(super) fn describe((s, b): &Entry) -> String {
     format!(
         "{s}{} ({} s{})",
         b.chunks
@@ -650,7 +464,7 @@ fn describe((s, b): &Entry) -> String {
 }
 
 /// `a`, `a and b`, `a, b and c`.
-fn and_list(items: &[String]) -> String {
+pub(super) fn and_list(items: &[String]) -> String {
     match items {
         [] => String::new(),
         [one] => one.clone(),
@@ -659,7 +473,7 @@ fn and_list(items: &[String]) -> String {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::results::rows::tests::row;
 
@@ -667,7 +481,7 @@ mod tests {
         findings(rows, g).iter().map(Finding::sentence).collect()
     }
 
-    fn with_ci(mut r: SummaryRow, low: f64, high: f64) -> SummaryRow {
+    pub(crate) fn with_ci(mut r: SummaryRow, low: f64, high: f64) -> SummaryRow {
         r.mean_ci_low_s = Some(low);
         r.mean_ci_high_s = Some(high);
         r
@@ -755,139 +569,5 @@ mod tests {
         ];
         let f = sentences(&rows, &rows[0].group()).join("\n");
         assert!(!f.contains("Karp–Flatt"), "{f}");
-    }
-
-    /// A strategy's best cell at 2 cores: `mean` seconds, its interval `mean ± half`.
-    fn entry(s: StrategyName, mean: f64, half: f64) -> Entry {
-        let r = with_ci(row(s, 2, None, mean), mean - half, mean + half);
-        (
-            s,
-            series::best_per_cores(std::slice::from_ref(&r), &r.group(), s).remove(0),
-        )
-    }
-
-    fn shift(toy: &[Entry], real: &[Entry]) -> String {
-        Finding::RankShift(Box::new(rank_shift(2, toy, real))).sentence()
-    }
-
-    #[test]
-    fn a_ranking_that_holds_with_intervals_apart_names_the_same_winner() {
-        use StrategyName::{RayonChunks, RayonIter};
-        let toy = [entry(RayonChunks, 2.0, 0.05), entry(RayonIter, 2.6, 0.05)];
-        let real = [entry(RayonIter, 3.0, 0.05), entry(RayonChunks, 2.5, 0.05)];
-        assert_eq!(
-            shift(&toy, &real),
-            "At 2 cores, the winner is the same: **rayon-chunks** is fastest on both workloads, \
-             its 95 % interval apart from every other strategy's on each. Every strategy \
-             measured on both keeps its place, with the 95 % intervals apart on both workloads."
-        );
-    }
-
-    #[test]
-    fn a_strategy_that_passes_another_beyond_the_intervals_moved_up_and_the_other_down() {
-        use StrategyName::{CrossbeamPool, RayonChunks, RayonIter, StdStatic};
-        let toy = [
-            entry(RayonChunks, 1.0, 0.01),
-            entry(CrossbeamPool, 1.1, 0.01),
-            entry(RayonIter, 1.2, 0.01),
-            entry(StdStatic, 1.3, 0.01),
-        ];
-        // On wcsph std-static passes crossbeam-pool and rayon-iter; rayon-iter passes
-        // crossbeam-pool within the intervals only.
-        let real = [
-            entry(RayonChunks, 1.0, 0.01),
-            entry(StdStatic, 1.05, 0.01),
-            entry(RayonIter, 1.2, 0.03),
-            entry(CrossbeamPool, 1.21, 0.03),
-        ];
-        let f = shift(&toy, &real);
-        assert!(
-            f.starts_with("At 2 cores, the winner is the same: **rayon-chunks**"),
-            "{f}"
-        );
-        assert!(
-            f.contains(
-                "Moved up on wcsph, with the 95 % intervals apart on both workloads: std-static \
-                 (past crossbeam-pool and rayon-iter); moved down: crossbeam-pool and rayon-iter."
-            ),
-            "{f}"
-        );
-        assert!(
-            f.contains(
-                "Not resolved, the 95 % intervals overlapping (or missing) on at least one \
-                 workload: rayon-iter now ahead of crossbeam-pool."
-            ),
-            "{f}"
-        );
-    }
-
-    #[test]
-    fn overlapping_intervals_leave_the_winner_and_the_swap_unresolved() {
-        use StrategyName::{RayonChunks, RayonIter};
-        let toy = [entry(RayonChunks, 2.0, 0.2), entry(RayonIter, 2.1, 0.2)];
-        let real = [entry(RayonIter, 2.0, 0.05), entry(RayonChunks, 2.5, 0.05)];
-        let f = shift(&toy, &real);
-        assert!(
-            f.starts_with(
-                "At 2 cores, whether the winner is the same is not resolved: on the toy \
-                 workload rayon-chunks and rayon-iter are indistinguishable within the trial \
-                 spread (their 95 % intervals overlap); on wcsph **rayon-iter** is fastest."
-            ),
-            "{f}"
-        );
-        assert!(f.contains("rayon-iter now ahead of rayon-chunks"), "{f}");
-        assert!(!f.contains("Moved up"), "{f}");
-    }
-
-    #[test]
-    fn contended_and_oversubscribed_cells_are_named_as_caveats_and_left_out() {
-        use StrategyName::{RayonChunks, RayonIter, StdStatic};
-        let mut noisy = entry(StdStatic, 0.5, 0.01);
-        noisy.1.contended = true;
-        let mut over = entry(RayonIter, 2.6, 0.05);
-        over.1.oversubscribed = true;
-        let toy = [noisy, entry(RayonChunks, 2.0, 0.05), over];
-        let real = [entry(RayonChunks, 2.0, 0.05), entry(StdStatic, 2.2, 0.05)];
-        let f = shift(&toy, &real);
-        assert!(
-            f.starts_with(
-                "At 2 cores (⚠ oversubscribed: more threads than the machine has), the winner \
-                 is the same: **rayon-chunks**"
-            ),
-            "{f}"
-        );
-        assert!(
-            f.contains("Measured without contention on the toy workload only: rayon-iter."),
-            "{f}"
-        );
-        assert!(
-            f.contains("Measured without contention on wcsph only: std-static."),
-            "{f}"
-        );
-        assert!(
-            f.ends_with("⚠ 1 contended cell is left out of this comparison."),
-            "{f}"
-        );
-    }
-
-    #[test]
-    fn without_intervals_no_winner_and_no_move_is_claimed() {
-        use StrategyName::{RayonChunks, RayonIter};
-        let bare = |s, mean| {
-            let mut e = entry(s, mean, 0.0);
-            e.1.mean_ci = None;
-            e
-        };
-        let toy = [bare(RayonChunks, 2.0), bare(RayonIter, 2.6)];
-        let real = [bare(RayonIter, 2.0), bare(RayonChunks, 2.6)];
-        let f = shift(&toy, &real);
-        assert!(
-            f.contains(
-                "on the toy workload the lowest mean is rayon-chunks's, but without \
-                        confidence intervals no strategy can be called fastest"
-            ),
-            "{f}"
-        );
-        assert!(!f.contains("Moved up") && f.contains("Not resolved"), "{f}");
     }
 }

@@ -32,6 +32,7 @@ pub mod markdown;
 pub mod numbers;
 pub mod paper;
 pub mod plan;
+pub mod rank_shift;
 pub mod series;
 pub mod traces;
 pub mod workloads;

@@ -8,7 +8,7 @@
 //! with the same neighbour search whose N is nearest (by absolute difference; then the nearest
 //! step count; then the first listed), and at every core count measured in both the strategies
 //! are ranked by their best cell there ([`series::best_per_cores`]: the lowest mean, a
-//! contended cell only where a strategy has nothing else, the rule of the report's tables). [`super::findings::rank_shift`] decides what
+//! contended cell only where a strategy has nothing else, the rule of the report's tables). [`super::rank_shift::rank_shift`] decides what
 //! the intervals support; [`markdown`] writes the section.
 //!
 //! [`section`] is pure: rows in, [`Section`] out; `None` when the rows lack either workload,
@@ -18,8 +18,9 @@ use std::fmt::Write as _;
 
 use sph_strategies::StrategyName;
 
-use super::findings::{self, Entry, Finding};
+use super::findings::{Entry, Finding};
 use super::numbers::{interval, sig, times};
+use super::rank_shift::rank_shift;
 use super::series::{self, Best, Group};
 use crate::results::key::LabelStyle;
 use crate::results::rows::SummaryRow;
@@ -170,7 +171,7 @@ fn rankings(rows: &[SummaryRow], toy: &Group, real: &Group) -> Vec<RankingAt> {
                         real: ranked(&r, s),
                     })
                     .collect(),
-                finding: Finding::RankShift(Box::new(findings::rank_shift(c, &t, &r))),
+                finding: Finding::RankShift(Box::new(rank_shift(c, &t, &r))),
             }
         })
         .collect()

@@ -41,7 +41,7 @@ pub struct Steps {
     pub every: usize,
     /// Untimed steps first, on a copy of the simulation that is then discarded: they wake
     /// the strategy's threads and leave the timed steps those of a run without warm-up. A
-    /// copy that diverges only ends the warm-up; a kernel's panic is an error.
+    /// copy that diverges (or leaves its model) only ends the warm-up; a kernel's panic is an error.
     pub warmup: usize,
     /// Simulated time at which the run ends early, s: it stops after the first step that
     /// reaches it (`total` then only caps the steps). `None`: run `total` steps.
@@ -104,7 +104,7 @@ impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
         } = self.steps;
         if warmup > 0 {
             match self.sim.clone().advance(exec, warmup) {
-                Ok(()) | Err(StepError::Diverged { .. }) => {}
+                Ok(()) | Err(StepError::Diverged { .. } | StepError::Unphysical { .. }) => {}
                 Err(e) => return Err(e),
             }
         }

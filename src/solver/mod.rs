@@ -33,6 +33,20 @@ pub enum StepError {
         /// The field in which it was found.
         field: &'static str,
     },
+    /// The run left what its model describes (`wcsph`: a fluid particle outside the tank or
+    /// with a density of zero or less).
+    #[error(
+        "the run left its model at step {step}: fluid particle {particle} {what} (a shorter \
+         --t-end or --steps stays within it)"
+    )]
+    Unphysical {
+        /// 1-based step number.
+        step: usize,
+        /// Index of the first such particle.
+        particle: usize,
+        /// What happened to it.
+        what: &'static str,
+    },
     /// A kernel panicked (a bug): the state is partly updated and must be discarded.
     #[error("step {step} failed")]
     Kernel {

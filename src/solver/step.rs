@@ -11,6 +11,7 @@
 use sph_strategies::{Executor, KernelPanic};
 
 use super::{Pass, Simulation, StepError};
+use crate::sph::physics::Physics;
 
 /// What a kernel call computes: part of the neighbour search's rebuild (the grid's, which
 /// runs its per-particle parts on the executor), or one of the three passes.
@@ -124,12 +125,8 @@ impl Simulation {
             }
             self.steps_done = step;
             self.time_s += self.last_dt();
-            if let Some((field, particle)) = hooks.check(step, || self.first_divergence()) {
-                return Err(StepError::Diverged {
-                    step,
-                    particle,
-                    field,
-                });
+            if let Some(error) = hooks.check(step, || self.first_fault(step)) {
+                return Err(error);
             }
         }
         Ok(())
@@ -153,17 +150,56 @@ impl Simulation {
         Ok(ran)
     }
 
+    /// What makes step `step` a failure, if anything: a non-finite value, or (WCSPH) a fluid
+    /// particle outside the tank or with a density ≤ 0.
+    fn first_fault(&self, step: usize) -> Option<StepError> {
+        if let Some((field, particle)) = self.first_divergence() {
+            return Some(StepError::Diverged {
+                step,
+                particle,
+                field,
+            });
+        }
+        let (particle, what) = self.first_unphysical()?;
+        Some(StepError::Unphysical {
+            step,
+            particle,
+            what,
+        })
+    }
+
     /// The first non-finite field and particle, if any.
     fn first_divergence(&self) -> Option<(&'static str, usize)> {
         // In Müller's model any non-finite density, pressure, force or position makes the
         // particle's own velocity non-finite in the same step; in WCSPH a non-finite density
-        // or pressure may reach the velocities only a step later, and a non-finite pressure
-        // comes from a non-finite density. So checking velocities and densities (3 arrays
-        // rather than 8) catches every divergence in the step it happens; the full scan then
-        // names the first field.
-        if self.state.velocities_finite() && self.state.densities_finite() {
+        // or pressure (the seventh power can overflow) reaches the velocities only a step
+        // later. So checking velocities, densities and pressures (4 arrays rather than 8)
+        // catches every divergence in the step it happens; the full scan then names the
+        // first field.
+        let s = &self.state;
+        if s.velocities_finite() && s.densities_finite() && s.pressures_finite() {
             return None;
         }
-        self.state.first_non_finite()
+        s.first_non_finite()
+    }
+
+    /// For WCSPH, the first fluid particle that left the tank (beyond a wall's outer face:
+    /// over the top of a wall and down outside it) or whose density is not positive, and why.
+    /// Either ends the dam break the model describes (the tank is open at the top), so the
+    /// run stops rather than go on with a wrong number.
+    fn first_unphysical(&self) -> Option<(usize, &'static str)> {
+        let Physics::Wcsph(prm) = &self.physics else {
+            return None;
+        };
+        let wall = prm.wall_layers() as f64 * prm.dx;
+        let (x_max, s) = (self.domain.width + wall, &self.state);
+        let fluid = prm.fluid;
+        let outside = |k: usize| s.x[k] < -wall || s.x[k] > x_max || s.y[k] < -wall;
+        if (0..fluid).any(outside) {
+            let k = (0..fluid).find(|&k| outside(k))?;
+            return Some((k, "left the tank over a wall"));
+        }
+        let k = s.rho[..fluid].iter().position(|&rho| rho <= 0.0)?;
+        Some((k, "has a density of zero or less"))
     }
 }

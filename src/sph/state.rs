@@ -113,6 +113,11 @@ impl State {
         first_non_finite(&self.rho).is_none()
     }
 
+    /// Whether every pressure is finite.
+    pub fn pressures_finite(&self) -> bool {
+        first_non_finite(&self.p).is_none()
+    }
+
     /// The first non-finite value, as (field name, particle index), scanning field by field.
     pub fn first_non_finite(&self) -> Option<(&'static str, usize)> {
         FIELD_NAMES

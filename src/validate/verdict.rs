@@ -12,8 +12,9 @@
 //!    by ΔT ≈ 0.2–0.25; Lethe's validation of the same case shifts the simulated times by
 //!    +0.175, and so does this one: the simulated curve moved right by 0.175.
 //!
-//! An experiment point beyond the simulated times is "not reached" and in no verdict; a
-//! verdict that counts no point at all fails.
+//! An experiment point beyond the simulated times is "not reached": outside a verdict's window
+//! it is only listed, inside it fails the verdict (its worst error is then unknown, NaN); a
+//! verdict that counts no point at all fails too.
 
 use serde::Serialize;
 
@@ -210,7 +211,12 @@ fn points_verdict(check: Check, points: &[PointCheck], tolerance: f64) -> Verdic
         .filter(|p| p.counted())
         .filter_map(|p| p.error);
     let (count, worst) = errors.fold((0, 0f64), |(n, w), e| (n + 1, w.max(e.abs())));
-    let measured = if count == 0 { f64::NAN } else { worst };
+    let unreached = points.iter().any(|p| p.in_window && p.error.is_none());
+    let measured = if count == 0 || unreached {
+        f64::NAN
+    } else {
+        worst
+    };
     verdict(check, measured, tolerance, count)
 }
 
@@ -384,6 +390,18 @@ mod tests {
         let failed: Vec<Check> = out.failed().iter().map(|v| v.check).collect();
         assert_eq!(failed, [Check::FrontSlope, Check::FrontPosition]);
         assert!(close(out.slopes.difference, -0.11));
+    }
+
+    #[test]
+    fn a_point_in_the_window_that_the_run_did_not_reach_fails_its_verdict() {
+        // Exact values, but the column stops short of τ = 2 (the window's last point).
+        let (front, column) = simulation(0.0, 0.0);
+        let short: Vec<Point> = column.into_iter().filter(|p| p.time < 1.5).collect();
+        let out = evaluate(&experiment(), &front, &short);
+        let [h, s, z] = out.verdicts;
+        assert!(!h.pass && h.measured.is_nan(), "{h:?}");
+        assert_eq!(h.points, 1, "the point reached still counts");
+        assert!(s.pass && z.pass);
     }
 
     #[test]
