@@ -10,8 +10,9 @@
 #                             every strategy, chunks 10..200 in steps of 10
 #   results/grid/             grid search at N = 1000, 10 000, 100 000, 100 steps
 #   results/all-pairs-small/  all-pairs at N = 1000, 3000, 100 steps (chart 6 beside the grid)
-#   results/wcsph/            the validated workload: wcsph, grid, R = 40 (3200 fluid
-#                             particles), 200 steps, every strategy
+#   results/wcsph/            the validated workload beside the toy at the same size: wcsph
+#                             and seed, grid, N = 3200 (wcsph: R = 40), 200 steps, every
+#                             strategy
 #   report/                   charts, REPORT.md and two traces (rayon-chunks, rayon-spawn)
 #   report/validation/        the wcsph dam break against Martin & Moyce (1952), R = 40
 # Run it on a quiet machine: nothing else should compete for the cores while it measures.
@@ -36,7 +37,7 @@ BIN=target/release/bench-sph
 "$BIN" sweep --preset seed --neighbors all-pairs --n 1000,3000 --steps 100 \
     --strategies rayon-chunks --cores "$CORES" --chunks 50 \
     --out results/all-pairs-small --force --no-plots
-"$BIN" sweep --preset wcsph --neighbors grid --n 3200 --steps 200 \
+"$BIN" sweep --preset seed,wcsph --neighbors grid --n 3200 --steps 200 \
     --cores "$CORES" --chunks 10,50,200 --out results/wcsph --force --no-plots
 
 mkdir -p report
