@@ -1,7 +1,7 @@
 //! Running cells: warm-ups, timed trials, the checksum guard, progress and Ctrl-C.
 //!
 //! Each run simulates the whole dam break from the group's initial state on a fresh
-//! [`Simulation`], through [`run_timed`] (the timed region is the step loop only). Every run —
+//! [`Simulation`](crate::solver::Simulation), through [`run_timed`] (the timed region is the step loop only). Every run —
 //! warm-up or trial — must end with the group's reference checksum, the one the group's
 //! `seq` cell produced first; the first run that does not, or that fails, ends the cell as
 //! failed with the reason, and the sweep goes on. A group whose `seq` cell failed has no
