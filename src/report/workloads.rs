@@ -196,7 +196,10 @@ pub fn markdown(section: Option<&Section>) -> String {
          the strategies are ranked by their best cell (the lowest mean, as in the tables \
          below; a contended cell only where a strategy has no other; equal means share a \
          rank); speedups are over each group's own `seq`. A change of place is stated only \
-         where the 95 % intervals are apart on both workloads.\n"
+         where the 95 % intervals are apart on both workloads. Each interval covers one \
+         cell's own trials: the two groups ran at different times, and on a shared machine \
+         the drift between runs minutes apart can exceed these intervals, so a change of \
+         place is worth confirming with a second sweep.\n"
     );
     for p in &section.pairs {
         pairing(&mut md, p);
@@ -411,6 +414,8 @@ mod tests {
             "| rayon-iter | 2 · 1.54× [1.46–1.62] | 1 · 2.00× [1.90–2.10] |",
             "- At 2 cores, the winner changes: **rayon-chunks** is fastest on the toy workload \
              and **rayon-iter** on wcsph",
+            // What the intervals do not cover is said before any ranking.
+            "the drift between runs minutes apart can exceed these intervals",
         ] {
             assert!(md.contains(needle), "lacks {needle:?}:\n{md}");
         }
