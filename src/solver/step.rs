@@ -14,7 +14,7 @@ use super::{Pass, Simulation, StepError};
 use crate::sph::physics::Physics;
 
 /// What a kernel call computes: part of the neighbour search's rebuild (the grid's, which
-/// runs its per-particle parts on the executor), or one of the three passes.
+/// runs its per-particle parts on the executor), or one of the model's passes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Phase {
     /// The neighbour search's rebuild, before the density pass.
@@ -195,8 +195,7 @@ impl Simulation {
         let (x_max, s) = (self.domain.width + wall, &self.state);
         let fluid = prm.fluid;
         let outside = |k: usize| s.x[k] < -wall || s.x[k] > x_max || s.y[k] < -wall;
-        if (0..fluid).any(outside) {
-            let k = (0..fluid).find(|&k| outside(k))?;
+        if let Some(k) = (0..fluid).find(|&k| outside(k)) {
             return Some((k, "left the tank over a wall"));
         }
         let k = s.rho[..fluid].iter().position(|&rho| rho <= 0.0)?;
