@@ -1,0 +1,477 @@
+#!/usr/bin/env bash
+# Speed figures of bench-sph as ratios to the plain compiled C++ all-pairs loop (issue 15),
+# measured in the same run: benches/plain-loop/mueller.cpp (seed preset, N = 1000, 1000 steps)
+# against `bench-sph simulate` all-pairs and grid at that size, plus the grid at N = 10^4, 10^5
+# and 10^6 with every strategy of LARGE_STRATEGIES below.
+#
+# Usage: scripts/speed-bench.sh [--runs K] [--quick] [--simd LIST] [--out FILE [--force]]
+#   --runs K      runs of every configuration, 1..=100 (default 5; 2 with --quick), interleaved
+#                 run by run (run 1 of every configuration, then run 2, ...), so that drift of
+#                 the machine's speed hits every configuration alike
+#   --quick       smoke test: fewer steps everywhere (reference 100 steps, large N 50/5/1 steps);
+#                 the ratios then describe the first 100 steps only
+#   --simd LIST   comma- or space-separated values of bench-sph's `simulate --simd`
+#                 (portable, avx2, avx512): every bench-sph row is run once per value with
+#                 `--simd X` and labelled by it (default: the flag is not passed)
+#   --out FILE    also write the table to FILE (atomically: a temporary file, then mv)
+#   --force       let --out replace an existing FILE
+# Environment (optional): CXX (default g++), CARGO_TARGET_DIR (default target).
+#
+# Per configuration it prints min, median and max of wall_s (the simulation loop only, as each
+# program reports it); for the N = 1000 rows the ratio plain-loop median / row median and its
+# range (plain min / row max .. plain max / row min); for large N the particle-steps/s range
+# (n * steps / wall_s), the parallel efficiency (seq median / (cores * median)) and, at
+# N = 10^6, the peak resident memory per particle. It checks that the plain loop ends in the
+# same state as `bench-sph simulate --strategy seq` (all-pairs): same checksum.
+# Without a C++ compiler the plain loop and the ratio columns are skipped.
+# Run it on an otherwise quiet machine: it warns when the 1-minute load exceeds half the
+# hardware threads. Needs bash, cargo, awk, sort; no jq.
+set -euo pipefail
+
+# ---- What is measured -------------------------------------------------------------------
+# The reference run (issue 15): seed preset, N = 1000, 1000 steps.
+REF_N=1000
+REF_STEPS=1000
+# Large-N grid runs: "N STEPS".
+LARGE_SIZES=("10000 1000" "100000 100" "1000000 10")
+# Strategies of the large-N runs: "STRATEGY CORES CHUNKS"; "-" = the flag is not passed.
+LARGE_STRATEGIES=("seq - -" "crossbeam-pool 2 10")
+# The N whose peak RSS per particle is reported.
+RSS_N=1000000
+# --quick replaces the step counts.
+QUICK_REF_STEPS=100
+QUICK_LARGE_SIZES=("10000 50" "100000 5" "1000000 1")
+
+usage() {
+    sed -n '2,/^set -euo/{/^set -euo/d;s/^# \{0,1\}//;p}' "$0"
+}
+
+die() {
+    echo "Error: $*" >&2
+    exit 2
+}
+
+# ---- Arguments ----------------------------------------------------------------------------
+RUNS=""
+QUICK=0
+SIMD_ARG=""
+OUT=""
+FORCE=0
+while (($# > 0)); do
+    case "$1" in
+    --runs)
+        (($# >= 2)) || die "--runs needs a value (1..=100)"
+        RUNS="$2"
+        shift 2
+        ;;
+    --runs=*)
+        RUNS="${1#--runs=}"
+        shift
+        ;;
+    --quick)
+        QUICK=1
+        shift
+        ;;
+    --simd)
+        (($# >= 2)) || die "--simd needs a list (portable, avx2, avx512)"
+        SIMD_ARG="$2"
+        shift 2
+        ;;
+    --simd=*)
+        SIMD_ARG="${1#--simd=}"
+        shift
+        ;;
+    --out)
+        (($# >= 2)) || die "--out needs a file name"
+        OUT="$2"
+        shift 2
+        ;;
+    --out=*)
+        OUT="${1#--out=}"
+        shift
+        ;;
+    --force)
+        FORCE=1
+        shift
+        ;;
+    -h | --help)
+        usage
+        exit 0
+        ;;
+    *) die "unknown argument '$1' (try --help)" ;;
+    esac
+done
+
+if [[ -z "$RUNS" ]]; then
+    if ((QUICK)); then RUNS=2; else RUNS=5; fi
+fi
+if ! [[ "$RUNS" =~ ^[0-9]{1,3}$ ]] || ((10#$RUNS < 1 || 10#$RUNS > 100)); then
+    die "--runs must be a whole number from 1 to 100, not '$RUNS'"
+fi
+RUNS=$((10#$RUNS))
+
+# SIMD variants; "" = no --simd flag.
+SIMDS=()
+for x in ${SIMD_ARG//,/ }; do
+    case "$x" in
+    portable | avx2 | avx512) SIMDS+=("$x") ;;
+    *) die "unknown --simd value '$x' (portable, avx2 or avx512)" ;;
+    esac
+done
+if ((${#SIMDS[@]} == 0)); then SIMDS=(""); fi
+
+if [[ -n "$OUT" ]]; then
+    [[ "$OUT" != */ ]] || die "--out needs a file name, not a folder: '$OUT'"
+    if [[ -e "$OUT" || -L "$OUT" ]] && ((!FORCE)); then
+        die "'$OUT' already exists (pass --force to replace it)"
+    fi
+    [[ ! -d "$OUT" ]] || die "'$OUT' is a folder"
+    OUT_DIR="$(dirname -- "$OUT")"
+    [[ -d "$OUT_DIR" && -w "$OUT_DIR" ]] || die "cannot write into the folder '$OUT_DIR'"
+    # Absolute, since the script changes folder.
+    OUT="$(cd -- "$OUT_DIR" && pwd)/$(basename -- "$OUT")"
+fi
+
+if ((QUICK)); then
+    REF_STEPS=$QUICK_REF_STEPS
+    LARGE_SIZES=("${QUICK_LARGE_SIZES[@]}")
+fi
+
+# A relative CARGO_TARGET_DIR means relative to where the script was started.
+if [[ -n "${CARGO_TARGET_DIR:-}" && "$CARGO_TARGET_DIR" != /* ]]; then
+    CARGO_TARGET_DIR="$PWD/$CARGO_TARGET_DIR"
+    export CARGO_TARGET_DIR
+fi
+cd "$(dirname -- "$0")/.."
+BIN="${CARGO_TARGET_DIR:-target}/release/bench-sph"
+CXX="${CXX:-g++}"
+
+WORK="$(mktemp -d "${TMPDIR:-/tmp}/speed-bench.XXXXXX")"
+OUT_TMP=""
+cleanup() {
+    rm -rf -- "$WORK"
+    if [[ -n "$OUT_TMP" ]]; then rm -f -- "$OUT_TMP"; fi
+}
+trap cleanup EXIT
+trap 'exit 130' INT
+trap 'exit 143' TERM
+
+TABLE="$WORK/table.txt"
+RESULTS="$WORK/results.txt"
+: >"$TABLE"
+: >"$RESULTS"
+# Everything the table says goes to stdout and to $TABLE (for --out).
+say() {
+    printf '%s\n' "$*" | tee -a "$TABLE"
+}
+sayf() {
+    # shellcheck disable=SC2059 # the format is the caller's
+    printf "$@" | tee -a "$TABLE"
+}
+
+# ---- The machine --------------------------------------------------------------------------
+THREADS="$(getconf _NPROCESSORS_ONLN 2>/dev/null || nproc 2>/dev/null || echo 1)"
+say "uptime: $(uptime)"
+if [[ -r /proc/loadavg ]]; then
+    read -r LOAD _ </proc/loadavg
+else
+    # "load average(s): 0.52, 0.40, 0.33" (some locales write 0,52).
+    LOAD="$(uptime | sed -n 's/.*load averages*: *\([0-9]*[.,][0-9]*\).*/\1/p' | tr , .)"
+fi
+if awk -v load="${LOAD:-0}" -v t="$THREADS" 'BEGIN { exit !(load > 0.5 * t) }'; then
+    echo "warning: the 1-minute load is $LOAD, above 0.5 x $THREADS hardware threads:" \
+        "other work is competing, so these figures are not clean" >&2
+    say "warning: 1-minute load $LOAD > 0.5 x $THREADS hardware threads (figures not clean)"
+fi
+
+# ---- Builds -------------------------------------------------------------------------------
+echo "building bench-sph (cargo build --release) ..." >&2
+cargo build --release >&2
+[[ -x "$BIN" ]] || die "no bench-sph binary at $BIN after the build"
+
+PLAIN=""
+if command -v -- "$CXX" >/dev/null 2>&1; then
+    echo "compiling benches/plain-loop/mueller.cpp with $CXX -O2 -ffp-contract=off ..." >&2
+    "$CXX" -O2 -ffp-contract=off -std=c++17 -o "$WORK/mueller" benches/plain-loop/mueller.cpp
+    PLAIN="$WORK/mueller"
+    PLAIN_CXX="$("$CXX" --version 2>/dev/null | head -n 1)"
+else
+    echo "no C++ compiler ('$CXX' not found): skipping the plain loop and the ratio columns" >&2
+fi
+
+# ---- How a run's peak resident memory is measured -----------------------------------------
+if [[ -x /usr/bin/time ]] && /usr/bin/time -f %M -o "$WORK/probe" true 2>/dev/null &&
+    [[ "$(cat "$WORK/probe")" =~ ^[0-9]+$ ]]; then
+    RSS_HOW="/usr/bin/time -f %M (peak RSS reported by the kernel at exit)"
+    RSS_MODE=gnu-time
+elif [[ -d /proc/self ]]; then
+    RSS_HOW="VmHWM of /proc/PID/status polled every 0.05 s by a wrapper (a lower bound)"
+    RSS_MODE=poll
+else
+    RSS_HOW="not measured (neither GNU /usr/bin/time nor /proc)"
+    RSS_MODE=none
+fi
+
+# run_measured RSS_FILE CMD...: runs CMD with stdout as this function's stdout, writes its
+# peak RSS in KiB (or "-") to RSS_FILE.
+run_measured() {
+    local rss_file="$1"
+    shift
+    case "$RSS_MODE" in
+    gnu-time)
+        /usr/bin/time -f %M -o "$rss_file" "$@"
+        ;;
+    poll)
+        local pid hwm=0 v status=0
+        "$@" &
+        pid=$!
+        while kill -0 "$pid" 2>/dev/null; do
+            v="$(awk '/^VmHWM:/ { print $2 }' "/proc/$pid/status" 2>/dev/null || true)"
+            if [[ -n "$v" ]]; then hwm="$v"; fi
+            sleep 0.05
+        done
+        wait "$pid" || status=$?
+        echo "$hwm" >"$rss_file"
+        return "$status"
+        ;;
+    *)
+        echo - >"$rss_file"
+        "$@"
+        ;;
+    esac
+}
+
+json_field() {
+    sed -n "s/.*\"$1\":\"\{0,1\}\([^,\"}]*\).*/\1/p"
+}
+
+# One line per run in $RESULTS: KEY WALL_S RSS_KIB CHECKSUM.
+# run_one KEY CMD...
+run_one() {
+    local key="$1" json wall sum rss
+    shift
+    if ! json="$(run_measured "$WORK/rss" "$@")"; then
+        echo "Error: this run failed: $*" >&2
+        exit 1
+    fi
+    wall="$(json_field wall_s <<<"$json")"
+    sum="$(json_field checksum <<<"$json")"
+    rss="$(tr -d ' \n' <"$WORK/rss")"
+    if [[ -z "$wall" || -z "$sum" ]]; then
+        echo "Error: no wall_s/checksum in the output of: $*" >&2
+        echo "  $json" >&2
+        exit 1
+    fi
+    echo "$key $wall ${rss:--} $sum" >>"$RESULTS"
+    printf '  run %d/%d  %-44s %10s s\n' "$run" "$RUNS" "$key" "$wall" >&2
+}
+
+# Keys: plain | ref:NEIGHBORS:SIMD | large:N:STEPS:STRATEGY:CORES:CHUNKS:SIMD ("-" = none).
+simd_flag() {
+    if [[ -n "$1" ]]; then printf '%s\n' --simd "$1"; fi
+}
+
+echo "runs: $RUNS, interleaved; rows per run: plain loop, reference, large N" >&2
+for ((run = 1; run <= RUNS; run++)); do
+    if [[ -n "$PLAIN" ]]; then
+        run_one plain "$PLAIN" "$REF_N" "$REF_STEPS"
+    fi
+    for simd in "${SIMDS[@]}"; do
+        mapfile -t sflag < <(simd_flag "$simd")
+        for nb in all-pairs grid; do
+            run_one "ref:$nb:${simd:--}" "$BIN" simulate --json --strategy seq --neighbors "$nb" \
+                --n "$REF_N" --steps "$REF_STEPS" ${sflag[@]+"${sflag[@]}"}
+        done
+    done
+    for size in "${LARGE_SIZES[@]}"; do
+        read -r n steps <<<"$size"
+        for strat in "${LARGE_STRATEGIES[@]}"; do
+            read -r strategy cores chunks <<<"$strat"
+            extra=()
+            if [[ "$cores" != - ]]; then extra+=(--cores "$cores"); fi
+            if [[ "$chunks" != - ]]; then extra+=(--chunks "$chunks"); fi
+            for simd in "${SIMDS[@]}"; do
+                mapfile -t sflag < <(simd_flag "$simd")
+                run_one "large:$n:$steps:$strategy:$cores:$chunks:${simd:--}" "$BIN" simulate \
+                    --json --strategy "$strategy" --neighbors grid --n "$n" --steps "$steps" \
+                    ${extra[@]+"${extra[@]}"} ${sflag[@]+"${sflag[@]}"}
+            done
+        done
+    done
+done
+
+# ---- Statistics ---------------------------------------------------------------------------
+# stats KEY: "min median max" of wall_s (the median of an even count is the mean of the middle
+# two), then the largest peak RSS (KiB, or -) and the number of distinct checksums.
+stats() {
+    awk -v k="$1" '$1 == k { print $2 }' "$RESULTS" | sort -g |
+        awk '{ v[NR] = $1 }
+             END {
+                 if (NR == 0) { print "- - -"; exit }
+                 m = (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2
+                 printf "%.17g %.17g %.17g\n", v[1], m, v[NR]
+             }'
+}
+peak_rss() {
+    awk -v k="$1" '$1 == k && $3 != "-" { if ($3 + 0 > m) m = $3 + 0; seen = 1 }
+                   END { if (seen) print m; else print "-" }' "$RESULTS"
+}
+checksums() {
+    awk -v k="$1" '$1 == k { print $4 }' "$RESULTS" | sort -u | tr '\n' ' ' | sed 's/ $//'
+}
+fmt_s() {
+    awk -v v="$1" 'BEGIN { if (v == "-") print "-"; else printf "%.4f", v }'
+}
+
+# Every configuration must end in the same state on every run.
+DETERMINISTIC=yes
+while read -r key; do
+    if [[ "$(checksums "$key")" == *" "* ]]; then
+        DETERMINISTIC=no
+        echo "warning: the runs of $key disagree on the checksum: $(checksums "$key")" >&2
+    fi
+done < <(awk '{ print $1 }' "$RESULTS" | sort -u)
+
+# ---- The table ----------------------------------------------------------------------------
+COMMIT="$(git rev-parse --short HEAD 2>/dev/null || echo '?')"
+if [[ -n "$(git status --porcelain --untracked-files=no 2>/dev/null || true)" ]]; then
+    COMMIT="$COMMIT (with uncommitted changes)"
+fi
+CPU="$(sed -n 's/^model name[[:space:]]*: *//p' /proc/cpuinfo 2>/dev/null | head -n 1)"
+say ""
+MODE=full
+if ((QUICK)); then MODE="quick (smoke test)"; fi
+say "speed-bench: $(date -u +%Y-%m-%dT%H:%M:%SZ), bench-sph $COMMIT, mode: $MODE, runs: $RUNS"
+say "machine: ${CPU:-unknown CPU}, $THREADS hardware threads"
+if [[ -n "$PLAIN" ]]; then
+    say "plain loop: benches/plain-loop/mueller.cpp, $PLAIN_CXX, -O2 -ffp-contract=off"
+else
+    say "plain loop: not run (no C++ compiler '$CXX'); no ratios"
+fi
+say "peak RSS: $RSS_HOW"
+say "wall_s: the step loop only, as each program reports it; seed preset, seed 2019"
+
+say ""
+say "Reference size: N = $REF_N, $REF_STEPS steps, seq (one thread)"
+sayf '%-34s %5s %10s %10s %10s   %-26s\n' configuration runs "min s" "median s" "max s" \
+    "plain/this median (range)"
+PLAIN_STATS=""
+if [[ -n "$PLAIN" ]]; then
+    PLAIN_STATS="$(stats plain)"
+    read -r pmin pmed pmax <<<"$PLAIN_STATS"
+    sayf '%-34s %5s %10s %10s %10s   %-26s\n' "plain C++ loop (all-pairs)" "$RUNS" \
+        "$(fmt_s "$pmin")" "$(fmt_s "$pmed")" "$(fmt_s "$pmax")" "1"
+fi
+for simd in "${SIMDS[@]}"; do
+    for nb in all-pairs grid; do
+        key="ref:$nb:${simd:--}"
+        read -r lo med hi <<<"$(stats "$key")"
+        ratio="-"
+        if [[ -n "$PLAIN" ]]; then
+            ratio="$(awk -v pmin="$pmin" -v pmed="$pmed" -v pmax="$pmax" -v lo="$lo" \
+                -v med="$med" -v hi="$hi" \
+                'BEGIN { printf "%.2fx (%.2f-%.2f)", pmed / med, pmin / hi, pmax / lo }')"
+        fi
+        label="bench-sph seq $nb${simd:+ simd=$simd}"
+        sayf '%-34s %5s %10s %10s %10s   %-26s\n' "$label" "$RUNS" "$(fmt_s "$lo")" \
+            "$(fmt_s "$med")" "$(fmt_s "$hi")" "$ratio"
+    done
+done
+
+say ""
+say "Large N: grid neighbour search"
+sayf '%-10s %6s %-34s %5s %10s %10s %10s %24s %6s %10s\n' N steps configuration runs \
+    "min s" "median s" "max s" "Mparticle-steps/s min-max" "eff" "RSS B/part"
+for size in "${LARGE_SIZES[@]}"; do
+    read -r n steps <<<"$size"
+    for simd in "${SIMDS[@]}"; do
+        seq_med=""
+        for strat in "${LARGE_STRATEGIES[@]}"; do
+            read -r strategy cores chunks <<<"$strat"
+            key="large:$n:$steps:$strategy:$cores:$chunks:${simd:--}"
+            read -r lo med hi <<<"$(stats "$key")"
+            if [[ "$strategy" == seq ]]; then seq_med="$med"; fi
+            rate="$(awk -v n="$n" -v s="$steps" -v lo="$lo" -v hi="$hi" \
+                'BEGIN { printf "%.2f-%.2f", n * s / hi / 1e6, n * s / lo / 1e6 }')"
+            eff="-"
+            if [[ "$cores" != - && "$strategy" != seq && -n "$seq_med" ]]; then
+                eff="$(awk -v s="$seq_med" -v c="$cores" -v m="$med" \
+                    'BEGIN { printf "%.2f", s / (c * m) }')"
+            fi
+            rss="-"
+            if [[ "$n" == "$RSS_N" ]]; then
+                kib="$(peak_rss "$key")"
+                if [[ "$kib" != - ]]; then
+                    rss="$(awk -v k="$kib" -v n="$n" 'BEGIN { printf "%.0f", k * 1024 / n }')"
+                fi
+            fi
+            label="$strategy"
+            if [[ "$cores" != - ]]; then label+=" cores=$cores"; fi
+            if [[ "$chunks" != - ]]; then label+=" chunks=$chunks"; fi
+            if [[ -n "$simd" ]]; then label+=" simd=$simd"; fi
+            sayf '%-10s %6s %-34s %5s %10s %10s %10s %24s %6s %10s\n' "$n" "$steps" "$label" \
+                "$RUNS" "$(fmt_s "$lo")" "$(fmt_s "$med")" "$(fmt_s "$hi")" "$rate" "$eff" "$rss"
+        done
+    done
+done
+say "eff = seq median / (cores x median); RSS B/part = the largest peak RSS of the N = $RSS_N" \
+    "runs / N"
+
+# ---- Checks -------------------------------------------------------------------------------
+say ""
+SAME_ALL=yes
+if [[ -n "$PLAIN" ]]; then
+    plain_sum="$(checksums plain)"
+    for simd in "${SIMDS[@]}"; do
+        ref_sum="$(checksums "ref:all-pairs:${simd:--}")"
+        same=no
+        if [[ "$plain_sum" == "$ref_sum" ]]; then same=yes; else SAME_ALL=no; fi
+        say "plain loop computes the same state${simd:+ (simd=$simd)}: $same" \
+            "(plain $plain_sum, bench-sph seq all-pairs $ref_sum)"
+    done
+else
+    say "plain loop computes the same state: not checked (no C++ compiler)"
+fi
+# Strategies must agree with seq bit for bit at every size.
+AGREE=yes
+for size in "${LARGE_SIZES[@]}"; do
+    read -r n steps <<<"$size"
+    for simd in "${SIMDS[@]}"; do
+        sums="$(for strat in "${LARGE_STRATEGIES[@]}"; do
+            read -r strategy cores chunks <<<"$strat"
+            checksums "large:$n:$steps:$strategy:$cores:$chunks:${simd:--}"
+            echo
+        done | sort -u | grep -c .)"
+        if [[ "$sums" != 1 ]]; then
+            AGREE=no
+            echo "warning: the strategies disagree at N = $n${simd:+ simd=$simd}" >&2
+        fi
+    done
+done
+say "large-N strategies agree with seq bit for bit: $AGREE; every configuration repeats its" \
+    "checksum run to run: $DETERMINISTIC"
+say "uptime: $(uptime)"
+
+# ---- --out --------------------------------------------------------------------------------
+if [[ -n "$OUT" ]]; then
+    OUT_TMP="$(mktemp "$(dirname -- "$OUT")/.speed-bench.XXXXXX")"
+    cat "$TABLE" >"$OUT_TMP"
+    chmod 644 "$OUT_TMP"
+    if ((FORCE)); then
+        mv -f -- "$OUT_TMP" "$OUT"
+    else
+        # -n never replaces a file that appeared while the benchmark ran.
+        mv -n -- "$OUT_TMP" "$OUT" 2>/dev/null || true
+        if [[ -e "$OUT_TMP" ]]; then
+            echo "Error: '$OUT' appeared while the benchmark ran; the table is only on stdout" >&2
+            exit 1
+        fi
+    fi
+    OUT_TMP=""
+    echo "wrote $OUT" >&2
+fi
+
+if [[ "$SAME_ALL" != yes || "$AGREE" != yes || "$DETERMINISTIC" != yes ]]; then
+    echo "Error: the runs did not all compute the same state (see above)" >&2
+    exit 1
+fi
