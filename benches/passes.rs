@@ -1,12 +1,14 @@
 //! Criterion benches: each pass (density, forces) and a full step, for every strategy in the
 //! registry, at 1 core and at all hardware threads, on the paper's all-pairs N = 1000 and on
 //! the grid at N = 100 000, each from the seed dam break after 100 steps. Chunked strategies
-//! use 10 chunks per core. Run with `cargo bench` or `cargo criterion` (install it with
+//! use 10 chunks per core. The `simd/...` groups run `seq` on each SIMD path this CPU has
+//! (`--simd`): the density pass, where the neighbour tests run, and a whole step. Run with `cargo bench` or `cargo criterion` (install it with
 //! `cargo install cargo-criterion`).
 
 use std::time::{Duration, Instant};
 
 use bench_sph::scene::dam_break;
+use bench_sph::simd::SimdPath;
 use bench_sph::solver::{Pass, Simulation};
 use bench_sph::sph::neighbors::NeighborMode;
 use bench_sph::sph::params::Preset;
@@ -141,5 +143,44 @@ fn grid_100k(c: &mut Criterion) {
     bench_scene(c, "grid-n100000", NeighborMode::Grid, 100_000);
 }
 
-criterion_group!(benches, all_pairs_1000, grid_100k);
+/// Each SIMD path this CPU runs, sequentially, on both scenes: the density pass (the
+/// neighbour tests) and a whole step.
+fn simd_paths(c: &mut Criterion) {
+    let scenes = [
+        ("all-pairs-n1000", NeighborMode::AllPairs, 1000),
+        ("grid-n100000", NeighborMode::Grid, 100_000),
+    ];
+    let seq = Config {
+        cores: 1,
+        chunks: 1,
+    };
+    for (label, mode, n) in scenes {
+        let settled = settled(mode, n);
+        for work in [Work::Pass(Pass::Density), Work::Step] {
+            let mut group = c.benchmark_group(format!("simd/{label}/{}", work.name()));
+            group
+                .sample_size(20)
+                .warm_up_time(Duration::from_millis(500))
+                .measurement_time(Duration::from_secs(2));
+            for path in SimdPath::available() {
+                let start = settled.clone().with_simd(path).expect("available");
+                let mut sim = start.clone();
+                group.bench_function(path.as_str(), |b| {
+                    b.iter_custom(|iters| {
+                        let timed = TimedIters {
+                            start: &start,
+                            sim: &mut sim,
+                            work,
+                            iters,
+                        };
+                        sph_strategies::run(StrategyName::Seq, &seq, timed).expect("seq builds")
+                    })
+                });
+            }
+            group.finish();
+        }
+    }
+}
+
+criterion_group!(benches, all_pairs_1000, grid_100k, simd_paths);
 criterion_main!(benches);

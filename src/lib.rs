@@ -3,6 +3,7 @@
 //! strategies, and the tools to measure them.
 //!
 //! - [`sph`]: the pure physics (constants, state, neighbour search, per-particle passes);
+//! - [`simd`]: the instruction sets the neighbour tests run on, picked at start-up;
 //! - [`solver`]: one step as the model's passes run by a strategy's executor;
 //! - [`scene`]: initial dam-break states; [`io`]: CSV in and out;
 //! - [`validate`]: the `wcsph` dam break against Martin & Moyce (1952) (`bench-sph validate`);
@@ -33,6 +34,7 @@ pub mod report;
 pub mod results;
 pub mod run;
 pub mod scene;
+pub mod simd;
 pub mod solver;
 pub mod sph;
 pub mod sweep;

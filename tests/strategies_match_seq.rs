@@ -1,10 +1,12 @@
-//! Every strategy gives the sequential run's bits, whatever the cores and chunks, and a panic
-//! inside a kernel becomes an error of the run (never a hang) on every strategy.
+//! Every strategy gives the sequential run's bits, whatever the cores, chunks and SIMD path
+//! (the portable path's sequential run is the reference), and a panic inside a kernel becomes
+//! an error of the run (never a hang) on every strategy.
 
 use std::time::Duration;
 
 use bench_sph::run::run_timed;
 use bench_sph::scene::{Scene, dam_break};
+use bench_sph::simd::SimdPath;
 use bench_sph::solver::Simulation;
 use bench_sph::sph::neighbors::NeighborMode;
 use bench_sph::sph::params::Preset;
@@ -19,11 +21,13 @@ const STEPS: usize = 25;
 fn run(
     preset: Preset,
     mode: NeighborMode,
+    simd: SimdPath,
     strategy: StrategyName,
     cores: usize,
     chunks: usize,
 ) -> State {
-    let mut sim = Scene::dam_break(preset, N, 7).unwrap().simulate(mode);
+    let scene = Scene::dam_break(preset, N, 7).unwrap();
+    let mut sim = scene.simulate(mode).with_simd(simd).unwrap();
     run_timed(&mut sim, strategy, &Config { cores, chunks }, STEPS)
         .unwrap_or_else(|e| panic!("{strategy} cores={cores} chunks={chunks}: {e}"));
     sim.state
@@ -41,24 +45,66 @@ fn first_bit_difference(a: &State, b: &State) -> Option<String> {
         })
 }
 
+/// The portable path and the widest this machine runs (CI runs both).
+fn tested_paths() -> Vec<SimdPath> {
+    let mut paths = vec![SimdPath::Portable, SimdPath::widest()];
+    paths.dedup();
+    paths
+}
+
 #[test]
 fn every_strategy_cores_and_chunks_gives_the_bits_of_the_sequential_run() {
     for preset in Preset::ALL {
         for mode in NeighborMode::ALL {
-            let reference = run(preset, mode, StrategyName::Seq, 1, 1);
-            for &strategy in StrategyName::ALL {
-                for cores in [1, 2, 3, 5] {
-                    for chunks in [1, 7, 64, N, 2 * N] {
-                        let got = run(preset, mode, strategy, cores, chunks);
-                        if let Some(diff) = first_bit_difference(&got, &reference) {
-                            panic!(
-                                "{preset} {mode} {strategy} cores={cores} chunks={chunks}: {diff}"
-                            );
+            let reference = run(preset, mode, SimdPath::Portable, StrategyName::Seq, 1, 1);
+            for simd in tested_paths() {
+                for &strategy in StrategyName::ALL {
+                    for cores in [1, 2, 3, 5] {
+                        for chunks in [1, 7, 64, N, 2 * N] {
+                            let got = run(preset, mode, simd, strategy, cores, chunks);
+                            if let Some(diff) = first_bit_difference(&got, &reference) {
+                                panic!(
+                                    "{preset} {mode} {simd} {strategy} cores={cores} \
+                                     chunks={chunks}: {diff}"
+                                );
+                            }
                         }
                     }
                 }
             }
         }
+    }
+}
+
+#[test]
+fn every_simd_path_this_machine_runs_gives_the_portable_bits() {
+    eprintln!("SIMD paths available here: {:?}", SimdPath::available());
+    for preset in Preset::ALL {
+        for mode in NeighborMode::ALL {
+            let reference = run(preset, mode, SimdPath::Portable, StrategyName::Seq, 1, 1);
+            for simd in SimdPath::available() {
+                for (strategy, cores, chunks) in [
+                    (StrategyName::Seq, 1, 1),
+                    (StrategyName::RayonChunks, 2, 7),
+                    (StrategyName::CrossbeamPool, 3, 64),
+                ] {
+                    let got = run(preset, mode, simd, strategy, cores, chunks);
+                    if let Some(diff) = first_bit_difference(&got, &reference) {
+                        panic!("{preset} {mode} {simd} {strategy}: {diff}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_path_this_cpu_lacks_is_refused() {
+    for simd in SimdPath::ALL {
+        let sim = Scene::dam_break(Preset::Seed, 10, 1)
+            .unwrap()
+            .simulate(NeighborMode::Grid);
+        assert_eq!(sim.with_simd(simd).is_ok(), simd.is_available(), "{simd}");
     }
 }
 

@@ -33,6 +33,10 @@ pub struct Cli {
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
+    /// Instructions for the neighbour tests: portable, avx2 or avx512 [default: the widest
+    /// this CPU runs]. Every path gives the same bits; a path the CPU lacks is an error.
+    #[arg(long, global = true, value_parser = values::simd())]
+    pub simd: Option<crate::simd::SimdPath>,
 }
 
 /// The commands.
@@ -120,7 +124,10 @@ pub enum Command {
 
 /// Parses the command line and runs the command.
 pub fn run() -> anyhow::Result<()> {
-    let command = Cli::parse().command;
+    let Cli { command, simd } = Cli::parse();
+    if let Some(path) = simd {
+        crate::simd::choose(path)?;
+    }
     if !matches!(command, Command::Sweep(_)) {
         // The sweep keeps its finished cells on Ctrl-C; every other command just stops, and
         // must not leave half-written temporary files behind.

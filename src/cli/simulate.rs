@@ -13,6 +13,7 @@ use crate::limits;
 use crate::output::console;
 use crate::run::fault::PanicAt;
 use crate::run::{RunError, Steps, run_timed_steps};
+use crate::simd::SimdPath;
 use crate::solver::{Simulation, StepError};
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
@@ -68,6 +69,7 @@ struct Report {
     cpu_s: f64,
     particle_steps_per_s: f64,
     checksum: String,
+    simd: SimdPath,
 }
 
 /// Runs `simulate`.
@@ -141,6 +143,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         cpu_s: elapsed.cpu_s,
         particle_steps_per_s: (n * sim.steps_done) as f64 / elapsed.wall_s,
         checksum: checksum_hex(&sim.state),
+        simd: sim.simd(),
     };
     print_report(&report, args.json)
 }
@@ -168,8 +171,8 @@ fn print_report(r: &Report, json: bool) -> anyhow::Result<()> {
     }
     let chunks = r.chunks.map_or_else(|| "n/a".to_owned(), |c| c.to_string());
     say(&format!(
-        "preset {}, {} neighbours, strategy {} (cores {}, chunks {chunks})",
-        r.preset, r.neighbors, r.strategy, r.cores
+        "preset {}, {} neighbours, strategy {} (cores {}, chunks {chunks}), simd {}",
+        r.preset, r.neighbors, r.strategy, r.cores, r.simd
     ))?;
     let walls = r
         .walls

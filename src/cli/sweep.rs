@@ -158,6 +158,7 @@ impl SweepArgs {
             trials,
             warmup: self.warmup,
             seed: self.seed,
+            simd: Some(crate::simd::current()),
             fake_timings: self.fake_timings.clone(),
             fake_contention: self.fake_contention.clone(),
         })

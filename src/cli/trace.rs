@@ -13,6 +13,7 @@ use crate::checksum::checksum_hex;
 use crate::output::atomic::AtomicFile;
 use crate::output::claim::{self, Claimed, Owner};
 use crate::output::console;
+use crate::simd::SimdPath;
 use crate::solver::Simulation;
 use crate::trace::files::{self, TOOL};
 use crate::trace::size::{self, Plan};
@@ -69,6 +70,7 @@ struct Meta<'a> {
     workers_used: usize,
     checksum: String,
     timeline_steps: [usize; 2],
+    simd: SimdPath,
 }
 
 /// Minimum and median of untraced and traced wall times.
@@ -120,6 +122,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
         workers_used: stats.total.workers_used,
         checksum: checksum_hex(&sim.state),
         timeline_steps: [args.steps + 1 - shown, args.steps],
+        simd: sim.simd(),
     };
     write_files(&paths, &run, &stats, &meta)?;
     let removed = claimed.remove_stale(&paths)?;

@@ -10,6 +10,7 @@ use clap::{Arg, ValueEnum};
 use sph_strategies::StrategyName;
 
 use crate::render::scale::ColorBy;
+use crate::simd::SimdPath;
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
 
@@ -52,6 +53,27 @@ impl From<NeighborsArg> for NeighborMode {
     }
 }
 
+/// `--simd`'s values.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum SimdArg {
+    /// What the compiled target guarantees (SSE2 on x86-64): the reference path.
+    Portable,
+    /// x86-64 AVX2, 4 lanes of f64.
+    Avx2,
+    /// x86-64 AVX-512, 8 lanes of f64.
+    Avx512,
+}
+
+impl From<SimdArg> for SimdPath {
+    fn from(arg: SimdArg) -> SimdPath {
+        match arg {
+            SimdArg::Portable => SimdPath::Portable,
+            SimdArg::Avx2 => SimdPath::Avx2,
+            SimdArg::Avx512 => SimdPath::Avx512,
+        }
+    }
+}
+
 /// `--color`'s values.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum ColorArg {
@@ -78,6 +100,11 @@ pub(super) fn preset() -> impl TypedValueParser<Value = Preset> {
 /// Parses a [`NeighborMode`] by its command-line name, listing the modes in `--help`.
 pub(super) fn neighbors() -> impl TypedValueParser<Value = NeighborMode> {
     EnumValueParser::<NeighborsArg>::new().map(NeighborMode::from)
+}
+
+/// Parses a [`SimdPath`] by its command-line name, listing the paths in `--help`.
+pub(super) fn simd() -> impl TypedValueParser<Value = SimdPath> {
+    EnumValueParser::<SimdArg>::new().map(SimdPath::from)
 }
 
 /// Parses a [`ColorBy`] by its command-line name, listing the quantities in `--help`.
@@ -141,6 +168,7 @@ mod tests {
             names::<PresetArg, Preset>(),
             names::<NeighborsArg, NeighborMode>(),
             names::<ColorArg, ColorBy>(),
+            names::<SimdArg, SimdPath>(),
         ];
         for (cli, domain) in all.iter().flatten() {
             assert_eq!(cli, domain);
@@ -155,5 +183,6 @@ mod tests {
             NeighborMode::ALL.len()
         );
         assert_eq!(ColorArg::value_variants().len(), ColorBy::ALL.len());
+        assert_eq!(SimdArg::value_variants().len(), SimdPath::ALL.len());
     }
 }

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use sph_strategies::StrategyName;
 
 use super::names::name_list;
+use crate::simd::SimdPath;
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
 
@@ -35,6 +36,10 @@ pub struct SweepParams {
     pub warmup: usize,
     /// Seed of the initial jitter.
     pub seed: u64,
+    /// SIMD path of the neighbour tests (`--simd`, else the widest the CPU ran); absent in
+    /// directories written before it was recorded. `--resume` runs the recorded path.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub simd: Option<SimdPath>,
     /// Test only: trial times replacing the measured ones (see [`crate::sweep::timing`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fake_timings: Option<String>,

@@ -14,11 +14,13 @@ pub use step::{Phase, PhaseJob, StepHooks};
 
 use sph_strategies::{Executor, KernelPanic};
 
+use crate::simd::{self, AnyLanes, SimdPath};
 use crate::sph::neighbors::{
     self, AnyNeighbors, NeighborLists, NeighborMode, Neighbors, WCSPH_SLOTS,
 };
 use crate::sph::physics::Physics;
 use crate::sph::state::{Domain, Positions, State};
+use crate::with_lanes;
 
 /// Why a step failed.
 #[derive(Debug, thiserror::Error)]
@@ -71,6 +73,7 @@ pub struct Simulation {
     /// Simulated time: the sum of the steps' time steps, s.
     pub time_s: f64,
     neighbors: AnyNeighbors,
+    lanes: AnyLanes,
     lists: NeighborLists,
     wcsph: schedule::wcsph::Scratch,
 }
@@ -172,12 +175,42 @@ impl Simulation {
             steps_done: 0,
             time_s: 0.0,
             neighbors,
+            lanes: simd::current()
+                .lanes()
+                .expect("the current SIMD path was checked available"),
             lists: match physics {
                 Physics::Mueller(_) => NeighborLists::new(fluid),
                 Physics::Wcsph(_) => NeighborLists::with_slots(state_len, WCSPH_SLOTS),
             },
             wcsph,
         }
+    }
+
+    /// The same simulation with its neighbour tests on `path` instead of the process's
+    /// [`simd::current`] path (the results are the same bits).
+    ///
+    /// # Errors
+    /// If this CPU cannot run `path`.
+    pub fn with_simd(mut self, path: SimdPath) -> Result<Self, simd::Unavailable> {
+        self.lanes = path.lanes().ok_or(simd::Unavailable(path))?;
+        Ok(self)
+    }
+
+    /// The same simulation with `width` neighbour slots per particle instead of its model's
+    /// (see [`NeighborLists`]): the results are the same bits, only speed and memory differ
+    /// (tests and benchmarks use it to show that).
+    ///
+    /// # Panics
+    /// If `width` is 0 (the last slot is scratch).
+    pub fn with_list_slots(mut self, width: usize) -> Self {
+        assert!(width >= 1, "a neighbour list needs its scratch slot");
+        self.lists = NeighborLists::with_slots(self.lists.count.len(), width);
+        self
+    }
+
+    /// The SIMD path the neighbour tests run on.
+    pub fn simd(&self) -> SimdPath {
+        self.lanes.path()
     }
 
     /// The model's passes, in step order.
@@ -230,13 +263,18 @@ impl Simulation {
     /// If `pass` is not one of the model's passes.
     pub fn run_pass<E: Executor>(&mut self, exec: &E, pass: Pass) -> Result<(), KernelPanic> {
         use schedule::{mueller, wcsph};
-        let (s, lists, nb) = (&mut self.state, &mut self.lists, &self.neighbors);
+        let (s, lists, nb, lanes) = (
+            &mut self.state,
+            &mut self.lists,
+            &self.neighbors,
+            self.lanes,
+        );
         match (&self.physics, pass) {
             (Physics::Mueller(prm), Pass::Density) => {
-                with_search!(nb, nb => mueller::density(exec, nb, lists, s, prm))
+                with_search!(nb, nb => with_lanes!(lanes, l => mueller::density(exec, l, nb, lists, s, prm)))
             }
             (Physics::Mueller(prm), Pass::Forces) => {
-                with_search!(nb, nb => mueller::forces(exec, nb, lists, s, prm))
+                with_search!(nb, nb => with_lanes!(lanes, l => mueller::forces(exec, l, nb, lists, s, prm)))
             }
             (Physics::Mueller(prm), Pass::Integrate) => {
                 mueller::integrate(exec, s, prm, self.domain)
@@ -245,7 +283,7 @@ impl Simulation {
                 wcsph::max_speed(exec, s, &mut self.wcsph, prm)
             }
             (Physics::Wcsph(prm), Pass::Neighbors) => {
-                with_search!(nb, nb => wcsph::neighbors(exec, nb, lists, s, prm))
+                with_search!(nb, nb => with_lanes!(lanes, l => wcsph::neighbors(exec, l, nb, lists, s, prm)))
             }
             (Physics::Wcsph(prm), Pass::Walls) => {
                 with_search!(nb, nb => wcsph::walls(exec, nb, lists, s, prm))

@@ -123,6 +123,10 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
         Target::Resume { dir } => reopen(dir, session)?,
     };
     let params = opened.meta.params.clone();
+    if let Some(path) = params.simd {
+        // A resumed sweep measures on the path its first cells did.
+        crate::simd::choose(path).context("cannot resume this sweep here")?;
+    }
     let timing = Timing::new(
         params.fake_timings.as_deref(),
         params.fake_contention.as_deref(),

@@ -74,6 +74,7 @@ mod tests {
             trials: 2,
             warmup: 0,
             seed: 7,
+            simd: None,
             fake_timings: None,
             fake_contention: None,
         }

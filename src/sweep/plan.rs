@@ -107,6 +107,7 @@ mod tests {
             trials: 2,
             warmup: 1,
             seed: 1,
+            simd: None,
             fake_timings: None,
             fake_contention: None,
         }

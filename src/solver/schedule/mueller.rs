@@ -3,14 +3,16 @@
 use glam::DVec2;
 use sph_strategies::{Executor, KernelPanic};
 
+use crate::simd::Lanes;
 use crate::sph::neighbors::{NeighborLists, Neighbors};
 use crate::sph::params::Params;
 use crate::sph::passes;
 use crate::sph::state::{Domain, Fields, Positions, State};
 
 /// Writes rho, p and the neighbour lists; reads positions.
-pub fn density<E: Executor, N: Neighbors>(
+pub fn density<E: Executor, N: Neighbors, L: Lanes>(
     exec: &E,
+    lanes: L,
     nb: &N,
     lists: &mut NeighborLists,
     s: &mut State,
@@ -20,16 +22,22 @@ pub fn density<E: Executor, N: Neighbors>(
     let (count, slots) = lists.split_mut();
     let out = (&mut s.rho[..], &mut s.p[..], count, slots);
     exec.for_each_chunk(out, |first, (rho, p, count, mut slots)| {
-        for (k, ((rho, p), count)) in rho.iter_mut().zip(p).zip(count).enumerate() {
-            (*rho, *p, *count) =
-                passes::density_pressure(first + k, pos, nb, prm, slots.particle(k));
-        }
+        lanes.vectorize(
+            #[inline(always)]
+            || {
+                for (k, ((rho, p), count)) in rho.iter_mut().zip(p).zip(count).enumerate() {
+                    (*rho, *p, *count) =
+                        passes::density_pressure(first + k, lanes, pos, nb, prm, slots.particle(k));
+                }
+            },
+        )
     })
 }
 
 /// Writes fx, fy; reads positions, velocities, rho, p and the neighbour lists.
-pub fn forces<E: Executor, N: Neighbors>(
+pub fn forces<E: Executor, N: Neighbors, L: Lanes>(
     exec: &E,
+    lanes: L,
     nb: &N,
     lists: &NeighborLists,
     s: &mut State,
@@ -37,11 +45,16 @@ pub fn forces<E: Executor, N: Neighbors>(
 ) -> Result<(), KernelPanic> {
     let input = Fields::new((&s.x, &s.y), (&s.vx, &s.vy), &s.rho, &s.p);
     exec.for_each_chunk((&mut s.fx[..], &mut s.fy[..]), |first, (fx, fy)| {
-        for (k, (fx, fy)) in fx.iter_mut().zip(fy).enumerate() {
-            let i = first + k;
-            let f = passes::force(i, &input, lists.of(i), nb, prm);
-            (*fx, *fy) = (f.x, f.y);
-        }
+        lanes.vectorize(
+            #[inline(always)]
+            || {
+                for (k, (fx, fy)) in fx.iter_mut().zip(fy).enumerate() {
+                    let i = first + k;
+                    let f = passes::force(i, lanes, &input, lists.of(i), nb, prm);
+                    (*fx, *fy) = (f.x, f.y);
+                }
+            },
+        )
     })
 }
 

@@ -4,6 +4,7 @@
 use glam::DVec2;
 use sph_strategies::{Executor, KernelPanic};
 
+use crate::simd::Lanes;
 use crate::sph::neighbors::{NeighborLists, Neighbors};
 use crate::sph::state::{Fields, Positions, State};
 use crate::sph::wcsph::params::WcParams;
@@ -65,8 +66,9 @@ pub fn max_speed<E: Executor>(
 }
 
 /// Writes every particle's neighbour list (walls: fluid neighbours only); reads positions.
-pub fn neighbors<E: Executor, N: Neighbors>(
+pub fn neighbors<E: Executor, N: Neighbors, L: Lanes>(
     exec: &E,
+    lanes: L,
     nb: &N,
     lists: &mut NeighborLists,
     s: &State,
@@ -74,9 +76,14 @@ pub fn neighbors<E: Executor, N: Neighbors>(
 ) -> Result<(), KernelPanic> {
     let pos = Positions { x: &s.x, y: &s.y };
     exec.for_each_chunk(lists.split_mut(), |first, (count, mut slots)| {
-        for (k, c) in count.iter_mut().enumerate() {
-            *c = passes::neighbors(first + k, pos, nb, prm, slots.particle(k));
-        }
+        lanes.vectorize(
+            #[inline(always)]
+            || {
+                for (k, c) in count.iter_mut().enumerate() {
+                    *c = passes::neighbors(first + k, lanes, pos, nb, prm, slots.particle(k));
+                }
+            },
+        )
     })
 }
 

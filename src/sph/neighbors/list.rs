@@ -11,9 +11,24 @@
 
 use sph_strategies::Split;
 
-/// Neighbour slots per particle (128 bytes). Dam-break particles have about 5–15 neighbours;
-/// piles in the corners can have more, and take the slower path.
+/// Neighbour slots per particle of Müller's presets below [`LARGE_RUN`] particles (128 bytes).
+/// Dam-break particles have about 5–15 neighbours; piles in the corners can have more, and
+/// take the slower path.
 pub const SLOTS: usize = 32;
+
+/// From this many particles on, Müller's presets get [`LARGE_SLOTS`] slots per particle.
+pub const LARGE_RUN: usize = 100_000;
+
+/// Neighbour slots per particle of a large run (32 bytes), so that a run of 10⁶ particles
+/// needs under 150 bytes each: a large scene is mostly at rest in its first steps (one or two
+/// neighbours each); a particle with more than seven is searched again by the force pass.
+pub const LARGE_SLOTS: usize = 8;
+
+/// The slots per particle of a Müller run of `n` particles: [`SLOTS`], or [`LARGE_SLOTS`]
+/// from [`LARGE_RUN`] on. Either gives the same bits; only memory and speed differ.
+pub fn mueller_slots(n: usize) -> usize {
+    if n >= LARGE_RUN { LARGE_SLOTS } else { SLOTS }
+}
 
 /// Neighbour slots per particle of the `wcsph` preset (256 bytes).
 pub const WCSPH_SLOTS: usize = 64;
@@ -31,16 +46,16 @@ pub struct NeighborLists {
 }
 
 impl NeighborLists {
-    /// Room for `n` particles of [`SLOTS`] slots each.
+    /// Room for `n` particles of Müller's presets ([`mueller_slots`] each).
     pub fn new(n: usize) -> Self {
-        Self::with_slots(n, SLOTS)
+        Self::with_slots(n, mueller_slots(n))
     }
 
     /// Room for `n` particles of `width` slots each.
     pub fn with_slots(n: usize, width: usize) -> Self {
         NeighborLists {
-            count: vec![0; n],
-            slots: vec![0; n * width],
+            count: written_zeros(n),
+            slots: written_zeros(n * width),
             width,
         }
     }
@@ -104,4 +119,13 @@ impl Split for SlotsMut<'_> {
             },
         )
     }
+}
+
+/// `n` zeros written now, not `vec![0; n]`: that one takes fresh pages from the OS which are
+/// only mapped at their first write — inside the first timed step, where a large run would
+/// pay for page faults instead of physics.
+pub(crate) fn written_zeros<T: Copy + Default>(n: usize) -> Vec<T> {
+    let mut v = Vec::with_capacity(n);
+    v.resize(n, T::default());
+    v
 }

@@ -9,12 +9,15 @@ mod grid;
 pub mod list;
 
 pub use all_pairs::AllPairs;
-pub use grid::Grid;
-pub use list::{NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS};
+pub use grid::{Grid, PAD as GRID_PAD};
+pub use list::{
+    LARGE_RUN, LARGE_SLOTS, NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS, mueller_slots,
+};
 
 use serde::Serialize;
 use sph_strategies::{Executor, KernelPanic};
 
+use crate::simd::Lanes;
 use crate::sph::state::{Domain, Positions};
 
 /// How candidates are found.
@@ -54,9 +57,11 @@ pub trait Neighbors: Sync {
     fn rebuild<E: Executor>(&mut self, exec: &E, pos: Positions<'_>) -> Result<(), KernelPanic>;
 
     /// Calls `visit(j, r2)` for every particle j (including `i` itself) whose squared
-    /// distance `r2 = dx*dx + dy*dy` (with `d = x_j − x_i`) is below `hsq`, in increasing j.
-    fn for_each_within(
+    /// distance `r2 = dx*dx + dy*dy` (with `d = x_j − x_i`) is below `hsq`, in increasing j,
+    /// testing candidates in `lanes` (every path finds the same j with the same r2).
+    fn for_each_within<L: Lanes>(
         &self,
+        lanes: L,
         i: usize,
         pos: Positions<'_>,
         hsq: f64,

@@ -5,6 +5,7 @@
 //! Notation: r_ab = x_a − x_b, v_ab = v_a − v_b, ∇_a W_ab = g(r) r_ab with
 //! g = [`WcParams::gradient_factor`].
 
+use crate::simd::{Lanes, Portable};
 use glam::DVec2;
 
 use super::params::WcParams;
@@ -25,9 +26,10 @@ pub fn max_speed_squared(vx: &[f64], vy: &[f64]) -> f64 {
 ///
 /// They are written to `slots` as many as fit before its last entry (scratch); the returned
 /// count is the true number (see [`crate::sph::neighbors::NeighborLists`]).
-#[inline]
+#[inline(always)]
 pub fn neighbors(
     i: usize,
+    lanes: impl Lanes,
     pos: Positions<'_>,
     nb: &impl Neighbors,
     prm: &WcParams,
@@ -36,7 +38,7 @@ pub fn neighbors(
     let scratch = slots.len() - 1;
     let mut count = 0usize;
     let limit = if i < prm.fluid { usize::MAX } else { prm.fluid };
-    nb.for_each_within(i, pos, prm.support_sq, |j, _| {
+    nb.for_each_within(lanes, i, pos, prm.support_sq, |j, _| {
         slots[count.min(scratch)] = j as u32;
         count += usize::from(j != i && j < limit);
     });
@@ -64,7 +66,8 @@ fn for_each_neighbor(
         }
         None => {
             let limit = if i < prm.fluid { usize::MAX } else { prm.fluid };
-            nb.for_each_within(i, pos, prm.support_sq, |b, r2| {
+            // A list too long for its slots is rare: the portable lanes serve (same hits).
+            nb.for_each_within(Portable, i, pos, prm.support_sq, |b, r2| {
                 if b != i && b < limit {
                     pair(b, r2);
                 }

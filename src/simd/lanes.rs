@@ -1,0 +1,207 @@
+//! The lanes of each path: one operation, the squared distances from particle i to eight
+//! candidates and which of them are below the search radius squared.
+
+/// The squared distances to eight candidates and the bit mask of those below `hsq` (bit k set
+/// when candidate k is within reach).
+#[derive(Debug, Clone, Copy)]
+pub struct Near8 {
+    /// Bit k: `r2[k] < hsq`.
+    pub mask: u8,
+    /// `dx*dx + dy*dy` per candidate, `d = x_j − x_i`, exactly as the scalar code computes it.
+    pub r2: [f64; 8],
+}
+
+/// One path's instructions.
+pub trait Lanes: Copy + Send + Sync {
+    /// Runs `f` compiled with this path's instructions enabled: code inlined into `f` (mark
+    /// the closure `#[inline(always)]`) may use them, including the compiler's own
+    /// vectorisation.
+    fn vectorize<R>(self, f: impl FnOnce() -> R) -> R;
+
+    /// The squared distances from `(xi, yi)` to eight candidates and which are below `hsq`.
+    fn near8(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8;
+}
+
+/// The compiled target's own instructions: a plain loop the compiler vectorises as it can.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Portable;
+
+impl Lanes for Portable {
+    #[inline(always)]
+    fn vectorize<R>(self, f: impl FnOnce() -> R) -> R {
+        f()
+    }
+
+    #[inline(always)]
+    fn near8(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8 {
+        let mut r2 = [0.0; 8];
+        let mut mask = 0u8;
+        for k in 0..8 {
+            let (dx, dy) = (xs[k] - xi, ys[k] - yi);
+            r2[k] = dx * dx + dy * dy;
+            mask |= u8::from(r2[k] < hsq) << k;
+        }
+        Near8 { mask, r2 }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub use x86::{Avx2, Avx512};
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use pulp::x86::{V3, V4};
+    use pulp::{cast, f64x4, f64x8};
+
+    use super::{Lanes, Near8};
+
+    /// AVX2: two 4-lane halves, each compare turned into four mask bits.
+    #[derive(Debug, Clone, Copy)]
+    pub struct Avx2(V3);
+
+    impl Avx2 {
+        /// The lanes, if this CPU has AVX2 (and the rest of x86-64-v3).
+        pub fn detect() -> Option<Avx2> {
+            V3::try_new().map(Avx2)
+        }
+    }
+
+    impl Lanes for Avx2 {
+        #[inline(always)]
+        fn vectorize<R>(self, f: impl FnOnce() -> R) -> R {
+            self.0.vectorize(f)
+        }
+
+        #[inline(always)]
+        fn near8(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8 {
+            // Inside a vectorised pass this inlines to nothing; called from elsewhere it is
+            // one call with the features on, not a call per instruction.
+            self.vectorize(
+                #[inline(always)]
+                || self.near8_inline(xi, yi, xs, ys, hsq),
+            )
+        }
+    }
+
+    impl Avx2 {
+        #[inline(always)]
+        fn near8_inline(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8 {
+            let v = self.0;
+            let half = |xs: [f64; 4], ys: [f64; 4]| {
+                let dx = v.sub_f64x4(cast(xs), v.splat_f64x4(xi));
+                let dy = v.sub_f64x4(cast(ys), v.splat_f64x4(yi));
+                let r2 = v.add_f64x4(v.mul_f64x4(dx, dx), v.mul_f64x4(dy, dy));
+                let below = v.cmp_lt_f64x4(r2, v.splat_f64x4(hsq));
+                let bits = v.avx._mm256_movemask_pd(cast(below)) as u8;
+                (bits, cast::<f64x4, [f64; 4]>(r2))
+            };
+            let split = |a: &[f64; 8]| -> ([f64; 4], [f64; 4]) {
+                ([a[0], a[1], a[2], a[3]], [a[4], a[5], a[6], a[7]])
+            };
+            let ((xlo, xhi), (ylo, yhi)) = (split(xs), split(ys));
+            let (mlo, rlo) = half(xlo, ylo);
+            let (mhi, rhi) = half(xhi, yhi);
+            let mut r2 = [0.0; 8];
+            r2[..4].copy_from_slice(&rlo);
+            r2[4..].copy_from_slice(&rhi);
+            Near8 {
+                mask: mlo | (mhi << 4),
+                r2,
+            }
+        }
+    }
+
+    /// AVX-512: one 8-lane compare straight into a mask register.
+    #[derive(Debug, Clone, Copy)]
+    pub struct Avx512(V4);
+
+    impl Avx512 {
+        /// The lanes, if this CPU has AVX-512 F/BW/CD/DQ/VL (x86-64-v4).
+        pub fn detect() -> Option<Avx512> {
+            V4::try_new().map(Avx512)
+        }
+    }
+
+    impl Lanes for Avx512 {
+        #[inline(always)]
+        fn vectorize<R>(self, f: impl FnOnce() -> R) -> R {
+            self.0.vectorize(f)
+        }
+
+        #[inline(always)]
+        fn near8(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8 {
+            // See `Avx2::near8`.
+            self.vectorize(
+                #[inline(always)]
+                || self.near8_inline(xi, yi, xs, ys, hsq),
+            )
+        }
+    }
+
+    impl Avx512 {
+        #[inline(always)]
+        fn near8_inline(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8 {
+            let v = self.0;
+            let dx = v.sub_f64x8(cast(*xs), v.splat_f64x8(xi));
+            let dy = v.sub_f64x8(cast(*ys), v.splat_f64x8(yi));
+            let r2 = v.add_f64x8(v.mul_f64x8(dx, dx), v.mul_f64x8(dy, dy));
+            let below = v.cmp_lt_f64x8(r2, v.splat_f64x8(hsq));
+            Near8 {
+                mask: below.0,
+                r2: cast::<f64x8, [f64; 8]>(r2),
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simd::SimdPath;
+
+    /// Candidates at, just inside and just outside the radius, NaN, infinities, signed zeros.
+    fn awkward() -> ([f64; 8], [f64; 8]) {
+        let h = 16.0_f64;
+        (
+            [
+                h,
+                h - 1e-12,
+                0.0,
+                -0.0,
+                f64::NAN,
+                f64::INFINITY,
+                3.0,
+                11.3137084989847,
+            ],
+            [
+                0.0,
+                0.0,
+                h,
+                -h + 1e-9,
+                0.0,
+                0.0,
+                f64::NEG_INFINITY,
+                11.3137084989848,
+            ],
+        )
+    }
+
+    #[test]
+    fn every_available_path_gives_the_portable_bits_and_mask() {
+        let (xs, ys) = awkward();
+        let want = Portable.near8(0.0, 0.0, &xs, &ys, 256.0);
+        assert_eq!(
+            want.mask & 0b1111,
+            0b1010,
+            "r2 = 256 is not below HSQ, 256 - eps is"
+        );
+        for path in SimdPath::available() {
+            let got = crate::with_lanes!(path.lanes().unwrap(), l => {
+                l.vectorize(#[inline(always)] || l.near8(0.0, 0.0, &xs, &ys, 256.0))
+            });
+            assert_eq!(got.mask, want.mask, "{path}");
+            let bits = |r: [f64; 8]| r.map(f64::to_bits);
+            assert_eq!(bits(got.r2), bits(want.r2), "{path}");
+        }
+    }
+}
