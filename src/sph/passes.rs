@@ -6,7 +6,7 @@
 
 use glam::DVec2;
 
-use super::neighbors::Neighbors;
+use super::neighbors::{Neighbors, distance_squared};
 use super::params::{Integrator, Params};
 use super::state::{Domain, Fields, Positions};
 use crate::simd::Lanes;
@@ -67,19 +67,10 @@ pub fn force(
     let mut acc = (DVec2::ZERO, DVec2::ZERO);
     match neighbors {
         Some(list) => {
-            // The pair terms of up to eight neighbours side by side (lane-wise, so the
-            // compiler may vectorise them with the run's SIMD path), then summed in index
-            // order exactly as `add_pair_force` adds them.
-            for group in list.chunks(8) {
-                let t = PairTerms::of(&me, group, input, prm);
-                for k in 0..group.len() {
-                    if t.r[k] < prm.h {
-                        if t.r[k] > 0.0 {
-                            acc.0 += DVec2::new(t.press_x[k], t.press_y[k]);
-                        }
-                        acc.1 += DVec2::new(t.visc_x[k], t.visc_y[k]);
-                    }
-                }
+            for &j in list {
+                let j = j as usize;
+                let r2 = distance_squared(me.x.x, me.x.y, input.pos.x[j], input.pos.y[j]);
+                add_pair_force(&mut acc, &me, j, r2, input, prm);
             }
         }
         None => nb.for_each_within(lanes, i, input.pos, prm.hsq, |j, r2| {
@@ -97,58 +88,6 @@ struct Particle {
     x: DVec2,
     v: DVec2,
     p: f64,
-}
-
-/// The force terms of up to eight neighbours, each computed exactly as [`add_pair_force`]
-/// computes it (lanes past the group's length, and terms the sum skips, hold garbage).
-struct PairTerms {
-    r: [f64; 8],
-    press_x: [f64; 8],
-    press_y: [f64; 8],
-    visc_x: [f64; 8],
-    visc_y: [f64; 8],
-}
-
-impl PairTerms {
-    #[inline(always)]
-    fn of(me: &Particle, group: &[u32], input: &Fields<'_>, prm: &Params) -> PairTerms {
-        let mut xj = [0.0; 8];
-        let mut yj = [0.0; 8];
-        let mut vxj = [0.0; 8];
-        let mut vyj = [0.0; 8];
-        let mut rhoj = [1.0; 8];
-        let mut pj = [0.0; 8];
-        for (k, &j) in group.iter().enumerate() {
-            let j = j as usize;
-            (xj[k], yj[k]) = (input.pos.x[j], input.pos.y[j]);
-            (vxj[k], vyj[k]) = (input.vx[j], input.vy[j]);
-            (rhoj[k], pj[k]) = (input.rho[j], input.p[j]);
-        }
-        let mut t = PairTerms {
-            r: [0.0; 8],
-            press_x: [0.0; 8],
-            press_y: [0.0; 8],
-            visc_x: [0.0; 8],
-            visc_y: [0.0; 8],
-        };
-        for k in 0..8 {
-            let (dx, dy) = (xj[k] - me.x.x, yj[k] - me.x.y);
-            let r = (dx * dx + dy * dy).sqrt();
-            let hr = prm.h - r;
-            // ((((−d / r) · MASS) · (p_i + p_j)) / (2 ρ_j)) · SPIKY_GRAD · (hr · hr), per
-            // component, left to right.
-            let (sum_p, two_rho) = (me.p + pj[k], 2.0 * rhoj[k]);
-            let press = |d: f64| ((((-d / r) * prm.mass) * sum_p) / two_rho) * prm.spiky_grad;
-            t.press_x[k] = press(dx) * (hr * hr);
-            t.press_y[k] = press(dy) * (hr * hr);
-            // (((VISC·MASS · (v_j − v_i)) / ρ_j) · VISC_LAP) · hr, per component.
-            let visc = |dv: f64| (((prm.visc_mass * dv) / rhoj[k]) * prm.visc_lap) * hr;
-            t.visc_x[k] = visc(vxj[k] - me.v.x);
-            t.visc_y[k] = visc(vyj[k] - me.v.y);
-            t.r[k] = r;
-        }
-        t
-    }
 }
 
 /// Adds neighbour j's pressure and viscosity terms to `(fpress, fvisc)` when `r < H`.
