@@ -37,7 +37,7 @@ REF_STEPS=1000
 # behaviour alone; more steps would change the physics (a collapsing dam has more neighbours).
 LARGE_SIZES=("10000 10" "100000 10" "1000000 10")
 # Strategies of the large-N runs: "STRATEGY CORES CHUNKS"; "-" = the flag is not passed.
-LARGE_STRATEGIES=("seq - -" "crossbeam-pool 2 10")
+LARGE_STRATEGIES=("seq - -" "rayon-chunks 2 10" "crossbeam-pool 2 10")
 # The N whose peak RSS per particle is reported.
 RSS_N=1000000
 # --quick replaces the step counts.

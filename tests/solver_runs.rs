@@ -185,3 +185,31 @@ fn a_diverging_run_stops_with_the_step_and_particle_that_went_non_finite() {
     }
     assert_eq!(sim.steps_done, 1);
 }
+
+#[test]
+fn a_large_run_checked_in_parallel_blocks_stops_at_the_same_step_and_particle() {
+    // 80 000 particles: the divergence check runs on the executor in blocks. The same two
+    // overflowing particles as above, placed last, away from the dam.
+    let n = 80_000;
+    let domain = dam_break::domain(Preset::Seed, n);
+    let mut init = dam_break::initial_state(Preset::Seed, n, 1);
+    let last = n - 2;
+    (init.x[last], init.x[last + 1]) = (domain.width - 100.0, domain.width - 95.0);
+    (init.y[last], init.y[last + 1]) = (100.0, 100.0);
+    (init.vy[last], init.vy[last + 1]) = (1e308, -1e308);
+    for (strategy, cores) in [(StrategyName::Seq, 1), (StrategyName::CrossbeamPool, 2)] {
+        let mut sim = Simulation::new(
+            Preset::Seed.params(),
+            domain,
+            init.clone(),
+            NeighborMode::Grid,
+        );
+        let config = Config { cores, chunks: 7 };
+        match run_timed(&mut sim, strategy, &config, 5).unwrap_err() {
+            RunError::Step(StepError::Diverged { step, particle, .. }) => {
+                assert_eq!((step, particle), (1, last), "{strategy}");
+            }
+            other => panic!("{strategy}: expected divergence, got {other}"),
+        }
+    }
+}
