@@ -78,6 +78,24 @@ impl Session for TimedIters<'_> {
     }
 }
 
+/// Times `iters` repetitions of `work` from `start` on `strategy` (see [`TimedIters`]).
+fn time_iters(
+    start: &Simulation,
+    sim: &mut Simulation,
+    work: Work,
+    iters: u64,
+    strategy: StrategyName,
+    config: &Config,
+) -> Duration {
+    let timed = TimedIters {
+        start,
+        sim,
+        work,
+        iters,
+    };
+    sph_strategies::run(strategy, config, timed).expect("strategy builds")
+}
+
 /// The seed dam break of `n` particles after [`SETTLE_STEPS`] steps, with this step's
 /// neighbour lists, densities and forces in place (so a single pass can be timed).
 fn settled(mode: NeighborMode, n: usize) -> Simulation {
@@ -120,13 +138,7 @@ fn bench_scene(c: &mut Criterion, label: &str, mode: NeighborMode, n: usize) {
                 let id = BenchmarkId::new(strategy.as_str(), format!("{cores}-cores"));
                 group.bench_function(id, |b| {
                     b.iter_custom(|iters| {
-                        let timed = TimedIters {
-                            start: &start,
-                            sim: &mut sim,
-                            work,
-                            iters,
-                        };
-                        sph_strategies::run(strategy, &config, timed).expect("strategy builds")
+                        time_iters(&start, &mut sim, work, iters, strategy, &config)
                     })
                 });
             }
@@ -167,13 +179,7 @@ fn simd_paths(c: &mut Criterion) {
                 let mut sim = start.clone();
                 group.bench_function(path.as_str(), |b| {
                     b.iter_custom(|iters| {
-                        let timed = TimedIters {
-                            start: &start,
-                            sim: &mut sim,
-                            work,
-                            iters,
-                        };
-                        sph_strategies::run(StrategyName::Seq, &seq, timed).expect("seq builds")
+                        time_iters(&start, &mut sim, work, iters, StrategyName::Seq, &seq)
                     })
                 });
             }

@@ -55,33 +55,50 @@ mod x86 {
 
     use super::{Lanes, Near8};
 
-    /// AVX2: two 4-lane halves, each compare turned into four mask bits.
-    #[derive(Debug, Clone, Copy)]
-    pub struct Avx2(V3);
+    /// A path's lanes type around its `pulp` token: detection, `vectorize`, and `near8` as
+    /// one call with the features on (inside a vectorised pass it inlines to nothing; called
+    /// from elsewhere it is one call, not a call per instruction).
+    macro_rules! lanes_of {
+        ($(#[$doc:meta])* $name:ident($token:ident), $detect_doc:literal) => {
+            $(#[$doc])*
+            #[derive(Debug, Clone, Copy)]
+            pub struct $name($token);
 
-    impl Avx2 {
-        /// The lanes, if this CPU has AVX2 (and the rest of x86-64-v3).
-        pub fn detect() -> Option<Avx2> {
-            V3::try_new().map(Avx2)
-        }
-    }
+            impl $name {
+                #[doc = $detect_doc]
+                pub fn detect() -> Option<$name> {
+                    $token::try_new().map($name)
+                }
+            }
 
-    impl Lanes for Avx2 {
-        #[inline(always)]
-        fn vectorize<R>(self, f: impl FnOnce() -> R) -> R {
-            self.0.vectorize(f)
-        }
-
-        #[inline(always)]
-        fn near8(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8 {
-            // Inside a vectorised pass this inlines to nothing; called from elsewhere it is
-            // one call with the features on, not a call per instruction.
-            self.vectorize(
+            impl Lanes for $name {
                 #[inline(always)]
-                || self.near8_inline(xi, yi, xs, ys, hsq),
-            )
-        }
+                fn vectorize<R>(self, f: impl FnOnce() -> R) -> R {
+                    self.0.vectorize(f)
+                }
+
+                #[inline(always)]
+                fn near8(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8 {
+                    self.vectorize(
+                        #[inline(always)]
+                        || self.near8_inline(xi, yi, xs, ys, hsq),
+                    )
+                }
+            }
+        };
     }
+
+    lanes_of!(
+        /// AVX2: two 4-lane halves, each compare turned into four mask bits.
+        Avx2(V3),
+        "The lanes, if this CPU has AVX2 (and the rest of x86-64-v3)."
+    );
+
+    lanes_of!(
+        /// AVX-512: one 8-lane compare straight into a mask register.
+        Avx512(V4),
+        "The lanes, if this CPU has AVX-512 F/BW/CD/DQ/VL (x86-64-v4)."
+    );
 
     impl Avx2 {
         #[inline(always)]
@@ -108,33 +125,6 @@ mod x86 {
                 mask: mlo | (mhi << 4),
                 r2,
             }
-        }
-    }
-
-    /// AVX-512: one 8-lane compare straight into a mask register.
-    #[derive(Debug, Clone, Copy)]
-    pub struct Avx512(V4);
-
-    impl Avx512 {
-        /// The lanes, if this CPU has AVX-512 F/BW/CD/DQ/VL (x86-64-v4).
-        pub fn detect() -> Option<Avx512> {
-            V4::try_new().map(Avx512)
-        }
-    }
-
-    impl Lanes for Avx512 {
-        #[inline(always)]
-        fn vectorize<R>(self, f: impl FnOnce() -> R) -> R {
-            self.0.vectorize(f)
-        }
-
-        #[inline(always)]
-        fn near8(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8 {
-            // See `Avx2::near8`.
-            self.vectorize(
-                #[inline(always)]
-                || self.near8_inline(xi, yi, xs, ys, hsq),
-            )
         }
     }
 
