@@ -51,7 +51,7 @@ fn grid_agrees_with_all_pairs_to_1e_9_after_10_steps_for_every_preset() {
 #[test]
 fn neighbour_lists_of_any_width_give_the_same_bits() {
     // Width 2 holds one neighbour: nearly every particle overflows and is searched again by
-    // the passes that read the lists (the path a large run's 8 slots take in dense regions).
+    // the passes that read the lists.
     for preset in Preset::ALL {
         for mode in NeighborMode::ALL {
             let run_with = |width: Option<usize>| {

@@ -3,8 +3,7 @@
 //!
 //! The estimate counts the arrays that grow with N, from the sizes of their element types:
 //! - the particle state: [`FIELD_NAMES`]`.len()` arrays of `f64` (64 B per particle);
-//! - the neighbour lists: a count and [`mueller_slots`] slots per particle, `u32` each (132 B,
-//!   36 B from [`crate::sph::neighbors::LARGE_RUN`] particles on);
+//! - the neighbour lists: a count and [`SLOTS`] slots per particle, `u32` each (132 B);
 //! - with `--neighbors grid`, the cell list: particle order and cell (`u32` each), sorted
 //!   positions (`f64` × 2), and one `u32` start per cell of the tank, which widens with N
 //!   (see [`crate::scene::dam_break`]).
@@ -18,7 +17,7 @@ use std::mem::size_of;
 use crate::limits::MAX_PARTICLES;
 use crate::scene::{dam_break, tank};
 use crate::solver::SPEED_BLOCK;
-use crate::sph::neighbors::{GRID_PAD, NeighborMode, WCSPH_SLOTS, mueller_slots};
+use crate::sph::neighbors::{NeighborMode, SLOTS, WCSPH_SLOTS};
 use crate::sph::params::Preset;
 use crate::sph::physics::Physics;
 use crate::sph::state::FIELD_NAMES;
@@ -68,13 +67,7 @@ pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
         }
         _ => {
             let physics = Physics::from(preset.params());
-            (
-                physics,
-                dam_break::domain(preset, n),
-                n,
-                mueller_slots(n),
-                0,
-            )
+            (physics, dam_break::domain(preset, n), n, SLOTS, 0)
         }
     };
     let n64 = n as u64;
@@ -93,7 +86,6 @@ pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
         let starts = cols.saturating_mul(rows).saturating_add(1);
         bytes = bytes
             .saturating_add(n64.saturating_mul(grid_per_particle as u64))
-            .saturating_add((2 * GRID_PAD * size_of::<f64>()) as u64)
             .saturating_add(starts.saturating_mul(size_of::<u32>() as u64));
     }
     bytes
@@ -175,13 +167,12 @@ pub fn human_bytes(bytes: u64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sph::neighbors::LARGE_RUN;
 
     #[test]
     fn the_estimate_is_what_a_simulation_allocates() {
         for preset in Preset::ALL {
             for mode in NeighborMode::ALL {
-                for n in [1, 1000, 5000, LARGE_RUN] {
+                for n in [1, 1000, 5000, 70_000] {
                     let scene = crate::scene::Scene::dam_break(preset, n, 1).unwrap();
                     let state_bytes: usize = scene
                         .state
@@ -198,9 +189,9 @@ mod tests {
     }
 
     #[test]
-    fn a_billion_particles_on_the_grid_need_about_140_gb_and_are_refused_on_21() {
+    fn a_billion_particles_on_the_grid_need_about_230_gb_and_are_refused_on_21() {
         let needs = estimate(Preset::Seed, NeighborMode::Grid, 1_000_000_000);
-        assert_eq!(human_bytes(needs), "140 GB");
+        assert_eq!(human_bytes(needs), "230 GB");
         // The hard limit comes first; below it the same rule gives the same sentence.
         assert_eq!(
             check(Preset::Seed, NeighborMode::Grid, 1_000_000_000, None),
@@ -214,7 +205,7 @@ mod tests {
         };
         assert_eq!(
             err.to_string(),
-            "--n 1000000000 needs about 140 GB of memory (grid search); \
+            "--n 1000000000 needs about 230 GB of memory (grid search); \
              this machine has 21 GB available"
         );
     }

@@ -2,6 +2,11 @@
 //! target guarantees: SSE2 on x86-64, NEON on aarch64) and, on x86-64, AVX2 and AVX-512, chosen
 //! at start-up from what the CPU has ([`SimdPath::widest`]) or forced with `--simd`.
 //!
+//! The all-pairs search tests eight candidates per call ([`Lanes::near8`]); every pass that
+//! searches runs inside [`Lanes::vectorize`], so the compiler may use the path's instructions
+//! for the rest of the pass too. The grid tests its candidates one by one: a row holds only
+//! 3–12, and blocks of eight measured slower there.
+//!
 //! Every path computes the same bits. What is vectorised is lane-wise IEEE arithmetic in the
 //! scalar code's order (`d = x_j − x_i`, `dx*dx + dy*dy`, then `< HSQ`): no fused multiply-add
 //! (Rust never contracts), no reassociation, and each particle's sums still run in index order

@@ -11,24 +11,13 @@
 
 use sph_strategies::Split;
 
-/// Neighbour slots per particle of Müller's presets below [`LARGE_RUN`] particles (128 bytes).
-/// Dam-break particles have about 5–15 neighbours; piles in the corners can have more, and
-/// take the slower path.
+/// Neighbour slots per particle of Müller's presets (128 bytes). Dam-break particles have
+/// about 5–15 neighbours; piles in the corners can have more, and take the slower path.
+///
+/// Narrower lists were measured (8 and 16 slots from 10⁵ particles on, 36 or 68 bytes): a
+/// 10⁶-particle dam at rest stepped 30 % faster, but a 10⁵-particle dam in motion (200 steps)
+/// 45 % slower, its many particles with more neighbours than slots searched twice a step.
 pub const SLOTS: usize = 32;
-
-/// From this many particles on, Müller's presets get [`LARGE_SLOTS`] slots per particle.
-pub const LARGE_RUN: usize = 100_000;
-
-/// Neighbour slots per particle of a large run (32 bytes), so that a run of 10⁶ particles
-/// needs under 150 bytes each: a large scene is mostly at rest in its first steps (one or two
-/// neighbours each); a particle with more than seven is searched again by the force pass.
-pub const LARGE_SLOTS: usize = 8;
-
-/// The slots per particle of a Müller run of `n` particles: [`SLOTS`], or [`LARGE_SLOTS`]
-/// from [`LARGE_RUN`] on. Either gives the same bits; only memory and speed differ.
-pub fn mueller_slots(n: usize) -> usize {
-    if n >= LARGE_RUN { LARGE_SLOTS } else { SLOTS }
-}
 
 /// Neighbour slots per particle of the `wcsph` preset (256 bytes).
 pub const WCSPH_SLOTS: usize = 64;
@@ -46,9 +35,9 @@ pub struct NeighborLists {
 }
 
 impl NeighborLists {
-    /// Room for `n` particles of Müller's presets ([`mueller_slots`] each).
+    /// Room for `n` particles of [`SLOTS`] slots each.
     pub fn new(n: usize) -> Self {
-        Self::with_slots(n, mueller_slots(n))
+        Self::with_slots(n, SLOTS)
     }
 
     /// Room for `n` particles of `width` slots each.

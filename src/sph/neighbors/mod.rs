@@ -9,10 +9,8 @@ mod grid;
 pub mod list;
 
 pub use all_pairs::AllPairs;
-pub use grid::{Grid, PAD as GRID_PAD};
-pub use list::{
-    LARGE_RUN, LARGE_SLOTS, NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS, mueller_slots,
-};
+pub use grid::Grid;
+pub use list::{NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS};
 
 use serde::Serialize;
 use sph_strategies::{Executor, KernelPanic};
