@@ -4,8 +4,9 @@
 //!
 //! The all-pairs search tests eight candidates per call ([`Lanes::near8`]); every pass that
 //! searches runs inside [`Lanes::vectorize`], so the compiler may use the path's instructions
-//! for the rest of the pass too. The grid tests its candidates one by one: a row holds only
-//! 3–12, and blocks of eight measured slower there.
+//! for the rest of the pass too. The grid tests its candidates one by one and its passes run
+//! as the target compiles them whatever the path: a row holds only 3–12 candidates, and both
+//! blocks of eight and passes compiled for AVX-512 measured slower there.
 //!
 //! Every path computes the same bits. What is vectorised is lane-wise IEEE arithmetic in the
 //! scalar code's order (`d = x_j − x_i`, `dx*dx + dy*dy`, then `< HSQ`): no fused multiply-add
