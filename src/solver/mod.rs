@@ -223,9 +223,13 @@ impl Simulation {
         self
     }
 
-    /// The SIMD path the neighbour tests run on.
+    /// The SIMD path the neighbour tests run on: the chosen one for all-pairs, `portable` for
+    /// the grid (see [`with_search_lanes!`]), so that `--json` and `meta.json` name what ran.
     pub fn simd(&self) -> SimdPath {
-        self.lanes.path()
+        match self.neighbors {
+            AnyNeighbors::AllPairs(_) => self.lanes.path(),
+            AnyNeighbors::Grid(_) => SimdPath::Portable,
+        }
     }
 
     /// The model's passes, in step order.
