@@ -544,3 +544,35 @@ fn cells_with_more_cores_than_hardware_threads_are_marked_and_warned_about() {
         assert!(r["stddev_s"].is_empty());
     }
 }
+
+#[test]
+fn a_resumed_sweep_runs_its_recorded_simd_path_and_refuses_another() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("s");
+    let d = dir.to_str().unwrap();
+    let mut args = vec!["--simd", "portable"];
+    args.extend(TINY);
+    args.extend([
+        "--out",
+        d,
+        "--stop-after-cells",
+        "2",
+        "--fake-timings",
+        "1,2",
+    ]);
+    fails_with(&args, &["Error:", "interrupted", "--resume"]);
+    let meta = std::fs::read_to_string(dir.join("meta.json")).unwrap();
+    assert!(meta.contains("\"simd\": \"portable\""), "{meta}");
+    let widest = bench_sph::simd::SimdPath::widest();
+    if widest != bench_sph::simd::SimdPath::Portable {
+        let asked = widest.as_str();
+        fails_with(
+            &["--simd", asked, "sweep", "--resume", d, "--no-plots"],
+            &[&format!(
+                "--simd {asked}: this sweep was measured on portable"
+            )],
+        );
+    }
+    let o = run(&["sweep", "--resume", d, "--no-plots"]);
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+}

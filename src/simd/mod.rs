@@ -134,6 +134,13 @@ macro_rules! with_lanes {
 /// The process's path, set once at start-up by `--simd`; `u8::MAX` until then (the widest).
 static CHOSEN: AtomicU8 = AtomicU8::new(u8::MAX);
 
+/// The path `--simd` asked for, if it was given.
+pub fn chosen() -> Option<SimdPath> {
+    SimdPath::ALL
+        .get(usize::from(CHOSEN.load(Ordering::Relaxed)))
+        .copied()
+}
+
 /// The path new simulations use: the one [`choose`]n, else the widest this CPU runs.
 pub fn current() -> SimdPath {
     match CHOSEN.load(Ordering::Relaxed) {

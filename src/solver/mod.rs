@@ -154,7 +154,7 @@ macro_rules! with_search {
 
 /// [`with_search!`], and `$l` bound to the lanes the search tests candidates in: the run's
 /// SIMD path for all-pairs; the portable lanes for the grid, which tests its few candidates
-/// per row one by one (its passes compiled for AVX-512 measured 10–15 % slower here).
+/// per row one by one (its passes compiled for AVX-512 measured 8–15 % slower here).
 macro_rules! with_search_lanes {
     ($any:expr, $lanes:expr, ($nb:ident, $l:ident) => $body:expr) => {
         match $any {

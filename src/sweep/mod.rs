@@ -125,6 +125,12 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
     let params = opened.meta.params.clone();
     if let Some(path) = params.simd {
         // A resumed sweep measures on the path its first cells did.
+        if let Some(asked) = crate::simd::chosen().filter(|&asked| asked != path) {
+            anyhow::bail!(
+                "--simd {asked}: this sweep was measured on {path}; resume it with --simd {path} \
+                 or without --simd"
+            );
+        }
         crate::simd::choose(path).context("cannot resume this sweep here")?;
     }
     let timing = Timing::new(
