@@ -224,7 +224,8 @@ impl Simulation {
     }
 
     /// The SIMD path the neighbour tests run on: the chosen one for all-pairs, `portable` for
-    /// the grid (see [`with_search_lanes!`]), so that `--json` and `meta.json` name what ran.
+    /// the grid (which tests its few candidates per row one by one), so that `--json` and
+    /// `meta.json` name what ran.
     pub fn simd(&self) -> SimdPath {
         match self.neighbors {
             AnyNeighbors::AllPairs(_) => self.lanes.path(),
