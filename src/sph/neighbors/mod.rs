@@ -56,7 +56,8 @@ pub trait Neighbors: Sync {
 
     /// Calls `visit(j, r2)` for every particle j (including `i` itself) whose squared
     /// distance `r2 = dx*dx + dy*dy` (with `d = x_j − x_i`) is below `hsq`, in increasing j,
-    /// testing candidates in `lanes` (every path finds the same j with the same r2).
+    /// testing candidates in `lanes` where the search uses them (all-pairs does, the grid does
+    /// not); every path finds the same j with the same r2.
     fn for_each_within<L: Lanes>(
         &self,
         lanes: L,
