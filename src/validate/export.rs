@@ -49,15 +49,12 @@ pub fn write_surge_front(
     scales: &Scales,
     out: impl Write,
 ) -> anyhow::Result<()> {
-    let mut w = csv::Writer::from_writer(out);
-    for s in samples {
-        w.serialize(FrontRow {
-            t_s: s.t_s,
-            front_time: scales.front_time(s.t_s),
-            front: s.front_m / scales.a,
-        })?;
-    }
-    w.flush().context("cannot write the surge front")
+    let rows = samples.iter().map(|s| FrontRow {
+        t_s: s.t_s,
+        front_time: scales.front_time(s.t_s),
+        front: s.front_m / scales.a,
+    });
+    write_rows(rows, out).context("cannot write the surge front")
 }
 
 /// Writes `column_height.csv`: per sample, t (s), τ = t √(g/a) and H = h / (2a).
@@ -66,15 +63,21 @@ pub fn write_column_height(
     scales: &Scales,
     out: impl Write,
 ) -> anyhow::Result<()> {
+    let rows = samples.iter().map(|s| ColumnRow {
+        t_s: s.t_s,
+        tau: scales.column_time(s.t_s),
+        height: s.column_m / (2.0 * scales.a),
+    });
+    write_rows(rows, out).context("cannot write the column height")
+}
+
+/// Writes `rows` as CSV with a header from their field names.
+fn write_rows(rows: impl Iterator<Item = impl Serialize>, out: impl Write) -> csv::Result<()> {
     let mut w = csv::Writer::from_writer(out);
-    for s in samples {
-        w.serialize(ColumnRow {
-            t_s: s.t_s,
-            tau: scales.column_time(s.t_s),
-            height: s.column_m / (2.0 * scales.a),
-        })?;
+    for row in rows {
+        w.serialize(row)?;
     }
-    w.flush().context("cannot write the column height")
+    w.flush().map_err(csv::Error::from)
 }
 
 /// Whether `path` is a file an earlier `validate` wrote, judged by name and content: the two
