@@ -68,6 +68,29 @@ impl Machine {
     }
 }
 
+impl Machine {
+    /// Whether timings from `self` and `other` may be pooled as one machine's: the same CPU
+    /// model and the same number of hardware threads. Anything else makes two sweeps a
+    /// comparison between machines, not one study.
+    pub fn same_hardware(&self, other: &Machine) -> bool {
+        self.cpu_model == other.cpu_model && self.hardware_threads == other.hardware_threads
+    }
+
+    /// How reports and messages name the machine, e.g. `Intel(R) Xeon(R) Processor, 2
+    /// hardware threads`.
+    pub fn label(&self) -> String {
+        format!(
+            "{}, {}",
+            self.cpu_model,
+            crate::output::console::plural(
+                self.hardware_threads,
+                "hardware thread",
+                "hardware threads"
+            )
+        )
+    }
+}
+
 /// The first `model name` (x86) or, failing that, `Hardware`/`Processor`/`cpu model` value.
 fn cpu_model(cpuinfo: &str) -> Option<String> {
     ["model name", "Hardware", "Processor", "cpu model"]

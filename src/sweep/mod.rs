@@ -510,7 +510,7 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
 /// Warns when a resumed sweep continues on another machine or with another build.
 fn warn_if_changed(meta: &Meta, session: &Session) {
     let (was, now) = (&meta.machine, &session.machine);
-    if was.cpu_model != now.cpu_model || was.hardware_threads != now.hardware_threads {
+    if !was.same_hardware(now) {
         console_warn(&format!(
             "warning: this sweep started on '{}' ({} hardware threads) and continues on '{}' \
              ({}): times from the two machines are not comparable",
