@@ -17,6 +17,7 @@
 //!   `viewer`): the same, live in a window;
 //! - [`sweep`]: the cores × chunks study (`bench-sph sweep`); [`results`]: the schema of its
 //!   results directory, which the sweep writes and the report reads;
+//! - [`merge`]: one results directory from the shards of a sweep (`bench-sph merge`);
 //! - [`report`]: charts and REPORT.md from results directories (`bench-sph report`);
 //! - [`trace`]: per-worker timelines of a few steps (`bench-sph trace`);
 //! - [`cli`]: the `bench-sph` command line.
@@ -27,6 +28,7 @@ pub mod clock;
 pub mod contention;
 pub mod io;
 pub mod limits;
+pub mod merge;
 pub mod output;
 pub mod plot;
 pub mod render;

@@ -12,6 +12,7 @@
 //! | `--trials` | 1 ..= [`MAX_TRIALS`] | |
 //! | `--warmup` | 0 ..= [`MAX_WARMUP`] | |
 //! | a sweep's cells | at most [`MAX_CELLS`] | the product of its lists |
+//! | `--shard I/K` | 1 ≤ I ≤ K ≤ [`MAX_SHARDS`] (1024) | as many nodes as `--cores` allows threads; a shard also repeats its groups' `seq` cells, so far more shards than cells only wastes node time |
 
 /// The most worker threads any command accepts.
 pub const MAX_CORES: usize = 1024;
@@ -30,6 +31,9 @@ pub const MAX_WARMUP: usize = 1000;
 /// The most cells one sweep may plan (the lists multiply: cores × chunks × N × …); far
 /// beyond any study that finishes, and small enough that the plan itself fits in memory.
 pub const MAX_CELLS: usize = 1_000_000;
+
+/// The most parts `sweep --shard I/K` may split a plan into.
+pub const MAX_SHARDS: usize = 1024;
 
 /// A numeric option outside its documented range.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

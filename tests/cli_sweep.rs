@@ -19,7 +19,7 @@ const TRIAL_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,parti
 const SUMMARY_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
     trials,mean_s,stddev_s,min_s,median_s,max_s,cpu_mean_s,speedup,efficiency,outliers,\
     oversubscribed,checksum,status,reason,mean_ci_low_s,mean_ci_high_s,speedup_ci_low,\
-    speedup_ci_high,foreign_cpu_mean_s,contended";
+    speedup_ci_high,foreign_cpu_mean_s,contended,reference_shard";
 
 /// A tiny sweep: 1 seq cell + 3 strategies × 2 cores + 2 strategies × 2 cores × 2 chunks = 15.
 const TINY: &[&str] = &[

@@ -3,6 +3,7 @@
 //! and the CLI's names for the domain's enums (`values`).
 
 mod list;
+mod merge;
 mod parallel;
 mod render;
 mod report;
@@ -19,6 +20,7 @@ use clap::{Parser, Subcommand};
 
 use crate::limits;
 
+pub use merge::MergeArgs;
 pub use render::RenderArgs;
 pub use report::ReportArgs;
 pub use simulate::SimulateArgs;
@@ -73,6 +75,19 @@ pub enum Command {
         bench-sph sweep --resume results/2026-11-22T031500Z"
     )]
     Sweep(SweepArgs),
+    /// Merge the shard directories of `sweep --shard I/K` into one results directory.
+    #[command(
+        after_help = "Refuses shards of different plans, builds or machines (that is a comparison: \
+        `bench-sph report A B`), a shard given twice, and missing cells unless --allow-partial. Each cell \
+        keeps the speedup its own shard measured against its own seq (column reference_shard); every \
+        shard's seq rows go to references.csv, and the merge warns when they disagree beyond their \
+        95 % intervals.\n\n\
+        Examples:\n  \
+        bench-sph sweep --cores 1..16 --chunks 10..200 --shard 1/3 --out results/study/shard-1   # on node 1, and so on\n  \
+        bench-sph merge results/study/shard-1 results/study/shard-2 results/study/shard-3 --out results/study/merged\n  \
+        bench-sph report results/study/merged"
+    )]
+    Merge(MergeArgs),
     /// Turn results directories into PNG charts and REPORT.md (also run at the end of a sweep).
     #[command(
         after_help = "Charts: runtime and CPU time against chunks per core count, best runtime and speedup \
@@ -138,6 +153,7 @@ pub fn run() -> anyhow::Result<()> {
         Command::List => list::run(&mut std::io::stdout().lock()),
         Command::Render(args) => render::run(&args),
         Command::Sweep(args) => sweep::run(&args),
+        Command::Merge(args) => merge::run(&args),
         Command::Report(args) => report::run(&args),
         Command::Trace(args) => trace::run(&args),
         Command::Validate(args) => validate::run(&args),

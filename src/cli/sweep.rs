@@ -6,6 +6,7 @@ use anyhow::Context;
 use clap::{Arg, Args};
 use sph_strategies::StrategyName;
 
+use crate::results::shard::Shard;
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
 use crate::sweep::params::SweepParams;
@@ -24,7 +25,7 @@ const QUICK_TRIALS: usize = 3;
 ///
 /// Not an `ArgGroup` that conflicts with `--resume`: clap's error for `--resume DIR --n 5`
 /// would then list every member of the group instead of naming `--n`.
-const NEW_SWEEP_ONLY: [&str; 15] = [
+const NEW_SWEEP_ONLY: [&str; 16] = [
     "cores",
     "chunks",
     "strategies",
@@ -40,6 +41,7 @@ const NEW_SWEEP_ONLY: [&str; 15] = [
     "quick",
     "fake_timings",
     "fake_contention",
+    "shard",
 ];
 
 /// Makes each of [`NEW_SWEEP_ONLY`] conflict with `--resume` (in place, keeping clap's order).
@@ -99,6 +101,11 @@ pub struct SweepArgs {
     /// directory.
     #[arg(long)]
     pub force: bool,
+    /// Run only shard I of K of the plan (1 ≤ I ≤ K ≤ 1024), e.g. one node of a batch job:
+    /// the plan's cells other than seq, dealt round-robin, plus the seq cell of every group
+    /// it touches. Merge the K directories with `bench-sph merge`; the report comes after.
+    #[arg(long, value_name = "I/K", value_parser = clap::value_parser!(Shard))]
+    pub shard: Option<Shard>,
     /// Do not draw charts at the end.
     #[arg(long)]
     pub no_plots: bool,
@@ -161,6 +168,7 @@ impl SweepArgs {
             simd: Some(crate::simd::current()),
             fake_timings: self.fake_timings.clone(),
             fake_contention: self.fake_contention.clone(),
+            shard: self.shard,
         })
     }
 
@@ -189,7 +197,12 @@ impl SweepArgs {
 /// cli → run → export.
 pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     let finished = crate::sweep::run(args.request()?)?;
-    let charts = if finished.is_complete() {
+    let charts = if let Some(shard) = finished.shard() {
+        Ok(format!(
+            "Charts: not drawn for shard {shard} alone: once every shard is done, \
+             `bench-sph merge SHARD_DIR... --out DIR` and `bench-sph report DIR`."
+        ))
+    } else if finished.is_complete() {
         charts(finished.dir(), args.no_plots)
     } else {
         Ok(String::new())

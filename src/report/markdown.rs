@@ -98,6 +98,7 @@ pub fn render(input: &Input<'_>) -> String {
 fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
     use crate::results::meta::SweepStatus;
     for s in sweeps {
+        shard_banner(md, s);
         let measured = s.rows.len() + s.dropped.len();
         if s.meta.status == SweepStatus::Complete && measured >= s.meta.planned_cells {
             continue;
@@ -112,7 +113,7 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
         let _ = writeln!(
             md,
             "> ⚠ **Partial study**: `{}` is {} — {} of {} planned cells measured{}. Its \
-             findings cover only what was measured; `bench-sph sweep --resume {}` completes it.\n",
+             findings cover only what was measured; {}.\n",
             s.dir.display(),
             format!("{:?}", s.meta.status).to_lowercase(),
             measured,
@@ -122,11 +123,49 @@ fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
             } else {
                 format!("; never measured: {}", never.join(", "))
             },
-            s.dir.display()
+            match &s.meta.merge {
+                Some(_) =>
+                    "run or resume the missing shards and merge again to complete it".to_owned(),
+                None => format!(
+                    "`bench-sph sweep --resume {}` completes it",
+                    s.dir.display()
+                ),
+            }
         );
     }
     contended_banner(md, rows);
     dropped_banner(md, sweeps);
+}
+
+/// The banner over one shard of a sharded sweep, and the line under a merge of shards.
+fn shard_banner(md: &mut String, s: &Sweep) {
+    if let Some(shard) = s.meta.params.shard {
+        let _ = writeln!(
+            md,
+            "> ⚠ **One shard**: `{}` is shard {shard} of a sharded sweep (plan {}): it holds \
+             only its part of the plan's cells, so its findings cover only those. `bench-sph \
+             merge` joins the shards into the study.\n",
+            s.dir.display(),
+            s.meta.plan_fingerprint.as_deref().unwrap_or("unknown")
+        );
+    }
+    if let Some(merge) = &s.meta.merge {
+        let shards: Vec<String> = merge.shards.iter().map(|m| m.shard.to_string()).collect();
+        let _ = writeln!(
+            md,
+            "`{}` is a merge of shards {} (plan {}): each cell's speedup divides by the `seq` \
+             of the shard that measured it (`reference_shard` in summary.csv; every shard's \
+             `seq` is in references.csv).{}\n",
+            s.dir.display(),
+            shards.join(", "),
+            s.meta.plan_fingerprint.as_deref().unwrap_or("unknown"),
+            merge
+                .warnings
+                .iter()
+                .map(|w| format!("\n\n> ⚠ {w}"))
+                .collect::<String>()
+        );
+    }
 }
 
 /// The banner over a study with contended cells.

@@ -49,12 +49,18 @@ use plan::ChartKind;
 /// (the report is often drawn into the sweep's directory) and any directory (traces; the
 /// report never writes into subdirectories).
 fn tolerated(path: &Path) -> bool {
-    use crate::results::{LOCK_FILE, META_FILE, SUMMARY_FILE, TRIALS_FILE};
+    use crate::results::{LOCK_FILE, META_FILE, REFERENCES_FILE, SUMMARY_FILE, TRIALS_FILE};
     path.is_dir()
-        || path
-            .file_name()
-            .and_then(|n| n.to_str())
-            .is_some_and(|n| [TRIALS_FILE, SUMMARY_FILE, META_FILE, LOCK_FILE].contains(&n))
+        || path.file_name().and_then(|n| n.to_str()).is_some_and(|n| {
+            [
+                TRIALS_FILE,
+                SUMMARY_FILE,
+                META_FILE,
+                LOCK_FILE,
+                REFERENCES_FILE,
+            ]
+            .contains(&n)
+        })
 }
 
 /// Reads the sweeps in `results_dirs`, draws every chart that applies into `out_dir`

@@ -12,6 +12,8 @@ pub const TRIALS_FILE: &str = "trials.csv";
 pub const SUMMARY_FILE: &str = "summary.csv";
 /// The metadata file.
 pub const META_FILE: &str = "meta.json";
+/// Every shard's `seq` rows, in a merge of shards (`bench-sph merge`; `summary.csv`'s columns).
+pub const REFERENCES_FILE: &str = "references.csv";
 /// The sweep's lock file (see `crate::sweep::lock`).
 pub const LOCK_FILE: &str = "sweep.lock";
 

@@ -24,7 +24,7 @@ use super::key::Cell;
 use super::meta::Meta;
 use super::rows::{
     LEGACY_SUMMARY_COLUMNS, LEGACY_TRIAL_COLUMNS, SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS,
-    TrialRow,
+    TrialRow, UNSHARDED_SUMMARY_COLUMNS,
 };
 use super::validate;
 
@@ -141,21 +141,26 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
 /// Reads a `summary.csv` (this version's columns or the first release's): its rows, and a
 /// note for each line that is not one.
 pub fn read_summary(path: &Path) -> anyhow::Result<(Vec<SummaryRow>, Vec<String>)> {
-    read_csv(path, &SUMMARY_COLUMNS, LEGACY_SUMMARY_COLUMNS, "summary")
+    read_csv(
+        path,
+        &SUMMARY_COLUMNS,
+        &[LEGACY_SUMMARY_COLUMNS, UNSHARDED_SUMMARY_COLUMNS],
+        "summary",
+    )
 }
 
 /// Reads a `trials.csv` (this version's columns or the first release's), as
 /// [`read_summary`].
 pub fn read_trials(path: &Path) -> anyhow::Result<(Vec<TrialRow>, Vec<String>)> {
-    read_csv(path, &TRIAL_COLUMNS, LEGACY_TRIAL_COLUMNS, "trial")
+    read_csv(path, &TRIAL_COLUMNS, &[LEGACY_TRIAL_COLUMNS], "trial")
 }
 
-/// The rows of a results CSV whose header is `columns` or its first `legacy` columns, and a
-/// note naming each line that is not such a row.
+/// The rows of a results CSV whose header is `columns` or the first `w` of them for a width `w`
+/// of `legacy` (an earlier version's file), and a note naming each line that is not a row.
 fn read_csv<R: serde::de::DeserializeOwned>(
     path: &Path,
     columns: &[&str],
-    legacy: usize,
+    legacy: &[usize],
     what: &str,
 ) -> anyhow::Result<(Vec<R>, Vec<String>)> {
     let mut reader = csv::Reader::from_path(path)
@@ -165,7 +170,7 @@ fn read_csv<R: serde::de::DeserializeOwned>(
         .with_context(|| format!("cannot read '{}'", path.display()))?
         .clone();
     let found: Vec<&str> = header.iter().collect();
-    if found != columns && found != columns[..legacy] {
+    if found != columns && !legacy.iter().any(|&w| found == columns[..w]) {
         bail!(
             "'{}' is not a bench-sph {}: its header is not {}",
             path.display(),

@@ -12,6 +12,7 @@ use anyhow::Context;
 use serde::{Deserialize, Serialize};
 
 use super::params::SweepParams;
+use super::shard::Shard;
 use super::stats::{CONFIDENCE, RESAMPLES};
 
 /// The version of bench-sph that wrote the file.
@@ -31,6 +32,9 @@ pub enum SweepStatus {
     Complete,
     /// Stopped by Ctrl-C; `--resume` continues it.
     Interrupted,
+    /// A merge of shards with cells missing (`bench-sph merge --allow-partial`): resume or run
+    /// the missing shards and merge again.
+    Partial,
 }
 
 /// The machine a session ran on.
@@ -211,8 +215,40 @@ pub struct Meta {
     /// before they existed).
     #[serde(default)]
     pub statistics: Option<Statistics>,
-    /// Every session, first to last.
+    /// Every session, first to last (for a merge: every shard's, shard by shard).
     pub sessions: Vec<Session>,
+    /// The plan's fingerprint ([`SweepParams::fingerprint`]), shared by every shard of one plan
+    /// (absent in sweeps written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plan_fingerprint: Option<String>,
+    /// For a merge of shards (`bench-sph merge`): where its cells came from.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub merge: Option<Merge>,
+}
+
+/// How a results directory was merged from shards (`meta.json`'s `merge`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Merge {
+    /// The shards merged, by shard number.
+    pub shards: Vec<MergedShard>,
+    /// Cells of the plan that no shard had, by label (empty unless `--allow-partial`).
+    pub missing_cells: Vec<String>,
+    /// What the merge warned about (shards whose `seq` means disagree).
+    pub warnings: Vec<String>,
+}
+
+/// One shard of a merge.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MergedShard {
+    /// Which shard.
+    pub shard: Shard,
+    /// Its results directory, as given to `bench-sph merge`.
+    pub dir: String,
+    /// Its state when merged.
+    pub status: SweepStatus,
+    /// Its cells in the merge (its `seq` cells count only where they are the merge's
+    /// reference; the others are in `references.csv`).
+    pub cells: usize,
 }
 
 impl Meta {
@@ -231,8 +267,10 @@ impl Meta {
             status: SweepStatus::Running,
             planned_cells,
             statistics: Some(Statistics::current(params.seed)),
+            plan_fingerprint: Some(params.fingerprint()),
             params,
             sessions: vec![session],
+            merge: None,
         }
     }
 

@@ -12,6 +12,7 @@
 //!   `seq` mean, efficiency = speedup / cores, outliers (|t − median| > 3 MAD),
 //!   oversubscribed, the common checksum, status and reason;
 //! - `meta.json`: machine, build, times, command lines and every parameter;
+//! - in a merge of shards, `references.csv`: every shard's `seq` rows;
 //! - `sweep.lock` while a sweep runs, and the report drawn from it (`REPORT.md`, charts).
 
 pub mod files;
@@ -21,7 +22,10 @@ pub mod meta;
 pub mod names;
 pub mod params;
 pub mod rows;
+pub mod shard;
 pub mod stats;
 pub mod validate;
 
-pub use files::{LOCK_FILE, META_FILE, REPORT_FILE, SUMMARY_FILE, TRIALS_FILE, is_report_file};
+pub use files::{
+    LOCK_FILE, META_FILE, REFERENCES_FILE, REPORT_FILE, SUMMARY_FILE, TRIALS_FILE, is_report_file,
+};

@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 use sph_strategies::StrategyName;
 
 use super::names::name_list;
+use super::shard::Shard;
 use crate::simd::SimdPath;
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
@@ -40,10 +41,27 @@ pub struct SweepParams {
     /// directories written before it was recorded. `--resume` runs the recorded path.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub simd: Option<SimdPath>,
+    /// Which part of the plan this sweep runs (`--shard I/K`); absent for the whole plan.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shard: Option<Shard>,
     /// Test only: trial times replacing the measured ones (see [`crate::sweep::timing`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fake_timings: Option<String>,
     /// Test only: foreign-CPU shares replacing the measured ones (see [`crate::sweep::timing`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fake_contention: Option<String>,
+}
+
+impl SweepParams {
+    /// The plan's fingerprint: FNV-1a (64-bit, [`crate::checksum::fingerprint`]) of these
+    /// parameters as `meta.json` writes them, without the shard, as 16 hex digits. The shards
+    /// of one plan share it; any other parameter that differs changes it.
+    pub fn fingerprint(&self) -> String {
+        let whole = SweepParams {
+            shard: None,
+            ..self.clone()
+        };
+        let json = serde_json::to_vec(&whole).expect("the parameters serialize");
+        format!("{:016x}", crate::checksum::fingerprint(&json))
+    }
 }

@@ -11,7 +11,10 @@
 //! keep working): per trial `foreign_cpu_s, steal_s, load1` ([`crate::contention`]); per cell
 //! the 95 % bootstrap intervals `mean_ci_low_s, mean_ci_high_s, speedup_ci_low,
 //! speedup_ci_high` ([`crate::sweep::bootstrap`]), `foreign_cpu_mean_s` and `contended` (some trial
-//! saw more foreign CPU than [`crate::contention::Threshold::allowed_s`]).
+//! saw more foreign CPU than [`crate::contention::Threshold::allowed_s`]), then
+//! `reference_shard`: in a shard of a sharded sweep (`sweep --shard I/K`) and in a merge of
+//! shards, the shard I whose `seq` cell is the row's speedup denominator, which is the shard
+//! that measured the row; empty in an unsharded sweep.
 
 use serde::{Deserialize, Serialize};
 use sph_strategies::StrategyName;
@@ -42,7 +45,7 @@ pub const TRIAL_COLUMNS: [&str; 17] = [
 ];
 
 /// The columns of `summary.csv`, in order.
-pub const SUMMARY_COLUMNS: [&str; 28] = [
+pub const SUMMARY_COLUMNS: [&str; 29] = [
     "strategy",
     "neighbors",
     "preset",
@@ -71,6 +74,7 @@ pub const SUMMARY_COLUMNS: [&str; 28] = [
     "speedup_ci_high",
     "foreign_cpu_mean_s",
     "contended",
+    "reference_shard",
 ];
 
 /// How many leading columns of each file bench-sph 0.1.0 wrote before the contention and
@@ -78,6 +82,9 @@ pub const SUMMARY_COLUMNS: [&str; 28] = [
 pub const LEGACY_TRIAL_COLUMNS: usize = 14;
 /// See [`LEGACY_TRIAL_COLUMNS`].
 pub const LEGACY_SUMMARY_COLUMNS: usize = 22;
+/// The columns of `summary.csv` before `reference_shard` was appended (bench-sph 0.1.0 with
+/// the contention and interval columns): read as they are, and upgraded by `--resume`.
+pub const UNSHARDED_SUMMARY_COLUMNS: usize = 28;
 
 /// Whether a cell's numbers can be used.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -203,6 +210,10 @@ pub struct SummaryRow {
     /// Whether some trial saw more foreign CPU than the threshold (empty where unknown).
     #[serde(default)]
     pub contended: Option<bool>,
+    /// The shard (1-based) whose `seq` cell is this row's speedup denominator: the shard that
+    /// measured it (empty in an unsharded sweep).
+    #[serde(default)]
+    pub reference_shard: Option<usize>,
 }
 
 /// The columns that name a row's cell, shared by both files.
@@ -321,6 +332,7 @@ pub(crate) mod tests {
             speedup_ci_high: Some(4.0 / mean * 1.05),
             foreign_cpu_mean_s: Some(0.0),
             contended: Some(false),
+            reference_shard: None,
         }
     }
 

@@ -240,6 +240,7 @@ mod tests {
             simd: None,
             fake_timings: None,
             fake_contention: None,
+            shard: None,
         })
     }
 

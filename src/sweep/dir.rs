@@ -1,7 +1,7 @@
 //! The results directory of a sweep: choosing it, locking it, and what may already be in it.
 //!
 //! A new sweep's directory must be new or empty, or hold only a sweep's own earlier output
-//! (`trials.csv`, `summary.csv`, its `meta.json`, `sweep.lock`, and the report the sweep drew:
+//! (`trials.csv`, `summary.csv`, its `meta.json`, `sweep.lock`, a merge's `references.csv`, and the report the sweep drew:
 //! `REPORT.md` and chart PNGs); that earlier output is replaced only with `--force`, and then
 //! all of it, so no REPORT.md or chart of the old data stays beside the new. Trace directories
 //! inside are left alone. Anything else is refused (see [`crate::output::claim`]).
@@ -17,6 +17,7 @@ use anyhow::{Context, bail};
 use super::lock::{self, DirLock, LOCK_FILE};
 use super::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
 use crate::output::claim::{self, Owner};
+use crate::results::REFERENCES_FILE;
 use crate::results::meta::Meta;
 
 /// The default results directory: `results/<UTC timestamp>`, or with `-2`, `-3`, … when a
@@ -81,6 +82,7 @@ fn check_contents(dir: &Path, force: bool, remove: bool) -> anyhow::Result<()> {
         TRIALS_FILE,
         SUMMARY_FILE,
         META_FILE,
+        REFERENCES_FILE,
         crate::results::REPORT_FILE,
     ] {
         claimed.check_writable(name)?;
@@ -145,7 +147,7 @@ fn owned(path: &Path) -> bool {
     match name {
         // By contents too: a hand-written trials.csv is not ours to replace (an empty one,
         // left by a sweep killed as it started, holds nothing to lose).
-        TRIALS_FILE | SUMMARY_FILE => {
+        TRIALS_FILE | SUMMARY_FILE | REFERENCES_FILE => {
             std::fs::metadata(path).is_ok_and(|m| m.len() == 0)
                 || crate::output::sniff::starts_with(path, b"strategy,neighbors,preset,n,steps,")
         }

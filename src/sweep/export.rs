@@ -143,7 +143,7 @@ mod tests {
             format!(
                 "{}\n\
                  rayon-chunks,grid,seed,60,3,2,5,12,2,0.375,{},0.25,0.375,0.5,0.75,2.0,1.0,0,\
-                 false,0123456789abcdef,ok,,0.25,0.5,1.5,3.0,0.01,false\n",
+                 false,0123456789abcdef,ok,,0.25,0.5,1.5,3.0,0.01,false,\n",
                 SUMMARY_COLUMNS.join(","),
                 0.03125f64.sqrt()
             )

@@ -36,6 +36,7 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use crate::output::console::plural;
 use crate::results::meta::{Machine, Meta, Session, SweepStatus};
 use crate::results::rows::{Status, SummaryRow, TrialRow};
+use crate::results::shard::Shard;
 use lock::DirLock;
 use params::SweepParams;
 use plan::{Cell, Group, LabelStyle, Plan};
@@ -100,6 +101,7 @@ pub struct Finished {
     /// Every finished cell's row, from every session.
     rows: Vec<SummaryRow>,
     status: SweepStatus,
+    shard: Option<Shard>,
     _lock: DirLock,
 }
 
@@ -181,6 +183,7 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
         exporter,
         progress: ProgressBar::hidden(),
         run_ms,
+        shard: params.shard.map(|s| s.index),
     };
     let outcome = measure(runner, &todo, &mut references)?;
     conclude(opened, plan, outcome.rows, outcome.interrupted)
@@ -243,6 +246,7 @@ fn conclude(
         plan,
         rows,
         status,
+        shard: opened.meta.params.shard,
         _lock: opened.lock,
     })
 }
@@ -251,6 +255,11 @@ impl Finished {
     /// The results directory.
     pub fn dir(&self) -> &Path {
         &self.dir
+    }
+
+    /// The shard of a plan this sweep ran, if it ran one.
+    pub fn shard(&self) -> Option<Shard> {
+        self.shard
     }
 
     /// Whether every planned cell is finished (the report is drawn only then).
@@ -456,6 +465,13 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
     let lock = dir::open_existing(dir)?;
     let meta_path = dir.join(META_FILE);
     let mut meta = Meta::read(&meta_path)?;
+    if meta.merge.is_some() {
+        bail!(
+            "'{}' is a merge of shards, not a sweep to resume: resume or run the shards that \
+             are missing (`bench-sph sweep --resume SHARD_DIR`) and merge again",
+            dir.display()
+        );
+    }
     meta.params.validate().with_context(|| {
         format!(
             "cannot resume '{}': its {META_FILE} has parameters the command line would refuse",
@@ -483,6 +499,12 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
     warn_if_changed(&meta, &session);
     for why in &repaired.rejected {
         console_warn(&format!("warning: dropped, will run again: {why}"));
+    }
+    if repaired.upgraded_summary {
+        print(&format!(
+            "Upgraded '{}': appended the reference_shard column (empty: not a shard)",
+            dir.join(SUMMARY_FILE).display()
+        ));
     }
     print(&format!(
         "Resuming '{}': {} finished cells kept{}",
@@ -546,6 +568,15 @@ fn print_plan(
     let mut text = format!("bench-sph sweep → {}\n", dir.display());
     for group in &plan.groups {
         text.push_str(&format!("  group: {}\n", group.label(LabelStyle::Sweep)));
+    }
+    if let Some(shard) = params.shard {
+        text.push_str(&format!(
+            "  shard {shard} of plan {}: {} of its {} (the seq cell of each group here is \
+             measured by every shard that has the group)\n",
+            params.fingerprint(),
+            plural(plan.cells.len(), "cell", "cells"),
+            plural(Plan::whole(params).cells.len(), "cell", "cells"),
+        ));
     }
     let names: Vec<&str> = params.strategies.iter().map(|s| s.as_str()).collect();
     text.push_str(&format!(

@@ -51,6 +51,21 @@ impl SweepParams {
             self.fake_timings.as_deref(),
             self.fake_contention.as_deref(),
         )?;
+        if let Some(shard) = self.shard {
+            let whole = super::plan::Plan::whole(self);
+            if whole.shard(shard).cells.is_empty() {
+                let parts = match whole.non_reference_cells() {
+                    0 => whole.groups.len(),
+                    k => k,
+                };
+                anyhow::bail!(
+                    "--shard {shard}: shard {} would have no cells: the plan has {parts} to \
+                     deal (cells besides the seq references, or groups when seq is all it \
+                     measures), so split it into at most {parts} shards",
+                    shard.index
+                );
+            }
+        }
         Ok(())
     }
 }
@@ -77,6 +92,7 @@ mod tests {
             simd: None,
             fake_timings: None,
             fake_contention: None,
+            shard: None,
         }
     }
 
@@ -119,6 +135,40 @@ mod tests {
                 .to_string()
                 .contains("--fake-contention")
         );
+    }
+
+    #[test]
+    fn an_empty_shard_is_refused_naming_the_most_shards_the_plan_allows() {
+        use crate::results::shard::Shard;
+        let mut p = example();
+        p.strategies = vec![StrategyName::StdStatic];
+        p.presets = vec![Preset::Seed];
+        p.n = vec![60];
+        p.cores = vec![1, 2];
+        p.shard = Some(Shard::new(2, 2).unwrap());
+        assert!(p.validate().is_ok());
+        p.shard = Some(Shard::new(3, 3).unwrap());
+        let err = p.validate().unwrap_err().to_string();
+        assert!(
+            err.contains("--shard 3/3") && err.contains("at most 2 shards"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn the_fingerprint_ignores_the_shard_and_nothing_else() {
+        use crate::results::shard::Shard;
+        let p = example();
+        let mut shard = example();
+        shard.shard = Some(Shard::new(2, 3).unwrap());
+        assert_eq!(p.fingerprint(), shard.fingerprint());
+        assert_eq!(p.fingerprint().len(), 16);
+        let mut other = example();
+        other.steps += 1;
+        assert_ne!(p.fingerprint(), other.fingerprint());
+        let mut other = example();
+        other.seed += 1;
+        assert_ne!(p.fingerprint(), other.fingerprint());
     }
 
     #[test]

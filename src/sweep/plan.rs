@@ -8,11 +8,21 @@
 //! its first run's checksum the one every other run of the group must reproduce. Then, for each
 //! other strategy in registry order and each cores value, one cell per chunks value for the
 //! strategies that use chunks, and one cell (chunks empty) for those that do not.
+//!
+//! A **shard** I/K of the plan ([`Plan::shard`], `sweep --shard I/K`) runs the plan's
+//! non-reference cells whose position among them is ≡ I−1 (mod K), dealt round-robin in plan
+//! order, plus the reference cell of every group it touches: each shard measures its own
+//! `seq`, so that its speedups never divide by another node's time. A group with no other cell
+//! (a sweep of `seq` alone) goes whole to shard (g mod K) + 1, g its position. Round-robin,
+//! not balanced by an estimate of each cell's cost: an estimate is measured, so it would
+//! differ from node to node and so would the partition; dealing in plan order spreads each
+//! strategy's cores and chunks values over all shards, which balances them well enough.
 
 use sph_strategies::StrategyName;
 
 pub use crate::results::key::{Cell, Group, LabelStyle};
 use crate::results::params::SweepParams;
+use crate::results::shard::Shard;
 use crate::scene::tank;
 use crate::sph::params::Preset;
 
@@ -26,8 +36,17 @@ pub struct Plan {
 }
 
 impl Plan {
-    /// The plan of `params`.
+    /// The plan of `params`: the whole plan, or the shard `params.shard` names.
     pub fn new(params: &SweepParams) -> Plan {
+        let whole = Plan::whole(params);
+        match params.shard {
+            Some(shard) => whole.shard(shard),
+            None => whole,
+        }
+    }
+
+    /// The whole plan of `params`, whatever shard they name.
+    pub fn whole(params: &SweepParams) -> Plan {
         let mut groups = Vec::new();
         for &preset in &params.presets {
             for &neighbors in &params.neighbors {
@@ -71,6 +90,52 @@ impl Plan {
     }
 }
 
+impl Plan {
+    /// The part of this (whole) plan that `shard` runs (see the module docs), in plan order;
+    /// its groups are those it has cells of.
+    pub fn shard(&self, shard: Shard) -> Plan {
+        let (i, k) = (shard.index - 1, shard.count);
+        let mut position = 0;
+        let mut mine: Vec<Cell> = Vec::new();
+        for (g, group) in self.groups.iter().enumerate() {
+            let of_group = self.cells.iter().filter(|c| c.group == *group);
+            let mut reference = None;
+            let mut taken = Vec::new();
+            let mut others = 0;
+            for &cell in of_group {
+                if cell.is_reference() {
+                    reference = Some(cell);
+                    continue;
+                }
+                if position % k == i {
+                    taken.push(cell);
+                }
+                position += 1;
+                others += 1;
+            }
+            let whole_group = others == 0 && g % k == i;
+            if !taken.is_empty() || whole_group {
+                mine.extend(reference);
+                mine.extend(taken);
+            }
+        }
+        Plan {
+            groups: self
+                .groups
+                .iter()
+                .copied()
+                .filter(|g| mine.iter().any(|c| c.group == *g))
+                .collect(),
+            cells: mine,
+        }
+    }
+
+    /// Cells that are not a group's reference.
+    pub fn non_reference_cells(&self) -> usize {
+        self.cells.iter().filter(|c| !c.is_reference()).count()
+    }
+}
+
 /// The particles a group of `preset` has for `--n` `n`: `n`, or for `wcsph` the fluid
 /// particles of the nearest resolution.
 pub fn particles(preset: Preset, n: usize) -> usize {
@@ -110,6 +175,7 @@ mod tests {
             simd: None,
             fake_timings: None,
             fake_contention: None,
+            shard: None,
         }
     }
 
@@ -148,6 +214,61 @@ mod tests {
                     .all(|c| c.chunks.is_some() == s.info().uses_chunks())
             );
         }
+    }
+
+    #[test]
+    fn the_shards_of_a_plan_deal_its_cells_round_robin_and_together_hold_each_exactly_once() {
+        let whole = Plan::new(&params(StrategyName::ALL));
+        let k = 3;
+        let shards: Vec<Plan> = (1..=k)
+            .map(|i| whole.shard(Shard::new(i, k).unwrap()))
+            .collect();
+        let mut others: Vec<Cell> = shards
+            .iter()
+            .flat_map(|s| s.cells.iter().copied().filter(|c| !c.is_reference()))
+            .collect();
+        assert_eq!(others.len(), whole.non_reference_cells());
+        let unique: std::collections::HashSet<Cell> = others.drain(..).collect();
+        assert_eq!(unique.len(), whole.non_reference_cells());
+        let sizes: Vec<usize> = shards.iter().map(Plan::non_reference_cells).collect();
+        assert!(
+            sizes.iter().max().unwrap() - sizes.iter().min().unwrap() <= 1,
+            "{sizes:?}"
+        );
+        for (s, shard) in shards.iter().enumerate() {
+            for group in &shard.groups {
+                let first = shard.cells.iter().find(|c| c.group == *group).unwrap();
+                assert!(first.is_reference(), "shard {} group {group:?}", s + 1);
+            }
+        }
+        // Round-robin in plan order: shard 1 has the 1st, 4th, … non-reference cells.
+        let order: Vec<Cell> = whole
+            .cells
+            .iter()
+            .copied()
+            .filter(|c| !c.is_reference())
+            .collect();
+        let first: Vec<Cell> = shards[0]
+            .cells
+            .iter()
+            .copied()
+            .filter(|c| !c.is_reference())
+            .collect();
+        assert_eq!(first, order.iter().copied().step_by(k).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn a_seq_only_plan_gives_whole_groups_to_shards_in_turn_and_one_shard_is_the_plan() {
+        let whole = Plan::new(&params(&[StrategyName::Seq]));
+        assert_eq!(whole.non_reference_cells(), 0);
+        let one = whole.shard(Shard::new(1, 2).unwrap());
+        let two = whole.shard(Shard::new(2, 2).unwrap());
+        assert_eq!((one.cells.len(), two.cells.len()), (1, 1));
+        assert_ne!(one.groups, two.groups);
+        assert!(whole.shard(Shard::new(1, 3).unwrap()).cells.len() == 1);
+        assert!(whole.shard(Shard::new(3, 3).unwrap()).cells.is_empty());
+        let all = Plan::new(&params(StrategyName::ALL));
+        assert_eq!(all.shard(Shard::new(1, 1).unwrap()), all);
     }
 
     #[test]

@@ -20,7 +20,9 @@ use anyhow::Context;
 
 use super::export::to_csv;
 use super::plan::Cell;
-use crate::results::rows::{SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow};
+use crate::results::rows::{
+    SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow, UNSHARDED_SUMMARY_COLUMNS,
+};
 
 /// A results file whose header is not this version's.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -54,6 +56,9 @@ pub struct Repaired {
     pub dropped_trial_rows: usize,
     /// Summary rows (or broken lines) dropped from `summary.csv`.
     pub dropped_summary_rows: usize,
+    /// Whether `summary.csv` had the columns of the version before `reference_shard` (its
+    /// repaired contents have every column: the upgrade).
+    pub upgraded_summary: bool,
 }
 
 /// Repairs the contents of `trials.csv` and `summary.csv` (either may be empty: no file);
@@ -65,10 +70,14 @@ pub fn repair(
     summary: &[u8],
     check: &dyn Fn(&SummaryRow) -> Result<(), String>,
 ) -> Result<Repaired, UnexpectedColumns> {
-    let (summary_rows, mut dropped_summary_rows) =
-        read_rows::<SummaryRow>(summary, "summary.csv", &SUMMARY_COLUMNS)?;
-    let (trial_rows, mut dropped_trial_rows) =
-        read_rows::<TrialRow>(trials, "trials.csv", &TRIAL_COLUMNS)?;
+    let (summary_rows, mut dropped_summary_rows, older) = read_rows::<SummaryRow>(
+        summary,
+        "summary.csv",
+        &SUMMARY_COLUMNS,
+        Some(UNSHARDED_SUMMARY_COLUMNS),
+    )?;
+    let (trial_rows, mut dropped_trial_rows, _) =
+        read_rows::<TrialRow>(trials, "trials.csv", &TRIAL_COLUMNS, None)?;
 
     // The first summary row of each cell; the trial rows of each cell, once per number.
     let mut seen = HashSet::new();
@@ -127,23 +136,26 @@ pub fn repair(
         rejected,
         dropped_trial_rows,
         dropped_summary_rows,
+        upgraded_summary: older,
     })
 }
 
-/// The complete rows of a CSV file and the number of lines that were not: a last line
-/// without its newline (cut off by a kill) or a row that does not parse.
+/// The complete rows of a CSV file, the number of lines that were not (a last line without
+/// its newline, cut off by a kill, or a row that does not parse), and whether its header was
+/// the first `older` of `columns` (an earlier version's file, whose missing columns are empty).
 fn read_rows<R: serde::de::DeserializeOwned>(
     bytes: &[u8],
     file: &'static str,
     columns: &[&str],
-) -> Result<(Vec<R>, usize), UnexpectedColumns> {
+    older: Option<usize>,
+) -> Result<(Vec<R>, usize, bool), UnexpectedColumns> {
     let complete = match bytes.iter().rposition(|&b| b == b'\n') {
         Some(last) => &bytes[..=last],
         None => &[][..],
     };
     let mut dropped = usize::from(complete.len() < bytes.len());
     if complete.is_empty() {
-        return Ok((Vec::new(), dropped));
+        return Ok((Vec::new(), dropped, false));
     }
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
@@ -152,8 +164,10 @@ fn read_rows<R: serde::de::DeserializeOwned>(
     let header = reader
         .headers()
         .map(|h| h.iter().collect::<Vec<_>>().join(","));
-    match header {
-        Ok(h) if h == columns.join(",") => {}
+    let is_older = |h: &str| older.is_some_and(|w| h == columns[..w].join(","));
+    let upgraded = match header {
+        Ok(h) if h == columns.join(",") => false,
+        Ok(h) if is_older(&h) => true,
         Ok(h) => return Err(UnexpectedColumns { file, found: h }),
         Err(_) => {
             return Err(UnexpectedColumns {
@@ -164,7 +178,7 @@ fn read_rows<R: serde::de::DeserializeOwned>(
                 .into_owned(),
             });
         }
-    }
+    };
     let mut rows = Vec::new();
     for record in reader.deserialize::<R>() {
         match record {
@@ -172,7 +186,7 @@ fn read_rows<R: serde::de::DeserializeOwned>(
             Err(_) => dropped += 1,
         }
     }
-    Ok((rows, dropped))
+    Ok((rows, dropped, upgraded))
 }
 
 /// Reads `dir`'s CSV files (a missing one counts as empty), repairs them with `check`, and
@@ -338,6 +352,23 @@ mod tests {
         let r = repair(b"", b"", &|_| Ok(())).unwrap();
         assert!(r.finished.is_empty());
         assert!(r.trials_csv.starts_with(b"strategy,"));
+    }
+
+    #[test]
+    fn a_summary_without_reference_shard_is_read_and_upgraded_to_every_column() {
+        let (t, s) = two_cells();
+        let text = String::from_utf8(s.clone()).unwrap();
+        // The file as the version before `reference_shard` wrote it: one column fewer.
+        let older: String = text
+            .lines()
+            .map(|l| format!("{}\n", &l[..l.rfind(',').unwrap()]))
+            .collect();
+        assert!(older.starts_with(&SUMMARY_COLUMNS[..UNSHARDED_SUMMARY_COLUMNS].join(",")));
+        let r = repair(&t, older.as_bytes(), &|_| Ok(())).unwrap();
+        assert!(r.upgraded_summary);
+        assert_eq!(r.finished.len(), 2);
+        assert_eq!(r.summary_csv, s);
+        assert!(!repair(&t, &s, &|_| Ok(())).unwrap().upgraded_summary);
     }
 
     #[test]

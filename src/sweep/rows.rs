@@ -63,6 +63,8 @@ pub struct CellContext<'a> {
     pub seed: u64,
     /// Bootstrap resamples per interval.
     pub resamples: usize,
+    /// The shard this sweep is (its `reference_shard`), if it is one.
+    pub shard: Option<usize>,
 }
 
 /// The summary row of a cell, against `ctx`; a failed cell has no statistics, speedup or
@@ -133,6 +135,7 @@ pub fn summary_row(
                 .zip(&walls)
                 .any(|(&foreign, &wall)| ctx.threshold.exceeded(foreign, wall, cell.cores))
         }),
+        reference_shard: ctx.shard,
     }
 }
 
@@ -148,6 +151,7 @@ pub(crate) fn test_context(seq_walls: Option<&[f64]>, hardware_threads: usize) -
         },
         seed: 1,
         resamples: 1000,
+        shard: None,
     }
 }
 

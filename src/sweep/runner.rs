@@ -267,6 +267,8 @@ pub struct Runner<'a, T: Write, S: Write> {
     pub progress: ProgressBar,
     /// Estimated milliseconds of one run of each cell of the plan.
     pub run_ms: Vec<u64>,
+    /// The shard of the plan this sweep runs (`reference_shard` of its rows), if it is one.
+    pub shard: Option<usize>,
 }
 
 /// What a session did.
@@ -387,6 +389,7 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
             threshold: self.threshold,
             seed: self.seed,
             resamples: self.resamples,
+            shard: self.shard,
         };
         let summary = summary_row(&cell, measured, failure.as_deref(), &ctx);
         let trials = trial_rows(&cell, measured, failure.as_deref());

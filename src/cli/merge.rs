@@ -1,0 +1,50 @@
+//! `bench-sph merge`: one results directory from the shards of a sweep.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+/// Options of `merge`.
+#[derive(Debug, Clone, Args)]
+pub struct MergeArgs {
+    /// The shard directories of `bench-sph sweep --shard I/K` (one per shard, any order).
+    #[arg(value_name = "SHARD_DIR", required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// The merged results directory (new or empty, unless --force).
+    #[arg(long, value_name = "DIR", required = true)]
+    pub out: PathBuf,
+    /// Merge even when cells are missing (a shard not given or unfinished): the merge is then
+    /// marked partial, and its report says so.
+    #[arg(long)]
+    pub allow_partial: bool,
+    /// Replace an earlier sweep's or merge's results in --out.
+    #[arg(long)]
+    pub force: bool,
+}
+
+/// Runs `merge` and says what it wrote.
+pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
+    let merged = crate::merge::run(&crate::merge::Request {
+        dirs: args.dirs.clone(),
+        out: args.out.clone(),
+        allow_partial: args.allow_partial,
+        force: args.force,
+    })?;
+    for w in &merged.warnings {
+        crate::output::console::warn(&format!("warning: {w}"));
+    }
+    let dir = merged.dir.display();
+    let text = format!(
+        "Merged {} of plan {} into {dir}: {} of the plan's {} cells, {} trial rows; every \
+         shard's seq rows ({}) in {dir}/references.csv.\nDraw the report with `bench-sph report \
+         {dir}`.",
+        crate::output::console::plural(args.dirs.len(), "shard", "shards"),
+        merged.fingerprint,
+        merged.cells.0,
+        merged.cells.1,
+        merged.trial_rows,
+        merged.references,
+    );
+    let _ = crate::output::console::line(&text);
+    Ok(())
+}

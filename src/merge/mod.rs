@@ -1,0 +1,309 @@
+//! `bench-sph merge`: one results directory from the shards of a sweep (`sweep --shard I/K`),
+//! which a batch scheduler ran on identical nodes.
+//!
+//! The pipeline: each shard directory is locked (no sweep may write it meanwhile) and read,
+//! keeping its believed cells ([`crate::results::validate::cell`]); [`check`] refuses shards of
+//! different plans, builds or machines and repeated shards; [`assemble`] puts the whole plan
+//! together, one row per cell, each keeping its own shard's speedup (`reference_shard`); a
+//! cell no shard has is an error unless `--allow-partial`, which marks the merge `partial`.
+//! The output directory is claimed like a new sweep's and written file by file through
+//! temporary names: `summary.csv`, `trials.csv`, `references.csv` (every shard's `seq` rows)
+//! and `meta.json` (the plan's parameters without the shard, every shard's sessions, and
+//! `merge`: where each cell came from, what is missing, what was warned about).
+
+pub mod assemble;
+pub mod check;
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+
+use crate::output::console::plural;
+use crate::results::load::{read_summary, read_trials};
+use crate::results::meta::{Merge, MergedShard, Meta, SweepStatus};
+use crate::results::rows::{SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow};
+use crate::results::{LOCK_FILE, META_FILE, REFERENCES_FILE, SUMMARY_FILE, TRIALS_FILE};
+use crate::sweep::export::to_csv;
+use crate::sweep::lock::{self, DirLock};
+use crate::sweep::plan::Plan;
+use assemble::Part;
+
+/// One invocation of `bench-sph merge`.
+#[derive(Debug, Clone)]
+pub struct Request {
+    /// The shard directories.
+    pub dirs: Vec<PathBuf>,
+    /// The merged results directory.
+    pub out: PathBuf,
+    /// Merge even when cells are missing (the result is marked partial).
+    pub allow_partial: bool,
+    /// Replace an earlier sweep's or merge's results in `out`.
+    pub force: bool,
+}
+
+/// What a merge wrote.
+#[derive(Debug)]
+pub struct Merged {
+    /// The merged directory.
+    pub dir: PathBuf,
+    /// The plan's fingerprint.
+    pub fingerprint: String,
+    /// Cells in the merge, and in the whole plan.
+    pub cells: (usize, usize),
+    /// Trial rows in the merge.
+    pub trial_rows: usize,
+    /// `seq` rows in `references.csv`.
+    pub references: usize,
+    /// Lines to show as warnings.
+    pub warnings: Vec<String>,
+}
+
+/// A shard directory read under its lock.
+struct Read {
+    dir: PathBuf,
+    meta: Meta,
+    rows: Vec<SummaryRow>,
+    trials: Vec<TrialRow>,
+    _lock: Option<DirLock>,
+}
+
+/// Merges `request.dirs` into `request.out` (see the module docs).
+pub fn run(request: &Request) -> anyhow::Result<Merged> {
+    refuse_output_among_inputs(request)?;
+    let read = request
+        .dirs
+        .iter()
+        .map(|d| read_shard(d))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let metas: Vec<check::ShardMeta<'_>> = read
+        .iter()
+        .map(|r| check::ShardMeta {
+            dir: r.dir.display().to_string(),
+            meta: &r.meta,
+        })
+        .collect();
+    let shards = check::shards(&metas)?;
+    let params = crate::results::params::SweepParams {
+        shard: None,
+        ..read[0].meta.params.clone()
+    };
+    let whole = Plan::new(&params);
+    let parts: Vec<Part> = read
+        .iter()
+        .zip(&shards)
+        .map(|(r, &shard)| Part {
+            shard,
+            dir: r.dir.display().to_string(),
+            rows: r.rows.clone(),
+            trials: r.trials.clone(),
+        })
+        .collect();
+    let merged = assemble::assemble(&whole, &parts)?;
+    if !merged.missing.is_empty() && !request.allow_partial {
+        bail!(missing_text(&whole, &read, &shards, &merged.missing));
+    }
+    let mut warnings = merged.disagreements.clone();
+    if !merged.missing.is_empty() {
+        warnings.push(format!(
+            "the merge is partial: {} of the plan's {} missing (--allow-partial); its report \
+             says so",
+            plural(merged.missing.len(), "cell is", "cells are"),
+            whole.cells.len()
+        ));
+    }
+    if read.iter().any(|r| r.meta.git_dirty) {
+        warnings.push(format!(
+            "the shards were measured by a build with uncommitted changes ({}): bench-sph \
+             cannot prove they ran the same code",
+            read[0].meta.git_commit
+        ));
+    }
+    let meta = merged_meta(&read, &shards, &params, &whole, &merged, &warnings);
+    let lock = crate::sweep::dir::open_new(&request.out, request.force)?;
+    write_all(&request.out, &merged, &meta)?;
+    drop(lock);
+    Ok(Merged {
+        dir: request.out.clone(),
+        fingerprint: params.fingerprint(),
+        cells: (merged.summary.len(), whole.cells.len()),
+        trial_rows: merged.trials.len(),
+        references: merged.references.len(),
+        warnings,
+    })
+}
+
+/// `--out` must not be one of the shards: `--force` would replace a shard's results.
+fn refuse_output_among_inputs(request: &Request) -> anyhow::Result<()> {
+    let Ok(out) = request.out.canonicalize() else {
+        return Ok(()); // Not there yet: not an input.
+    };
+    for d in &request.dirs {
+        if d.canonicalize().is_ok_and(|d| d == out) {
+            bail!(
+                "--out '{}' is one of the shards being merged: write the merge to a new \
+                 directory",
+                request.out.display()
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Reads a shard directory under its lock: `meta.json`, and the cells of `summary.csv` whose
+/// trials in `trials.csv` bear them out (others are left out: they count as missing).
+fn read_shard(dir: &Path) -> anyhow::Result<Read> {
+    if !dir.join(META_FILE).is_file() {
+        bail!(
+            "'{}' is not a results directory of bench-sph sweep (no {META_FILE})",
+            dir.display()
+        );
+    }
+    // A sweep always leaves its lock file; never create one in a directory that has none.
+    let lock = match dir.join(LOCK_FILE).is_file() {
+        true => Some(lock::acquire(dir)?),
+        false => None,
+    };
+    let meta = Meta::read(&dir.join(META_FILE))?;
+    let (summary, _) = read_summary(&dir.join(SUMMARY_FILE))
+        .with_context(|| format!("cannot merge '{}'", dir.display()))?;
+    let (trials, _) = read_trials(&dir.join(TRIALS_FILE))
+        .with_context(|| format!("cannot merge '{}'", dir.display()))?;
+    let mut by_cell: HashMap<_, Vec<TrialRow>> = HashMap::new();
+    for t in trials {
+        by_cell.entry(t.key()).or_default().push(t);
+    }
+    let mut rows = Vec::new();
+    let mut kept = Vec::new();
+    for row in summary {
+        let mut of_cell = by_cell.remove(&row.key()).unwrap_or_default();
+        of_cell.sort_by_key(|t| t.trial);
+        if crate::results::validate::cell(&row, &of_cell).is_ok() {
+            kept.extend(of_cell);
+            rows.push(row);
+        }
+    }
+    Ok(Read {
+        dir: dir.to_path_buf(),
+        meta,
+        rows,
+        trials: kept,
+        _lock: lock,
+    })
+}
+
+/// Why a merge without `--allow-partial` is refused: how many cells are missing, and which
+/// shards are absent or unfinished.
+fn missing_text(
+    whole: &Plan,
+    read: &[Read],
+    shards: &[crate::results::shard::Shard],
+    missing: &[crate::results::key::Cell],
+) -> String {
+    let count = shards[0].count;
+    let mut causes = Vec::new();
+    let absent: Vec<String> = (1..=count)
+        .filter(|i| !shards.iter().any(|s| s.index == *i))
+        .map(|i| format!("{i}/{count}"))
+        .collect();
+    if !absent.is_empty() {
+        causes.push(format!("not given: shard {}", absent.join(", ")));
+    }
+    for (r, s) in read.iter().zip(shards) {
+        if r.meta.status != SweepStatus::Complete {
+            causes.push(format!(
+                "shard {s} is {} (`bench-sph sweep --resume {}`)",
+                format!("{:?}", r.meta.status).to_lowercase(),
+                r.dir.display()
+            ));
+        }
+    }
+    format!(
+        "{} of the plan's {} missing (the first: {}){}; merge with --allow-partial to merge \
+         what there is (the study is then marked partial)",
+        plural(missing.len(), "cell is", "cells are"),
+        whole.cells.len(),
+        missing[0].label_with_group(),
+        match causes.is_empty() {
+            true => String::new(),
+            false => format!(": {}", causes.join("; ")),
+        }
+    )
+}
+
+/// The merged `meta.json`: the first shard's, with the plan's parameters, every shard's
+/// sessions and the merge's own record.
+fn merged_meta(
+    read: &[Read],
+    shards: &[crate::results::shard::Shard],
+    params: &crate::results::params::SweepParams,
+    whole: &Plan,
+    merged: &assemble::Assembled,
+    warnings: &[String],
+) -> Meta {
+    let mut order: Vec<usize> = (0..read.len()).collect();
+    order.sort_by_key(|&i| shards[i].index);
+    let first = &read[order[0]].meta;
+    let complete = merged.missing.is_empty();
+    Meta {
+        params: params.clone(),
+        planned_cells: whole.cells.len(),
+        status: if complete {
+            SweepStatus::Complete
+        } else {
+            SweepStatus::Partial
+        },
+        started_utc: order
+            .iter()
+            .map(|&i| read[i].meta.started_utc.clone())
+            .min()
+            .unwrap_or_default(),
+        finished_utc: Some(crate::results::meta::now_utc()),
+        sessions: order
+            .iter()
+            .flat_map(|&i| read[i].meta.sessions.clone())
+            .collect(),
+        plan_fingerprint: Some(params.fingerprint()),
+        merge: Some(Merge {
+            shards: order
+                .iter()
+                .map(|&i| MergedShard {
+                    shard: shards[i],
+                    dir: read[i].dir.display().to_string(),
+                    status: read[i].meta.status,
+                    cells: merged
+                        .cells_from
+                        .get(&shards[i].index)
+                        .copied()
+                        .unwrap_or(0),
+                })
+                .collect(),
+            missing_cells: merged
+                .missing
+                .iter()
+                .map(|c| c.label_with_group())
+                .collect(),
+            warnings: warnings.to_vec(),
+        }),
+        ..first.clone()
+    }
+}
+
+/// Writes the merged files, each through a temporary name; `meta.json` last, so a directory
+/// with a merge's `meta.json` has all of its files.
+fn write_all(dir: &Path, merged: &assemble::Assembled, meta: &Meta) -> anyhow::Result<()> {
+    let csv = |r: csv::Result<Vec<u8>>| r.context("cannot write the merged CSV files");
+    crate::output::atomic::write(
+        &dir.join(TRIALS_FILE),
+        &csv(to_csv(&TRIAL_COLUMNS, &merged.trials))?,
+    )?;
+    crate::output::atomic::write(
+        &dir.join(SUMMARY_FILE),
+        &csv(to_csv(&SUMMARY_COLUMNS, &merged.summary))?,
+    )?;
+    crate::output::atomic::write(
+        &dir.join(REFERENCES_FILE),
+        &csv(to_csv(&SUMMARY_COLUMNS, &merged.references))?,
+    )?;
+    meta.write(&dir.join(META_FILE))
+}

@@ -1,0 +1,297 @@
+//! `sweep --shard I/K` and `bench-sph merge`, end to end through the binary: shards run as
+//! separate processes one after another (never at once: on this 2-core machine that would
+//! spoil the timings), merged, give exactly the unsharded plan's cells and trials; and every
+//! refusal of the merge. Timings are the hidden `--fake-timings`, so nothing here is timed.
+
+mod common;
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use common::*;
+
+/// 1 group: seq, rayon-chunks at 1..2 cores × chunks 2,4 and std-static at 1..2 cores: 7
+/// cells, 6 of them dealt to shards.
+const PLAN: &str = "--n 60 --steps 3 --trials 2 --warmup 0 --cores 1..2 --chunks 2,4 \
+                    --strategies rayon-chunks,std-static --fake-timings 1,1.1,0.9 --no-plots";
+
+fn sweep(dir: &Path, extra: &str) {
+    let o = sweep_into(dir, &format!("{PLAN} {extra}"));
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// Shards 1/3, 2/3 and 3/3 of [`PLAN`], run one after another, under `root`.
+fn shards(root: &Path) -> Vec<PathBuf> {
+    (1..=3)
+        .map(|i| {
+            let dir = root.join(format!("shard-{i}"));
+            sweep(&dir, &format!("--shard {i}/3"));
+            dir
+        })
+        .collect()
+}
+
+fn merge(dirs: &[PathBuf], out: &Path, extra: &[&str]) -> std::process::Output {
+    let mut args: Vec<String> = vec!["merge".into()];
+    args.extend(dirs.iter().map(|d| d.display().to_string()));
+    args.extend(["--out".into(), out.display().to_string()]);
+    args.extend(extra.iter().map(|s| s.to_string()));
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    run(&args)
+}
+
+fn merge_fails(dirs: &[PathBuf], out: &Path, needles: &[&str]) {
+    let o = merge(dirs, out, &[]);
+    assert!(!o.status.success(), "{}", stdout(&o));
+    let err = stderr(&o);
+    assert!(err.starts_with("Error: "), "{err}");
+    assert_holds_all("stderr", &err, needles);
+    no_panic(&o);
+    assert!(
+        !out.join("summary.csv").exists(),
+        "a refused merge wrote files"
+    );
+}
+
+/// Trial rows per cell key (strategy, cores, chunks) of a results directory.
+fn trials_per_cell(dir: &Path) -> BTreeMap<String, usize> {
+    let mut cells = BTreeMap::new();
+    for r in rows(&dir.join("trials.csv")) {
+        let key = format!("{} {} {}", r["strategy"], r["cores"], r["chunks"]);
+        *cells.entry(key).or_default() += 1;
+    }
+    cells
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+    }
+}
+
+/// Edits `dir/meta.json` with `edit`.
+fn edit_meta(dir: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
+    let path = dir.join("meta.json");
+    let mut meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    edit(&mut meta);
+    std::fs::write(&path, serde_json::to_string_pretty(&meta).unwrap()).unwrap();
+}
+
+#[test]
+fn three_shards_run_one_after_another_merge_into_exactly_the_unsharded_plans_cells_and_trials() {
+    let tmp = tempfile::tempdir().unwrap();
+    let whole = tmp.path().join("whole");
+    sweep(&whole, "");
+    let parts = shards(tmp.path());
+    let merged = tmp.path().join("merged");
+    let o = merge(&parts, &merged, &[]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("7 of the plan's 7 cells"),
+        "{}",
+        stdout(&o)
+    );
+
+    assert_eq!(trials_per_cell(&merged), trials_per_cell(&whole));
+    assert_eq!(trials_per_cell(&whole).len(), 7);
+    let summary = rows(&merged.join("summary.csv"));
+    assert_eq!(summary.len(), 7);
+    assert!(
+        summary
+            .iter()
+            .all(|r| r["trials"] == "2" && r["status"] == "ok")
+    );
+    // Each row names the shard whose seq it divides by; an unsharded sweep leaves it empty.
+    assert!(
+        summary
+            .iter()
+            .all(|r| ["1", "2", "3"].contains(&r["reference_shard"].as_str()))
+    );
+    assert!(
+        rows(&whole.join("summary.csv"))
+            .iter()
+            .all(|r| r["reference_shard"].is_empty())
+    );
+    let references = rows(&merged.join("references.csv"));
+    assert_eq!(references.len(), 3, "each shard measured the group's seq");
+    assert!(references.iter().all(|r| r["strategy"] == "seq"));
+
+    let meta = std::fs::read_to_string(merged.join("meta.json")).unwrap();
+    let meta: serde_json::Value = serde_json::from_str(&meta).unwrap();
+    assert_eq!(meta["status"], "complete");
+    assert_eq!(meta["planned_cells"], 7);
+    assert!(meta["params"].get("shard").is_none());
+    assert_eq!(meta["merge"]["shards"].as_array().unwrap().len(), 3);
+    assert_eq!(meta["sessions"].as_array().unwrap().len(), 3);
+    let whole_meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(whole.join("meta.json")).unwrap()).unwrap();
+    assert_eq!(meta["plan_fingerprint"], whole_meta["plan_fingerprint"]);
+
+    let report = succeeds(tmp.path(), &["report", merged.to_str().unwrap()]);
+    assert!(report.contains("REPORT.md"), "{report}");
+    let md = std::fs::read_to_string(merged.join("REPORT.md")).unwrap();
+    assert!(md.contains("is a merge of shards 1/3, 2/3, 3/3"), "{md}");
+    assert!(!md.contains("Partial study"), "{md}");
+}
+
+#[test]
+fn a_shard_records_its_part_and_the_plans_fingerprint_and_draws_no_charts() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("s");
+    let o = sweep_into(&dir, &format!("{PLAN} --shard 2/3"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("shard 2/3 of plan "), "{}", stdout(&o));
+    assert!(
+        stdout(&o).contains("3 cells of its 7 cells"),
+        "{}",
+        stdout(&o)
+    );
+    assert!(
+        stdout(&o).contains("not drawn for shard 2/3"),
+        "{}",
+        stdout(&o)
+    );
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap();
+    assert_eq!(meta["params"]["shard"]["index"], 2);
+    assert_eq!(meta["params"]["shard"]["count"], 3);
+    assert_eq!(meta["plan_fingerprint"].as_str().unwrap().len(), 16);
+    let summary = rows(&dir.join("summary.csv"));
+    assert_eq!(summary[0]["strategy"], "seq");
+    assert!(summary.iter().all(|r| r["reference_shard"] == "2"));
+    // Its own report says it holds one shard.
+    succeeds(tmp.path(), &["report", dir.to_str().unwrap()]);
+    let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
+    assert!(md.contains("**One shard**"), "{md}");
+}
+
+#[test]
+fn a_shard_that_would_be_empty_or_a_malformed_shard_is_refused() {
+    let (_tmp, dir) = scratch("s");
+    let mut cmd = sweep_command(&dir, &format!("{PLAN} --shard 7/7"));
+    cmd.env("NO_COLOR", "1");
+    expect_failure(cmd, &["Error: ", "--shard 7/7", "at most 6 shards"]);
+    assert!(!dir.join("summary.csv").exists());
+    for bad in ["0/3", "4/3", "x"] {
+        let cmd = sweep_command(&dir, &format!("{PLAN} --shard {bad}"));
+        expect_failure(cmd, &["--shard", "expected I/K"]);
+    }
+}
+
+#[test]
+fn merging_refuses_missing_cells_unless_partial_and_then_the_report_says_so() {
+    let tmp = tempfile::tempdir().unwrap();
+    let parts = shards(tmp.path());
+    let out = tmp.path().join("merged");
+    let two = [parts[0].clone(), parts[2].clone()];
+    merge_fails(
+        &two,
+        &out,
+        &["missing", "not given: shard 2/3", "--allow-partial"],
+    );
+
+    let o = merge(&two, &out, &["--allow-partial"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("the merge is partial"),
+        "{}",
+        stderr(&o)
+    );
+    let meta = std::fs::read_to_string(out.join("meta.json")).unwrap();
+    assert!(meta.contains("\"status\": \"partial\""), "{meta}");
+    assert!(meta.contains("\"missing_cells\""), "{meta}");
+    succeeds(tmp.path(), &["report", out.to_str().unwrap()]);
+    let md = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
+    assert!(
+        md.contains("Partial study") && md.contains("merge again"),
+        "{md}"
+    );
+    // A merge is not a sweep to resume.
+    fails_with(
+        &["sweep", "--resume", out.to_str().unwrap()],
+        &["is a merge of shards", "merge again"],
+    );
+}
+
+#[test]
+fn merging_refuses_repeats_other_plans_other_splits_and_directories_that_are_not_shards() {
+    let tmp = tempfile::tempdir().unwrap();
+    let parts = shards(tmp.path());
+    let out = tmp.path().join("merged");
+
+    let again = tmp.path().join("again");
+    copy_dir(&parts[0], &again);
+    let repeated = [parts[0].clone(), parts[1].clone(), parts[2].clone(), again];
+    merge_fails(&repeated, &out, &["shard 1/3 is given twice"]);
+
+    let other = tmp.path().join("other-plan");
+    let o = sweep_into(&other, &format!("{PLAN} --shard 2/3 --seed 7"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let mixed = [parts[0].clone(), other, parts[2].clone()];
+    merge_fails(&mixed, &out, &["different plans"]);
+
+    let halves = tmp.path().join("half");
+    let o = sweep_into(&halves, &format!("{PLAN} --shard 2/2"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    merge_fails(&[parts[0].clone(), halves], &out, &["different splits"]);
+
+    let whole = tmp.path().join("whole");
+    sweep(&whole, "");
+    merge_fails(&[whole], &out, &["is not a shard"]);
+
+    let shard_one = std::fs::read(parts[0].join("summary.csv")).unwrap();
+    let o = merge(&parts, &parts[0], &["--force"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("is one of the shards being merged"), "{}", stderr(&o));
+    assert_eq!(std::fs::read(parts[0].join("summary.csv")).unwrap(), shard_one);
+}
+
+#[test]
+fn merging_refuses_shards_from_another_machine_or_another_build() {
+    let tmp = tempfile::tempdir().unwrap();
+    let parts = shards(tmp.path());
+    let out = tmp.path().join("merged");
+
+    let elsewhere = tmp.path().join("elsewhere");
+    copy_dir(&parts[1], &elsewhere);
+    edit_meta(&elsewhere, |m| {
+        m["machine"]["cpu_model"] = "Another CPU".into();
+        for s in m["sessions"].as_array_mut().unwrap() {
+            s["machine"]["cpu_model"] = "Another CPU".into();
+        }
+    });
+    let mixed = [parts[0].clone(), elsewhere, parts[2].clone()];
+    merge_fails(
+        &mixed,
+        &out,
+        &["Another CPU", "a comparison, not a merge", "report A B"],
+    );
+
+    let rebuilt = tmp.path().join("rebuilt");
+    copy_dir(&parts[1], &rebuilt);
+    edit_meta(&rebuilt, |m| {
+        m["git_commit"] = "0123456789ab".into();
+        for s in m["sessions"].as_array_mut().unwrap() {
+            s["git_commit"] = "0123456789ab".into();
+        }
+    });
+    let mixed = [parts[0].clone(), rebuilt, parts[2].clone()];
+    merge_fails(&mixed, &out, &["0123456789ab", "different builds"]);
+}
+
+#[test]
+fn a_merge_never_replaces_existing_results_without_force() {
+    let tmp = tempfile::tempdir().unwrap();
+    let parts = shards(tmp.path());
+    let out = tmp.path().join("merged");
+    assert!(merge(&parts, &out, &[]).status.success());
+    let before = std::fs::read(out.join("summary.csv")).unwrap();
+    let o = merge(&parts, &out, &[]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("--force"), "{}", stderr(&o));
+    assert_eq!(std::fs::read(out.join("summary.csv")).unwrap(), before);
+    assert!(merge(&parts, &out, &["--force"]).status.success());
+}
