@@ -245,8 +245,15 @@ fn merging_refuses_repeats_other_plans_other_splits_and_directories_that_are_not
     let shard_one = std::fs::read(parts[0].join("summary.csv")).unwrap();
     let o = merge(&parts, &parts[0], &["--force"]);
     assert!(!o.status.success());
-    assert!(stderr(&o).contains("is one of the shards being merged"), "{}", stderr(&o));
-    assert_eq!(std::fs::read(parts[0].join("summary.csv")).unwrap(), shard_one);
+    assert!(
+        stderr(&o).contains("is one of the shards being merged"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(
+        std::fs::read(parts[0].join("summary.csv")).unwrap(),
+        shard_one
+    );
 }
 
 #[test]

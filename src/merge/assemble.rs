@@ -10,6 +10,7 @@ use std::collections::{HashMap, HashSet};
 
 use anyhow::bail;
 
+use crate::report::numbers::sig;
 use crate::results::key::{Cell, Group, LabelStyle};
 use crate::results::rows::{SummaryRow, TrialRow};
 use crate::results::shard::Shard;
@@ -131,7 +132,9 @@ fn disagreement(group: &Group, seqs: &[(&Part, SummaryRow)]) -> Option<String> {
     }
     let each: Vec<String> = with
         .iter()
-        .map(|(s, mean, (lo, hi))| format!("shard {s}: {mean:.4} s [{lo:.4}, {hi:.4}]"))
+        .map(|(s, mean, (lo, hi))| {
+            format!("shard {s}: {} s [{}–{}]", sig(*mean), sig(*lo), sig(*hi))
+        })
         .collect();
     Some(format!(
         "{}: the shards' seq means disagree beyond their 95 % intervals ({}): the nodes may not \
@@ -242,7 +245,7 @@ mod tests {
         assert_eq!(merged.disagreements.len(), 1);
         let line = &merged.disagreements[0];
         assert!(
-            line.contains("shard 1: 4.0000 s") && line.contains("shard 3: 5.0000 s"),
+            line.contains("shard 1: 4.00 s [3.92–4.08]") && line.contains("shard 3: 5.00 s"),
             "{line}"
         );
     }
