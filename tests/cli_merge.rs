@@ -7,6 +7,7 @@ mod common;
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
 
 use common::*;
 
@@ -14,6 +15,14 @@ use common::*;
 /// cells, 6 of them dealt to shards.
 const PLAN: &str = "--n 60 --steps 3 --trials 2 --warmup 0 --cores 1..2 --chunks 2,4 \
                     --strategies rayon-chunks,std-static --fake-timings 1,1.1,0.9 --no-plots";
+
+/// Held by every test for its whole run: the tests of one file run on parallel threads.
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+/// Waits for the other tests' shards to finish (a failed test's poison does not matter here).
+fn alone() -> MutexGuard<'static, ()> {
+    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
+}
 
 fn sweep(dir: &Path, extra: &str) {
     let o = sweep_into(dir, &format!("{PLAN} {extra}"));
@@ -82,6 +91,7 @@ fn edit_meta(dir: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
 
 #[test]
 fn three_shards_run_one_after_another_merge_into_exactly_the_unsharded_plans_cells_and_trials() {
+    let _alone = alone();
     let tmp = tempfile::tempdir().unwrap();
     let whole = tmp.path().join("whole");
     sweep(&whole, "");
@@ -139,6 +149,7 @@ fn three_shards_run_one_after_another_merge_into_exactly_the_unsharded_plans_cel
 
 #[test]
 fn a_shard_records_its_part_and_the_plans_fingerprint_and_draws_no_charts() {
+    let _alone = alone();
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("s");
     let o = sweep_into(&dir, &format!("{PLAN} --shard 2/3"));
@@ -170,6 +181,7 @@ fn a_shard_records_its_part_and_the_plans_fingerprint_and_draws_no_charts() {
 
 #[test]
 fn a_shard_that_would_be_empty_or_a_malformed_shard_is_refused() {
+    let _alone = alone();
     let (_tmp, dir) = scratch("s");
     let mut cmd = sweep_command(&dir, &format!("{PLAN} --shard 7/7"));
     cmd.env("NO_COLOR", "1");
@@ -183,6 +195,7 @@ fn a_shard_that_would_be_empty_or_a_malformed_shard_is_refused() {
 
 #[test]
 fn merging_refuses_missing_cells_unless_partial_and_then_the_report_says_so() {
+    let _alone = alone();
     let tmp = tempfile::tempdir().unwrap();
     let parts = shards(tmp.path());
     let out = tmp.path().join("merged");
@@ -218,6 +231,7 @@ fn merging_refuses_missing_cells_unless_partial_and_then_the_report_says_so() {
 
 #[test]
 fn merging_refuses_repeats_other_plans_other_splits_and_directories_that_are_not_shards() {
+    let _alone = alone();
     let tmp = tempfile::tempdir().unwrap();
     let parts = shards(tmp.path());
     let out = tmp.path().join("merged");
@@ -258,6 +272,7 @@ fn merging_refuses_repeats_other_plans_other_splits_and_directories_that_are_not
 
 #[test]
 fn merging_refuses_shards_from_another_machine_or_another_build() {
+    let _alone = alone();
     let tmp = tempfile::tempdir().unwrap();
     let parts = shards(tmp.path());
     let out = tmp.path().join("merged");
@@ -291,6 +306,7 @@ fn merging_refuses_shards_from_another_machine_or_another_build() {
 
 #[test]
 fn a_merge_never_replaces_existing_results_without_force() {
+    let _alone = alone();
     let tmp = tempfile::tempdir().unwrap();
     let parts = shards(tmp.path());
     let out = tmp.path().join("merged");

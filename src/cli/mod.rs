@@ -72,7 +72,8 @@ pub enum Command {
         bench-sph sweep --cores 1..6 --chunks 10..200          # the paper's study, every strategy\n  \
         bench-sph sweep --cores 1,2 --chunks 10,50 --n 300 --steps 50 --trials 3 --no-plots\n  \
         bench-sph sweep --strategies rayon-chunks,crossbeam-pool --neighbors all-pairs,grid --out results/grid\n  \
-        bench-sph sweep --resume results/2026-11-22T031500Z"
+        bench-sph sweep --resume results/2026-11-22T031500Z\n  \
+        bench-sph sweep --cores 1..16 --shard 2/4 --out results/study/shard-2   # one node's part; then bench-sph merge"
     )]
     Sweep(SweepArgs),
     /// Merge the shard directories of `sweep --shard I/K` into one results directory.
