@@ -318,3 +318,70 @@ fn a_merge_never_replaces_existing_results_without_force() {
     assert_eq!(std::fs::read(out.join("summary.csv")).unwrap(), before);
     assert!(merge(&parts, &out, &["--force"]).status.success());
 }
+
+/// `scripts/<name>` of this repository, run by bash with the test's binary as `BENCH_SPH`.
+fn script(name: &str) -> std::process::Command {
+    let mut cmd = std::process::Command::new("bash");
+    cmd.arg(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scripts")
+            .join(name),
+    )
+    .env("BENCH_SPH", env!("CARGO_BIN_EXE_bench-sph"));
+    cmd
+}
+
+#[test]
+fn parallel_sweep_without_hosts_runs_the_shards_one_after_another_then_merges_and_reports() {
+    let _alone = alone();
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path().join("study");
+    let mut cmd = script("parallel-sweep.sh");
+    cmd.args(["-k", "3", "-o", root.to_str().unwrap(), "--"])
+        .args(PLAN.split_whitespace().filter(|&a| a != "--no-plots"));
+    let o = cmd.output().unwrap();
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    let merged = root.join("merged");
+    let whole = tmp.path().join("whole");
+    sweep(&whole, "");
+    assert_eq!(trials_per_cell(&merged), trials_per_cell(&whole));
+    assert!(merged.join("REPORT.md").is_file());
+    // Run again without -f or -r: refused, nothing replaced.
+    let before = std::fs::read(merged.join("summary.csv")).unwrap();
+    let mut again = script("parallel-sweep.sh");
+    again
+        .args(["-k", "3", "-o", root.to_str().unwrap(), "--"])
+        .args(PLAN.split_whitespace());
+    let o = again.output().unwrap();
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("already holds a sharded sweep"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(std::fs::read(merged.join("summary.csv")).unwrap(), before);
+}
+
+#[test]
+fn the_slurm_script_submits_an_array_of_shards_and_a_merge_that_waits_for_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let root = tmp.path().join("study");
+    let mut cmd = script("slurm-sweep.sh");
+    cmd.env("SBATCH", "echo")
+        .args(["-k", "4", "-o", root.to_str().unwrap(), "--"])
+        .args(["--cores", "1..2", "--n", "60", "--steps", "3"]);
+    let o = cmd.output().unwrap();
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    let out = format!("{}{}", stdout(&o), stderr(&o));
+    assert_holds_all(
+        "the dry run",
+        &out,
+        &[
+            "--array=1-4",
+            "--exclusive",
+            "--dependency=afterok:",
+            "shard-job.sh merge 4",
+        ],
+    );
+    assert!(!root.exists(), "a dry run wrote {}", root.display());
+}
