@@ -94,10 +94,14 @@ pub enum Command {
         after_help = "Charts: runtime and CPU time against chunks per core count, best runtime and speedup \
         against cores (with the paper's speedups where comparable), every strategy's speedup with error bars, \
         efficiency and Karp–Flatt serial fraction, all-pairs against grid. Trace directories (timeline.png + \
-        stats.csv) under the results or output directory are embedded; --trace adds others.\n\n\
+        stats.csv) under the results or output directory are embedded; --trace adds others. Directories \
+        of different machines (meta.json) are compared instead, one side per machine: speedup and \
+        efficiency per strategy with a line per machine, and each machine's best strategy; --compare \
+        does the same with one side per directory.\n\n\
         Examples:\n  \
         bench-sph report results/2026-11-22T031500Z                 # writes the charts and REPORT.md there\n  \
         bench-sph report results/paper results/grid --out report    # several sweeps as one study\n  \
+        bench-sph report laptop/ server/ --out compare              # two machines: compared, not pooled\n  \
         bench-sph report results/paper --out report --trace trace-chunks"
     )]
     Report(ReportArgs),

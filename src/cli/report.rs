@@ -5,11 +5,15 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 
+use crate::report::compare::SideRule;
+
 /// Options of `report`.
 #[derive(Debug, Clone, Args)]
 pub struct ReportArgs {
     /// Results directories of `bench-sph sweep` (each with summary.csv and meta.json); several
-    /// are read as one study (e.g. an all-pairs sweep and a grid sweep).
+    /// of one machine are read as one study (e.g. an all-pairs sweep and a grid sweep);
+    /// directories of different machines (CPU model or hardware threads in meta.json) are
+    /// compared, never pooled.
     #[arg(value_name = "DIR", required = true)]
     pub dirs: Vec<PathBuf>,
     /// Where to write the charts and REPORT.md [default: the first DIR].
@@ -23,12 +27,21 @@ pub struct ReportArgs {
     /// stay untouched; only the report's own files are replaced).
     #[arg(long)]
     pub force: bool,
+    /// Compare the directories, one side each, even when they ran on the same machine (the
+    /// report then warns that their differences are not machine differences).
+    #[arg(long)]
+    pub compare: bool,
 }
 
 /// Runs `report`.
 pub fn run(args: &ReportArgs) -> anyhow::Result<()> {
     let out = args.out.clone().unwrap_or_else(|| args.dirs[0].clone());
-    let written = crate::report::generate(&args.dirs, &out, &args.trace, args.force)?;
+    let rule = if args.compare {
+        SideRule::EachDirectory
+    } else {
+        SideRule::ByMachine
+    };
+    let written = crate::report::generate_with(&args.dirs, &out, &args.trace, args.force, rule)?;
     let mut text = format!("Report in {}:", out.display());
     for p in &written {
         text.push_str(&format!("\n  {}", p.display()));

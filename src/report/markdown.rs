@@ -37,8 +37,10 @@ pub struct Input<'a> {
 
 pub use super::numbers::{mean_sd, secs, times};
 
-const OVERSUBSCRIBED: &str = "⚠ oversubscribed";
-const CONTENDED: &str = "⚠ contended";
+/// How tables flag a cell with more threads than the machine has.
+pub(super) const OVERSUBSCRIBED: &str = "⚠ oversubscribed";
+/// How tables flag a cell that other work disturbed.
+pub(super) const CONTENDED: &str = "⚠ contended";
 
 /// The whole of `REPORT.md`.
 pub fn render(input: &Input<'_>) -> String {
@@ -68,17 +70,7 @@ pub fn render(input: &Input<'_>) -> String {
             "groups"
         }
     );
-    if input
-        .sweeps
-        .iter()
-        .any(|s| s.meta.params.fake_timings.is_some())
-    {
-        let _ = writeln!(
-            md,
-            "> ⚠ **Test data**: these sweeps were run with `--fake-timings`; their times are \
-             made up, not measurements.\n"
-        );
-    }
+    test_data_banner(&mut md, input.sweeps);
     banners(&mut md, input.sweeps, &rows);
     machine(&mut md, input.sweeps);
     md.push_str(&super::workloads::markdown(
@@ -93,9 +85,20 @@ pub fn render(input: &Input<'_>) -> String {
     md
 }
 
+/// The banner over sweeps timed by `--fake-timings`.
+pub(super) fn test_data_banner(md: &mut String, sweeps: &[Sweep]) {
+    if sweeps.iter().any(|s| s.meta.params.fake_timings.is_some()) {
+        let _ = writeln!(
+            md,
+            "> ⚠ **Test data**: these sweeps were run with `--fake-timings`; their times are \
+             made up, not measurements.\n"
+        );
+    }
+}
+
 /// What a reader must know before any number: a partial study, contended cells, cells
 /// dropped as impossible.
-fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
+pub(super) fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
     use crate::results::meta::SweepStatus;
     for s in sweeps {
         shard_banner(md, s);

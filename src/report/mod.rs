@@ -19,6 +19,9 @@
 //! and per preset, where both neighbour searches were measured:
 //! 6. all-pairs against grid, seconds per step against N.
 //!
+//! Directories of different machines (by `meta.json`) are not pooled: the report compares the
+//! machines instead ([`compare`]).
+//!
 //! Where the rows hold both the toy workload (`seed`/`cpp`) and `wcsph`, REPORT.md compares
 //! the strategy ranking of the two ([`workloads`]) before the groups' sections.
 //!
@@ -27,6 +30,7 @@
 //! lists them with their reason.
 
 pub mod charts;
+pub mod compare;
 pub mod findings;
 pub mod markdown;
 pub mod numbers;
@@ -69,16 +73,46 @@ fn tolerated(path: &Path) -> bool {
 /// `trace_dirs`, writes `out_dir/REPORT.md`, and removes the charts of an earlier report that
 /// this one did not draw again. Cells dropped as impossible are listed on standard error and
 /// in the report. Returns the files written, the report last.
+///
+/// Directories of different machines are not pooled: the report compares them
+/// ([`compare`]); see [`generate_with`].
 pub fn generate(
     results_dirs: &[PathBuf],
     out_dir: &Path,
     trace_dirs: &[PathBuf],
     force: bool,
 ) -> anyhow::Result<Vec<PathBuf>> {
+    generate_with(
+        results_dirs,
+        out_dir,
+        trace_dirs,
+        force,
+        compare::SideRule::ByMachine,
+    )
+}
+
+/// [`generate`], with the directories grouped into sides by `rule`: one side is one study,
+/// as always; several sides (several machines, or `--compare`) make a comparison of machines
+/// ([`compare`]), whose charts are named `compare-…` and which embeds no trace (traces
+/// belong to one machine's full report).
+pub fn generate_with(
+    results_dirs: &[PathBuf],
+    out_dir: &Path,
+    trace_dirs: &[PathBuf],
+    force: bool,
+    rule: compare::SideRule,
+) -> anyhow::Result<Vec<PathBuf>> {
     if results_dirs.is_empty() {
         bail!("no results directory given");
     }
-    let sweeps = load::load_all(results_dirs)?;
+    if rule == compare::SideRule::EachDirectory && results_dirs.len() < 2 {
+        bail!("--compare needs two results directories or more (each becomes a side)");
+    }
+    let sweeps = load::load_each(results_dirs)?;
+    let sides = compare::sides::sides(&sweeps, rule);
+    for side in &sides {
+        load::refuse_shared_cells(side.sweeps.iter().copied())?;
+    }
     for s in &sweeps {
         for why in &s.dropped {
             crate::output::console::warn(&format!(
@@ -96,28 +130,73 @@ pub fn generate(
     };
     let claimed = crate::output::claim::claim(out_dir, &owner, force)?;
     claimed.check_writable(REPORT_FILE)?;
-    let rows: Vec<_> = sweeps.iter().flat_map(|s| s.rows.clone()).collect();
 
-    let planned = plan::plan(&rows);
     let mut written = Vec::new();
-    for chart in &planned.charts {
-        let path = claimed.check_writable(&chart.file)?;
-        draw(&path, chart)?;
-        written.push(path);
-    }
-
-    let traces = embed_traces(results_dirs, out_dir, trace_dirs, &mut written)?;
-    let text = markdown::render(&markdown::Input {
-        sweeps: &sweeps,
-        charts: &planned.charts,
-        skipped: &planned.skipped,
-        traces: &traces,
-    });
+    let text = if compare::sides::is_comparison(&sides, rule) {
+        if !trace_dirs.is_empty() {
+            crate::output::console::warn(
+                "warning: --trace is not used when machines are compared: traces belong to \
+                 one machine's full report",
+            );
+        }
+        compared(&sweeps, &sides, rule, &claimed, &mut written)?
+    } else {
+        let traces = (results_dirs, out_dir, trace_dirs);
+        pooled(&sweeps, traces, &claimed, &mut written)?
+    };
     let report = out_dir.join(REPORT_FILE);
     crate::output::atomic::write(&report, text.as_bytes())?;
     written.push(report);
     claimed.remove_stale(&written)?;
     Ok(written)
+}
+
+/// One study (one machine's directories): draws its charts into `claimed` (adding them to
+/// `written`), embeds the traces found from `(results_dirs, out_dir, trace_dirs)` (see
+/// [`embed_traces`]), and returns REPORT.md's text.
+fn pooled(
+    sweeps: &[load::Sweep],
+    (results_dirs, out_dir, trace_dirs): (&[PathBuf], &Path, &[PathBuf]),
+    claimed: &crate::output::claim::Claimed,
+    written: &mut Vec<PathBuf>,
+) -> anyhow::Result<String> {
+    let rows: Vec<_> = sweeps.iter().flat_map(|s| s.rows.clone()).collect();
+    let planned = plan::plan(&rows);
+    for chart in &planned.charts {
+        let path = claimed.check_writable(&chart.file)?;
+        draw(&path, chart)?;
+        written.push(path);
+    }
+    let traces = embed_traces(results_dirs, out_dir, trace_dirs, written)?;
+    Ok(markdown::render(&markdown::Input {
+        sweeps,
+        charts: &planned.charts,
+        skipped: &planned.skipped,
+        traces: &traces,
+    }))
+}
+
+/// A comparison of `sides`: draws its charts into `claimed` (adding them to `written`) and
+/// returns REPORT.md's text.
+fn compared(
+    sweeps: &[load::Sweep],
+    sides: &[compare::sides::Side<'_>],
+    rule: compare::SideRule,
+    claimed: &crate::output::claim::Claimed,
+    written: &mut Vec<PathBuf>,
+) -> anyhow::Result<String> {
+    let planned = compare::plan::plan(sides);
+    for chart in planned.compared.iter().flat_map(|c| &c.charts) {
+        let path = claimed.check_writable(&chart.file)?;
+        charts::compare::draw(&path, &chart.title, &chart.subtitle, &chart.lines)?;
+        written.push(path);
+    }
+    Ok(compare::markdown::render(&compare::markdown::Input {
+        sweeps,
+        sides,
+        rule,
+        plan: &planned,
+    }))
 }
 
 /// The traces found under the results directories and `out_dir` or named in `trace_dirs`;

@@ -29,11 +29,15 @@ pub const TIMELINE_WIDTH: u32 = 1600;
 /// The report's file name.
 pub const REPORT_FILE: &str = "REPORT.md";
 
+/// How the charts of a comparison of machines begin (`compare-seed-all-pairs-n1000-s100-…`),
+/// so that no name of theirs is a chart name of a normal report (those begin with a preset).
+pub const COMPARE_CHART_PREFIX: &str = "compare-";
+
 /// Whether a file is one `bench-sph report` writes, by name **and** contents, so that a
 /// user's file that merely has a similar name is never replaced or removed: a `REPORT.md`
-/// that starts with `# bench-sph report`, a chart (`<preset>-….png`, a PNG of the charts'
-/// size) or a copied timeline (`…-timeline.png`, a PNG of the timelines' width). A sweep
-/// that draws its report owns these too.
+/// that starts with `# bench-sph report`, a chart (`<preset>-….png` or, comparing machines,
+/// `compare-….png`, a PNG of the charts' size) or a copied timeline (`…-timeline.png`, a PNG
+/// of the timelines' width). A sweep that draws its report owns these too.
 pub fn is_report_file(path: &Path) -> bool {
     use crate::sph::params::Preset;
     let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
@@ -48,8 +52,9 @@ pub fn is_report_file(path: &Path) -> bool {
     if name.ends_with("-timeline.png") {
         return png_size(path).is_some_and(|(w, _)| w == TIMELINE_WIDTH);
     }
-    Preset::ALL
-        .iter()
-        .any(|p| name.starts_with(&format!("{}-", p.as_str())))
-        && png_size(path) == Some((CHART_WIDTH, CHART_HEIGHT))
+    let prefixed = name.starts_with(COMPARE_CHART_PREFIX)
+        || Preset::ALL
+            .iter()
+            .any(|p| name.starts_with(&format!("{}-", p.as_str())));
+    prefixed && png_size(path) == Some((CHART_WIDTH, CHART_HEIGHT))
 }

@@ -11,8 +11,10 @@
 //! - A cell whose numbers are impossible (not finite and positive, statistics that are not
 //!   those of its trial rows, counts beyond the documented limits) is dropped, and the report
 //!   lists it with the reason ([`Sweep::dropped`]).
-//! - The same directory twice, or the same cell in two directories, is refused: counting a
-//!   cell twice would weigh it double in every finding.
+//! - The same directory twice is refused ([`load_each`]), and so is the same cell in two
+//!   directories of one study ([`refuse_shared_cells`]): counting a cell twice would weigh it
+//!   double in every finding. The report checks cells per machine: the same cell measured on
+//!   two machines is what a comparison of machines is made of.
 
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -41,8 +43,8 @@ pub struct Sweep {
     pub dropped: Vec<String>,
 }
 
-/// Reads every directory of `dirs`, refusing repeats (see the module docs).
-pub fn load_all(dirs: &[PathBuf]) -> anyhow::Result<Vec<Sweep>> {
+/// Reads every directory of `dirs`, refusing a directory given twice (under any path).
+pub fn load_each(dirs: &[PathBuf]) -> anyhow::Result<Vec<Sweep>> {
     let mut seen: HashMap<PathBuf, &Path> = HashMap::new();
     for d in dirs {
         let canonical = d
@@ -57,12 +59,14 @@ pub fn load_all(dirs: &[PathBuf]) -> anyhow::Result<Vec<Sweep>> {
             );
         }
     }
-    let sweeps = dirs
-        .iter()
-        .map(|d| load(d))
-        .collect::<anyhow::Result<Vec<_>>>()?;
+    dirs.iter().map(|d| load(d)).collect()
+}
+
+/// Refuses `sweeps` that hold the same cell twice: they are to be pooled into one study (one
+/// machine's), where a cell must count once.
+pub fn refuse_shared_cells<'a>(sweeps: impl IntoIterator<Item = &'a Sweep>) -> anyhow::Result<()> {
     let mut owner: HashMap<Cell, &Path> = HashMap::new();
-    for s in &sweeps {
+    for s in sweeps {
         for r in &s.rows {
             if let Some(first) = owner.insert(r.key(), &s.dir) {
                 bail!(
@@ -75,7 +79,7 @@ pub fn load_all(dirs: &[PathBuf]) -> anyhow::Result<Vec<Sweep>> {
             }
         }
     }
-    Ok(sweeps)
+    Ok(())
 }
 
 /// Reads `dir/meta.json`, `dir/summary.csv` and (where present) `dir/trials.csv`.

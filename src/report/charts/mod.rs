@@ -5,6 +5,7 @@
 
 pub mod best;
 pub mod chunks;
+pub mod compare;
 pub mod efficiency;
 pub mod neighbors;
 pub mod speedup;

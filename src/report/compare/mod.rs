@@ -1,0 +1,19 @@
+//! Comparing machines: `bench-sph report` on results directories of different machines.
+//!
+//! Directories whose `meta.json` machines differ are never pooled: they form **sides**, one
+//! per machine ([`sides`]; `--compare` makes every directory a side), and the report becomes
+//! a comparison: the machines, then per workload measured on two sides or more each machine's
+//! fastest strategy and one chart per strategy with a line per machine ([`plan`], pure), then
+//! per side a short summary ([`markdown`], pure). [`crate::report::generate`] draws the
+//! charts ([`crate::report::charts::compare`]) and writes the text.
+//!
+//! A cell counts once within a side (the same cell in two directories of one machine is
+//! refused, as in a single study); the same cell on two sides is what a comparison compares.
+//! Chart files are named `compare-…`, so that they never take the name of a chart of the
+//! normal report.
+
+pub mod markdown;
+pub mod plan;
+pub mod sides;
+
+pub use sides::SideRule;
