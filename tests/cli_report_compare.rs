@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{assert_holds_all, fake_sweep, line_containing, names, run, text};
+use common::{assert_holds_all, fails_with, fake_sweep, line_containing, names, run, text};
 
 const WIDTH: u32 = 1000;
 const HEIGHT: u32 = 650;
@@ -337,4 +337,21 @@ fn a_normal_report_and_a_comparison_replace_each_others_charts_in_one_directory(
         "{:?}",
         pngs(&out)
     );
+}
+
+#[test]
+fn a_comparison_is_never_written_over_one_compared_directorys_own_report() {
+    let tmp = tempfile::tempdir().unwrap();
+    let (a, b) = two_machines(tmp.path());
+    let before = names(&a);
+    for extra in [&[][..], &["--out", a.to_str().unwrap()][..]] {
+        let mut args = vec!["report", a.to_str().unwrap(), b.to_str().unwrap()];
+        args.extend(extra);
+        fails_with(&args, &["compared, not pooled", "--out DIR"]);
+        assert_eq!(
+            names(&a),
+            before,
+            "nothing written into a compared directory"
+        );
+    }
 }

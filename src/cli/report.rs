@@ -16,7 +16,8 @@ pub struct ReportArgs {
     /// compared, never pooled.
     #[arg(value_name = "DIR", required = true)]
     pub dirs: Vec<PathBuf>,
-    /// Where to write the charts and REPORT.md [default: the first DIR].
+    /// Where to write the charts and REPORT.md [default: the first DIR; required when the
+    /// directories are compared, which must not replace one directory's own report].
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// A trace directory of `bench-sph trace` to embed (repeatable). Trace directories under

@@ -121,6 +121,10 @@ pub fn generate_with(
             ));
         }
     }
+    let comparison = compare::sides::is_comparison(&sides, rule);
+    if comparison {
+        refuse_comparison_into_an_input(results_dirs, out_dir)?;
+    }
     let owns = |p: &Path| p.is_file() && is_report_file(p);
     let owner = crate::output::claim::Owner {
         command: "bench-sph report",
@@ -132,7 +136,7 @@ pub fn generate_with(
     claimed.check_writable(REPORT_FILE)?;
 
     let mut written = Vec::new();
-    let text = if compare::sides::is_comparison(&sides, rule) {
+    let text = if comparison {
         if !trace_dirs.is_empty() {
             crate::output::console::warn(
                 "warning: --trace is not used when machines are compared: traces belong to \
@@ -221,6 +225,25 @@ fn embed_traces(
         }
     }
     Ok(traces)
+}
+
+/// A comparison of machines belongs to none of them: written into one of the results
+/// directories, it would replace that sweep's own REPORT.md and remove its charts as stale.
+fn refuse_comparison_into_an_input(results_dirs: &[PathBuf], out_dir: &Path) -> anyhow::Result<()> {
+    let Ok(out) = out_dir.canonicalize() else {
+        return Ok(());
+    };
+    if let Some(dir) = results_dirs
+        .iter()
+        .find(|d| d.canonicalize().is_ok_and(|d| d == out))
+    {
+        bail!(
+            "these directories are compared, not pooled, and the comparison would replace \
+             '{}''s own report: write it elsewhere with --out DIR",
+            dir.display()
+        );
+    }
+    Ok(())
 }
 
 /// Draws one planned chart into `path`.

@@ -163,6 +163,7 @@ pub(crate) mod tests {
             simd: None,
             fake_timings: None,
             fake_contention: None,
+            shard: None,
         };
         let mut meta = Meta::new(params, rows.len(), session);
         meta.finish(SweepStatus::Complete, rows.len());
