@@ -15,6 +15,9 @@
 #                             strategy
 #   report/                   charts, REPORT.md and two traces (rayon-chunks, rayon-spawn)
 #   report/validation/        the wcsph dam break against Martin & Moyce (1952), R = 40
+#   results/grid-50steps/     the grid sweep again at 50 steps (N = 1000, 10 000), and
+#   report/compare/           its comparison with results/grid (report --compare): a
+#                             stand-in for a second machine, labelled as one
 # Run it on a quiet machine: nothing else should compete for the cores while it measures.
 set -euo pipefail
 
@@ -51,10 +54,18 @@ mkdir -p report
 "$BIN" report results/paper results/grid results/all-pairs-small results/wcsph \
     --out report --force
 "$BIN" validate --resolution 40 --out report/validation --force
+# A stand-in for a second machine (README, "Comparing machines"): the grid study again at 50
+# steps on this machine, compared with --compare, whose banner says it is one machine.
+"$BIN" sweep --preset seed --neighbors grid --n 1000,10000 --steps 50 \
+    --cores "$CORES" --chunks 10,50,200 --out results/grid-50steps --force --no-plots
+mkdir -p report/compare
+"$BIN" report results/grid results/grid-50steps --compare --out report/compare --force
 
 # A study measured while other work used the machine is not one to commit.
-contended=$(cat results/paper/summary.csv results/grid/summary.csv \
-    results/all-pairs-small/summary.csv results/wcsph/summary.csv | awk -F, '$NF == "true" {n++} END {print n + 0}')
+# The `contended` column by name: columns are appended over time (reference_shard follows it).
+contended=$(awk -F, 'FNR == 1 {for (i = 1; i <= NF; i++) if ($i == "contended") c = i; next}
+    $c == "true" {n++} END {print n + 0}' results/paper/summary.csv results/grid/summary.csv \
+    results/all-pairs-small/summary.csv results/wcsph/summary.csv results/grid-50steps/summary.csv)
 if [ "$contended" -gt 0 ]; then
     echo "warning: $contended contended cells (see report/REPORT.md): rerun on a quiet machine" >&2
     exit 1
