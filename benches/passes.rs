@@ -131,10 +131,7 @@ fn bench_scene(c: &mut Criterion, label: &str, mode: NeighborMode, n: usize) {
                     continue;
                 }
                 let mut sim = start.clone();
-                let config = Config {
-                    cores,
-                    chunks: 10 * cores,
-                };
+                let config = Config::new(cores, 10 * cores);
                 let id = BenchmarkId::new(strategy.as_str(), format!("{cores}-cores"));
                 group.bench_function(id, |b| {
                     b.iter_custom(|iters| {
@@ -162,10 +159,7 @@ fn simd_paths(c: &mut Criterion) {
         ("all-pairs-n1000", NeighborMode::AllPairs, 1000),
         ("grid-n100000", NeighborMode::Grid, 100_000),
     ];
-    let seq = Config {
-        cores: 1,
-        chunks: 1,
-    };
+    let seq = Config::new(1, 1);
     for (label, mode, n) in scenes {
         let settled = settled(mode, n);
         for work in [Work::Pass(Pass::Density), Work::Step] {

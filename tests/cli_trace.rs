@@ -54,10 +54,7 @@ fn trace(strategy: StrategyName, out: &Path, extra: &[&str]) -> Output {
 
 /// Kernel calls per pass, where the strategy fixes it (rayon-iter lets rayon decide).
 fn expected_calls(strategy: StrategyName) -> Option<usize> {
-    let config = sph_strategies::Config {
-        cores: CORES,
-        chunks: CHUNKS,
-    };
+    let config = sph_strategies::Config::new(CORES, CHUNKS);
     strategy.info().kernel_calls(N, &config)
 }
 

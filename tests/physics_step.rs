@@ -16,16 +16,7 @@ const TANK: Domain = Domain {
 
 fn step(preset: Preset, state: State, mode: NeighborMode, steps: usize) -> State {
     let mut sim = Simulation::new(preset.params(), TANK, state, mode);
-    run_timed(
-        &mut sim,
-        StrategyName::Seq,
-        &Config {
-            cores: 1,
-            chunks: 1,
-        },
-        steps,
-    )
-    .expect("step runs");
+    run_timed(&mut sim, StrategyName::Seq, &Config::new(1, 1), steps).expect("step runs");
     sim.state
 }
 

@@ -9,10 +9,7 @@ use bench_sph::sph::params::Preset;
 use bench_sph::sph::state::{Domain, FIELD_NAMES, State};
 use sph_strategies::{Config, StrategyName};
 
-const SEQ: Config = Config {
-    cores: 1,
-    chunks: 1,
-};
+const SEQ: Config = Config::new(1, 1);
 
 fn run(preset: Preset, n: usize, steps: usize, mode: NeighborMode) -> State {
     let mut sim = Scene::dam_break(preset, n, 2019).unwrap().simulate(mode);
@@ -204,7 +201,7 @@ fn a_large_run_checked_in_parallel_blocks_stops_at_the_same_step_and_particle() 
             init.clone(),
             NeighborMode::Grid,
         );
-        let config = Config { cores, chunks: 7 };
+        let config = Config::new(cores, 7);
         match run_timed(&mut sim, strategy, &config, 5).unwrap_err() {
             RunError::Step(StepError::Diverged { step, particle, .. }) => {
                 assert_eq!((step, particle), (1, last), "{strategy}");

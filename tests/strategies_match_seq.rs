@@ -28,7 +28,7 @@ fn run(
 ) -> State {
     let scene = Scene::dam_break(preset, N, 7).unwrap();
     let mut sim = scene.simulate(mode).with_simd(simd).unwrap();
-    run_timed(&mut sim, strategy, &Config { cores, chunks }, STEPS)
+    run_timed(&mut sim, strategy, &Config::new(cores, chunks), STEPS)
         .unwrap_or_else(|e| panic!("{strategy} cores={cores} chunks={chunks}: {e}"));
     sim.state
 }
@@ -118,7 +118,7 @@ fn more_cores_and_chunks_than_particles_still_match_the_sequential_run() {
             init,
             NeighborMode::Grid,
         );
-        run_timed(&mut sim, strategy, &Config { cores, chunks }, 10).expect("runs");
+        run_timed(&mut sim, strategy, &Config::new(cores, chunks), 10).expect("runs");
         sim.state
     };
     let reference = tiny(StrategyName::Seq, 1, 1);

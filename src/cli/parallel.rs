@@ -46,9 +46,9 @@ impl ParallelArgs {
     /// The strategy's configuration: `--cores` (default: the machine's hardware threads)
     /// and `--chunks`.
     pub fn config(&self) -> Config {
-        Config {
-            cores: self.cores.unwrap_or_else(super::hardware_threads),
-            chunks: self.chunks,
-        }
+        Config::new(
+            self.cores.unwrap_or_else(super::hardware_threads),
+            self.chunks,
+        )
     }
 }

@@ -93,10 +93,7 @@ impl Cell {
 
     /// The strategy configuration (strategies without chunks ignore `chunks`).
     pub fn config(&self) -> Config {
-        Config {
-            cores: self.cores,
-            chunks: self.chunks.unwrap_or(1),
-        }
+        Config::new(self.cores, self.chunks.unwrap_or(1))
     }
 
     /// Particles in the largest of the `min(chunks, n)` balanced chunks:

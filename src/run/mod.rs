@@ -226,10 +226,7 @@ mod tests {
         test_simulation(n, 7)
     }
 
-    const CONFIG: Config = Config {
-        cores: 2,
-        chunks: 5,
-    };
+    const CONFIG: Config = Config::new(2, 5);
 
     /// Notes the step and the thread of every segment, and stops after `stop_after`.
     struct Seen {

@@ -155,10 +155,7 @@ mod tests {
 
     #[test]
     fn a_traced_run_ends_in_the_same_state_as_an_untraced_one_on_every_strategy() {
-        let config = Config {
-            cores: 2,
-            chunks: 5,
-        };
+        let config = Config::new(2, 5);
         for &strategy in StrategyName::ALL {
             let mut plain = sim(90);
             run_timed(&mut plain, strategy, &config, 3).unwrap();
@@ -187,10 +184,7 @@ mod tests {
     fn divergence_stops_a_traced_run_with_the_step_and_particle() {
         let mut s = sim(20);
         s.state.vx[3] = f64::NAN;
-        let config = Config {
-            cores: 2,
-            chunks: 3,
-        };
+        let config = Config::new(2, 3);
         let err = run_traced(&mut s, StrategyName::RayonChunks, &config, 5, 0).unwrap_err();
         assert!(
             matches!(err, RunError::Step(StepError::Diverged { step: 1, .. })),

@@ -103,10 +103,7 @@ impl Plan {
     /// ([`sph_strategies::Info::kernel_calls`]), and where the runtime decides (`rayon-iter`)
     /// min([`RAYON_ITER_LEAVES_PER_CORE`] × cores, N).
     pub fn calls_per_pass(&self) -> usize {
-        let config = Config {
-            cores: self.cores,
-            chunks: self.chunks,
-        };
+        let config = Config::new(self.cores, self.chunks);
         let n = self.n;
         self.strategy
             .info()

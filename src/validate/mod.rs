@@ -132,10 +132,7 @@ mod tests {
 
     #[test]
     fn a_coarse_run_reaches_t_3_4_with_a_sample_every_hundredth_of_a_second() {
-        let config = Config {
-            cores: 1,
-            chunks: 1,
-        };
+        let config = Config::new(1, 1);
         let v = validate(8, StrategyName::Seq, &config).unwrap();
         assert_eq!((v.fluid, v.samples[0].t_s), (128, 0.0));
         let last = v.samples.last().unwrap().t_s;

@@ -235,10 +235,7 @@ mod tests {
             seed: 1,
             neighbors: NeighborMode::Grid,
             strategy: StrategyName::Seq,
-            config: Config {
-                cores: 2,
-                chunks: 4,
-            },
+            config: Config::new(2, 4),
             every: 3,
             color: ColorBy::Speed,
             width: 400,

@@ -194,10 +194,7 @@ mod tests {
         crate::run::test_simulation(n, 3)
     }
 
-    const CONFIG: Config = Config {
-        cores: 2,
-        chunks: 3,
-    };
+    const CONFIG: Config = Config::new(2, 3);
 
     #[test]
     fn a_stepper_gives_the_bits_of_one_plain_run_across_segments_and_strategy_switches() {

@@ -55,8 +55,8 @@ use crate::degrade::Degrade;
 use crate::erased_job::JobBoard;
 use crate::thread_start::ThreadStarts;
 use crate::{
-    BuildError, Config, Executor, Info, KernelPanic, Session, Split, Strategy, balanced_chunks,
-    panic,
+    BuildError, Config, Executor, Info, KernelPanic, Placement, Session, Split, Strategy,
+    balanced_chunks, panic,
 };
 use crossbeam::queue::ArrayQueue;
 use std::cell::{Cell, RefCell};
@@ -68,6 +68,7 @@ use std::sync::OnceLock;
 pub struct CrossbeamPool {
     cores: usize,
     chunks: usize,
+    placement: Placement,
     starts: ThreadStarts,
 }
 
@@ -85,6 +86,7 @@ impl Strategy for CrossbeamPool {
         Ok(CrossbeamPool {
             cores: config.cores,
             chunks: config.chunks,
+            placement: config.placement,
             starts: ThreadStarts::default(),
         })
     }
@@ -105,24 +107,31 @@ impl Strategy for CrossbeamPool {
             )),
             not_sync: PhantomData,
         };
-        let cores = self.cores;
+        let (cores, placement) = (self.cores, self.placement);
+        let board = &board;
         let outcome = crossbeam::scope(|scope| {
             // Created before the first worker, so that every way out of this closure — a
             // return, a refused thread, a panicking session — releases the workers first.
-            let _stop = ShutDownOnDrop(&board);
+            let _stop = ShutDownOnDrop(board);
             for i in 1..cores {
                 self.starts.start(i, cores, || {
                     scope
                         .builder()
                         .name(format!("crossbeam-pool-{i}"))
-                        .spawn(|_| board.serve())
+                        .spawn(move |_| {
+                            placement.on_start(i);
+                            board.serve()
+                        })
                 })?;
             }
             let session_thread = self.starts.start(0, cores, || {
                 scope
                     .builder()
                     .name("crossbeam-pool-0".to_owned())
-                    .spawn(move |_| session.run(&executor))
+                    .spawn(move |_| {
+                        placement.on_start(0);
+                        session.run(&executor)
+                    })
             })?;
             Ok(session_thread.join())
         })
@@ -239,6 +248,7 @@ mod tests {
             let strategy = CrossbeamPool {
                 cores: 4,
                 chunks: 8,
+                placement: Placement::OS,
                 starts: ThreadStarts {
                     refuse: Some(refuse),
                 },

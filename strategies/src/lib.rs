@@ -28,6 +28,7 @@ pub mod crossbeam_pool;
 mod degrade;
 mod erased_job;
 mod panic;
+pub mod placement;
 pub mod rayon_chunks;
 pub mod rayon_iter;
 mod rayon_pool;
@@ -42,6 +43,7 @@ mod testing;
 mod thread_start;
 
 pub use panic::KernelPanic;
+pub use placement::Placement;
 pub use registry::{StrategyName, UnknownStrategy, run};
 pub use split::{Split, balanced_chunks};
 
@@ -53,6 +55,8 @@ pub struct Config {
     /// Requested number of chunks per pass (>= 1); the strategy makes `min(chunks, len)`
     /// balanced chunks. Strategies without a chunks parameter ignore it.
     pub chunks: usize,
+    /// What each worker thread does first (see [`placement`]); [`Placement::OS`] by default.
+    pub placement: Placement,
 }
 
 /// Static facts about a strategy, shown by `bench-sph list` and used by the study runner, the
@@ -144,6 +148,20 @@ pub enum BuildError {
 }
 
 impl Config {
+    /// `cores` threads and `chunks` chunks, placed by the operating system.
+    pub const fn new(cores: usize, chunks: usize) -> Config {
+        Config {
+            cores,
+            chunks,
+            placement: Placement::OS,
+        }
+    }
+
+    /// The same, with its worker threads placed by `placement`.
+    pub const fn placed(self, placement: Placement) -> Config {
+        Config { placement, ..self }
+    }
+
     /// Checks the numbers a strategy relies on.
     pub fn validate(&self) -> Result<(), BuildError> {
         if self.cores == 0 {
@@ -213,10 +231,7 @@ mod tests {
 
     #[test]
     fn each_kind_of_strategy_promises_its_kernel_calls_per_pass() {
-        let config = Config {
-            cores: 3,
-            chunks: 7,
-        };
+        let config = Config::new(3, 7);
         let calls = |kind, len| info(kind).kernel_calls(len, &config);
         assert_eq!(calls(Calls::Whole, 100), Some(1));
         assert_eq!(calls(Calls::Whole, 0), Some(0));

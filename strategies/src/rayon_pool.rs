@@ -2,11 +2,14 @@
 
 use crate::{BuildError, Config, Executor, Session};
 
-/// A rayon pool with exactly `config.cores` threads, named `{name}-{index}`.
+/// A rayon pool with exactly `config.cores` threads, named `{name}-{index}`, each placed by
+/// `config.placement` as it starts.
 pub(crate) fn build(config: &Config, name: &'static str) -> Result<rayon::ThreadPool, BuildError> {
+    let placement = config.placement;
     rayon::ThreadPoolBuilder::new()
         .num_threads(config.cores)
         .thread_name(move |i| format!("{name}-{i}"))
+        .start_handler(move |i| placement.on_start(i))
         .build()
         .map_err(|e| BuildError::Pool(e.to_string()))
 }

@@ -19,13 +19,15 @@ use std::cell::RefCell;
 
 use crate::thread_start::ThreadStarts;
 use crate::{
-    BuildError, Config, Executor, Info, KernelPanic, Session, Split, Strategy, balanced_chunks,
+    BuildError, Config, Executor, Info, KernelPanic, Placement, Session, Split, Strategy,
+    balanced_chunks,
 };
 
 /// One fresh scoped thread per block, `cores` blocks per pass.
 #[derive(Debug, Clone, Copy)]
 pub struct StdStatic {
     cores: usize,
+    placement: Placement,
     starts: ThreadStarts,
 }
 
@@ -41,6 +43,7 @@ impl Strategy for StdStatic {
         config.validate()?;
         Ok(StdStatic {
             cores: config.cores,
+            placement: config.placement,
             starts: ThreadStarts::default(),
         })
     }
@@ -81,7 +84,11 @@ impl Executor for StdStaticExecutor {
             let mut refused = None;
             for (index, (first, block)) in blocks.into_iter().enumerate() {
                 let started = self.strategy.starts.start(index, count, || {
-                    std::thread::Builder::new().spawn_scoped(scope, move || kernel(first, block))
+                    let placement = self.strategy.placement;
+                    std::thread::Builder::new().spawn_scoped(scope, move || {
+                        placement.on_start(index);
+                        kernel(first, block)
+                    })
                 });
                 match started {
                     Ok(thread) => threads.push(thread),
@@ -131,6 +138,7 @@ mod tests {
     fn a_block_thread_the_system_refuses_fails_the_run_after_joining_the_blocks_started() {
         let strategy = StdStatic {
             cores: 4,
+            placement: Placement::OS,
             starts: ThreadStarts { refuse: Some(2) },
         };
         let counted = run_counting(strategy, 100, 5);

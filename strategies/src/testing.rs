@@ -17,7 +17,7 @@ pub(crate) fn thread_ids_per_pass<S: Strategy>(
     len: usize,
     passes: usize,
 ) -> Vec<Vec<ThreadId>> {
-    let strategy = S::build(&Config { cores, chunks }).expect("the strategy builds");
+    let strategy = S::build(&Config::new(cores, chunks)).expect("the strategy builds");
     strategy
         .run(ThreadIds { len, passes })
         .expect("the threads start")

@@ -54,7 +54,7 @@ fn more_cores_and_more_chunks_than_elements_neither_panic_nor_deadlock() {
         for &name in StrategyName::ALL {
             for len in [1, 2, 3] {
                 for (cores, chunks) in [(8, 100), (len + 1, len + 1), (16, 1), (1, 1000)] {
-                    let config = Config { cores, chunks };
+                    let config = Config::new(cores, chunks);
                     let what = format!("{name} {config:?} len={len}");
                     let passes = run(name, &config, Recorder::new(len, 5, Outputs::Tuple))
                         .unwrap_or_else(|e| panic!("{what}: {e}"));
@@ -72,23 +72,9 @@ fn more_cores_and_more_chunks_than_elements_neither_panic_nor_deadlock() {
 fn every_strategy_refuses_zero_cores_or_zero_chunks() {
     for &name in StrategyName::ALL {
         let session = || Recorder::new(1, 1, Outputs::Single);
-        let zero_cores = run(
-            name,
-            &Config {
-                cores: 0,
-                chunks: 1,
-            },
-            session(),
-        );
+        let zero_cores = run(name, &Config::new(0, 1), session());
         assert!(matches!(zero_cores, Err(BuildError::ZeroCores)), "{name}");
-        let zero_chunks = run(
-            name,
-            &Config {
-                cores: 1,
-                chunks: 0,
-            },
-            session(),
-        );
+        let zero_chunks = run(name, &Config::new(1, 0), session());
         assert!(matches!(zero_chunks, Err(BuildError::ZeroChunks)), "{name}");
     }
 }

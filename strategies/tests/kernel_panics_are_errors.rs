@@ -19,7 +19,7 @@ fn a_kernel_panic_on_one_element_is_returned_with_its_message_and_the_next_pass_
             for len in [1, 2, 500] {
                 for cores in CORES {
                     for chunks in chunk_counts(len) {
-                        let config = Config { cores, chunks };
+                        let config = Config::new(cores, chunks);
                         let what = format!("{name} {config:?} len={len}");
                         let bad = len / 2;
                         let session = Recorder {
@@ -64,7 +64,7 @@ fn a_kernel_that_panics_on_every_element_is_an_error_not_a_hang() {
     within(LIMIT, || {
         for &name in StrategyName::ALL {
             for (cores, chunks) in [(1, 1), (2, 7), (5, 64), (3, 1000)] {
-                let config = Config { cores, chunks };
+                let config = Config::new(cores, chunks);
                 let session = Recorder {
                     panic_everywhere_in: Some(0),
                     ..Recorder::new(200, 2, Outputs::Single)
@@ -108,7 +108,7 @@ fn a_session_that_panics_unwinds_out_of_run_without_hanging() {
     within(LIMIT, || {
         for &name in StrategyName::ALL {
             for cores in CORES {
-                let config = Config { cores, chunks: 7 };
+                let config = Config::new(cores, 7);
                 let outcome =
                     catch_unwind(AssertUnwindSafe(|| run(name, &config, PanickingSession)));
                 let payload = outcome.expect_err("the session's panic reaches the caller");

@@ -10,22 +10,10 @@ fn a_session_can_run_25_passes_on_one_executor() {
     within(LIMIT, || {
         for &name in StrategyName::ALL {
             for config in [
-                Config {
-                    cores: 1,
-                    chunks: 1,
-                },
-                Config {
-                    cores: 2,
-                    chunks: 7,
-                },
-                Config {
-                    cores: 3,
-                    chunks: 64,
-                },
-                Config {
-                    cores: 5,
-                    chunks: 1000,
-                },
+                Config::new(1, 1),
+                Config::new(2, 7),
+                Config::new(3, 64),
+                Config::new(5, 1000),
             ] {
                 for len in [0, 1, 500] {
                     let what = format!("{name} {config:?} len={len}");

@@ -31,7 +31,7 @@ pub fn for_each_grid_point(mut f: impl FnMut(StrategyName, Config, usize)) {
         for len in LENS {
             for cores in CORES {
                 for chunks in chunk_counts(len) {
-                    f(name, Config { cores, chunks }, len);
+                    f(name, Config::new(cores, chunks), len);
                 }
             }
         }
