@@ -93,8 +93,9 @@ impl CpuTicks {
     }
 }
 
-/// The CPUs this process may run on (its affinity mask, read once), or `None` if unknown.
-fn allowed_cpus() -> Option<&'static [usize]> {
+/// The CPUs this process may run on (its affinity mask, read once: later changes, such as
+/// pinning the main thread, do not show), ascending, or `None` if unknown.
+pub(crate) fn allowed_cpus() -> Option<&'static [usize]> {
     static CPUS: std::sync::OnceLock<Option<Vec<usize>>> = std::sync::OnceLock::new();
     CPUS.get_or_init(|| {
         let set = nix::sched::sched_getaffinity(nix::unistd::Pid::from_raw(0)).ok()?;

@@ -10,6 +10,8 @@
 //! - [`run`]: a run in one strategy session: the step loop timed (in segments, with an
 //!   observer between them), warm-up, fault injection; [`clock`], [`checksum`]: what a run
 //!   reports; [`contention`]: what the rest of the machine did meanwhile;
+//! - [`topology`]: the cores, SMT siblings, sockets, caches and frequency policy of the CPUs
+//!   the process may use (sysfs), and the orders worker threads would be pinned in;
 //! - [`limits`]: the documented range of every numeric option;
 //! - [`output`]: files written whole or not at all, output directories, a closable stdout;
 //! - [`plot`]: the bundled font shared by charts and animations;
@@ -40,6 +42,7 @@ pub mod simd;
 pub mod solver;
 pub mod sph;
 pub mod sweep;
+pub mod topology;
 pub mod trace;
 pub mod validate;
 #[cfg(feature = "viewer")]

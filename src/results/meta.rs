@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 use super::params::SweepParams;
 use super::shard::Shard;
 use super::stats::{CONFIDENCE, RESAMPLES};
+use crate::topology::Topology;
 
 /// The version of bench-sph that wrote the file.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
@@ -50,6 +51,10 @@ pub struct Machine {
     pub kernel: String,
     /// The CPU architecture bench-sph was built for.
     pub arch: String,
+    /// Cores, SMT siblings, sockets, caches and frequency policy of the CPUs the process
+    /// may use (unknown, `logical_cpus` 0, in files written before it was recorded).
+    #[serde(default)]
+    pub topology: Topology,
 }
 
 impl Machine {
@@ -68,6 +73,7 @@ impl Machine {
                 kernel
             },
             arch: std::env::consts::ARCH.to_owned(),
+            topology: Topology::detect(),
         }
     }
 }
@@ -353,6 +359,30 @@ mod tests {
         let m = Machine::detect();
         assert!(m.hardware_threads >= 1);
         assert!(!m.cpu_model.is_empty() && !m.os.is_empty() && !m.kernel.is_empty());
+    }
+
+    #[test]
+    fn a_meta_json_without_topology_still_loads_with_the_topology_unknown() {
+        let mut meta: serde_json::Value = serde_json::from_str(include_str!(
+            "../../tests/fixtures/report-results/meta.json"
+        ))
+        .unwrap();
+        // Whatever the fixture holds now, take the topology out as older files lack it.
+        meta["machine"].as_object_mut().unwrap().remove("topology");
+        for session in meta["sessions"].as_array_mut().unwrap() {
+            session["machine"]
+                .as_object_mut()
+                .unwrap()
+                .remove("topology");
+        }
+        let meta: Meta = serde_json::from_value(meta).unwrap();
+        assert_eq!(meta.machine.topology, Topology::default());
+        assert_eq!(meta.sessions[0].machine.topology, Topology::default());
+        assert!(meta.machine.hardware_threads >= 1);
+        // And a machine with its topology reads back the same.
+        let machine = Machine::detect();
+        let json = serde_json::to_string(&machine).unwrap();
+        assert_eq!(serde_json::from_str::<Machine>(&json).unwrap(), machine);
     }
 
     #[test]

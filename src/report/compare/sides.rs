@@ -147,6 +147,7 @@ pub(crate) mod tests {
             os: "Debian GNU/Linux 12 (bookworm)".to_owned(),
             kernel: "6.1.0".to_owned(),
             arch: "x86_64".to_owned(),
+            topology: Default::default(),
         };
         let session = Session::start(vec!["bench-sph".to_owned()], machine);
         let params = SweepParams {
