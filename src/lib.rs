@@ -13,6 +13,7 @@
 //! - [`topology`]: the cores, SMT siblings, sockets, caches and frequency policy of the CPUs
 //!   the process may use (sysfs), and the orders worker threads would be pinned in;
 //! - [`limits`]: the documented range of every numeric option;
+//! - [`placement`]: `--pin`, which logical CPUs a run's threads run on;
 //! - [`output`]: files written whole or not at all, output directories, a closable stdout;
 //! - [`plot`]: the bundled font shared by charts and animations;
 //! - [`render`]: animations of the dam break (GIF or PNG frames); `viewer` (cargo feature
@@ -32,6 +33,7 @@ pub mod io;
 pub mod limits;
 pub mod merge;
 pub mod output;
+pub mod placement;
 pub mod plot;
 pub mod render;
 pub mod report;

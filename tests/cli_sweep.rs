@@ -15,11 +15,11 @@ use common::{
 };
 
 const TRIAL_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
-    trial,wall_s,cpu_s,checksum,status,reason,foreign_cpu_s,steal_s,load1";
+    trial,wall_s,cpu_s,checksum,status,reason,foreign_cpu_s,steal_s,load1,pin";
 const SUMMARY_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
     trials,mean_s,stddev_s,min_s,median_s,max_s,cpu_mean_s,speedup,efficiency,outliers,\
     oversubscribed,checksum,status,reason,mean_ci_low_s,mean_ci_high_s,speedup_ci_low,\
-    speedup_ci_high,foreign_cpu_mean_s,contended,reference_shard";
+    speedup_ci_high,foreign_cpu_mean_s,contended,reference_shard,pin,smt";
 
 /// A tiny sweep: 1 seq cell + 3 strategies × 2 cores + 2 strategies × 2 cores × 2 chunks = 15.
 const TINY: &[&str] = &[

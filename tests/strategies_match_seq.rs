@@ -1,6 +1,6 @@
-//! Every strategy gives the sequential run's bits, whatever the cores, chunks and SIMD path
-//! (the portable path's sequential run is the reference), and a panic inside a kernel becomes
-//! an error of the run (never a hang) on every strategy.
+//! Every strategy gives the sequential run's bits, whatever the cores, chunks, SIMD path and
+//! thread placement (`--pin`) (the portable path's unpinned sequential run is the reference),
+//! and a panic inside a kernel becomes an error of the run (never a hang) on every strategy.
 
 use std::time::Duration;
 
@@ -68,6 +68,34 @@ fn every_strategy_cores_and_chunks_gives_the_bits_of_the_sequential_run() {
                                      chunks={chunks}: {diff}"
                                 );
                             }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn every_strategy_pinned_compact_or_spread_gives_the_bits_of_the_unpinned_sequential_run() {
+    use bench_sph::placement::placement;
+    use bench_sph::topology::Pin;
+    for preset in Preset::ALL {
+        for mode in NeighborMode::ALL {
+            let reference = run(preset, mode, SimdPath::Portable, StrategyName::Seq, 1, 1);
+            for pin in [Pin::Compact, Pin::Spread] {
+                let placed = placement(pin).expect("this machine accepts its own CPUs");
+                for &strategy in StrategyName::ALL {
+                    // More threads than CPUs too: worker i goes to CPU i mod the order's length.
+                    for cores in [1, 2, 3] {
+                        let scene = Scene::dam_break(preset, N, 7).unwrap();
+                        let mut sim = scene.simulate(mode);
+                        let config = Config::new(cores, 7).placed(placed);
+                        run_timed(&mut sim, strategy, &config, STEPS).unwrap_or_else(|e| {
+                            panic!("{preset} {mode} --pin {pin} {strategy} cores={cores}: {e}")
+                        });
+                        if let Some(diff) = first_bit_difference(&sim.state, &reference) {
+                            panic!("{preset} {mode} --pin {pin} {strategy} cores={cores}: {diff}");
                         }
                     }
                 }

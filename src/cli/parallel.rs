@@ -5,6 +5,8 @@
 use clap::{Arg, Args};
 use sph_strategies::{Config, StrategyName};
 
+use crate::topology::Pin;
+
 /// Which strategy runs the passes, on how many threads, in how many chunks.
 #[derive(Debug, Clone, Args)]
 pub struct ParallelArgs {
@@ -17,6 +19,11 @@ pub struct ParallelArgs {
     /// Chunks per pass, for strategies that use chunks.
     #[arg(long, default_value_t = 10, value_parser = super::chunks)]
     pub chunks: usize,
+    /// Where the threads run: none (the operating system decides), compact (fill each physical
+    /// core's SMT siblings first) or spread (one thread per physical core first). The calling
+    /// thread is pinned too; a CPU the operating system refuses is an error.
+    #[arg(long, default_value = "none", value_parser = super::values::pin())]
+    pub pin: Pin,
 }
 
 /// Gives `--strategy` the help text `help` (for `Command::mut_args`, which edits the option
@@ -43,12 +50,13 @@ pub(super) fn strategy_required(help: &'static str) -> impl FnMut(Arg) -> Arg {
 }
 
 impl ParallelArgs {
-    /// The strategy's configuration: `--cores` (default: the machine's hardware threads)
-    /// and `--chunks`.
-    pub fn config(&self) -> Config {
-        Config::new(
+    /// The strategy's configuration: `--cores` (default: the machine's hardware threads),
+    /// `--chunks` and `--pin` (an error if the operating system refuses one of its CPUs).
+    pub fn config(&self) -> anyhow::Result<Config> {
+        let config = Config::new(
             self.cores.unwrap_or_else(super::hardware_threads),
             self.chunks,
-        )
+        );
+        Ok(config.placed(crate::placement::placement(self.pin)?))
     }
 }

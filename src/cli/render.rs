@@ -108,7 +108,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
     // Particles that move: what a step costs (wcsph's walls are fixed).
     let fluid = scene.fluid();
     let bar = progress_bar(args, &scene.physics, fluid);
-    let config = args.parallel.config();
+    let config = args.parallel.config()?;
     let mut sim = scene.simulate(args.scene.neighbors);
     let started = std::time::Instant::now();
 

@@ -17,6 +17,7 @@ use crate::simd::SimdPath;
 use crate::solver::{Simulation, StepError};
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
+use crate::topology::Pin;
 
 /// Options of `simulate`.
 #[derive(Debug, Clone, Args)]
@@ -70,6 +71,7 @@ struct Report {
     particle_steps_per_s: f64,
     checksum: String,
     simd: SimdPath,
+    pin: Pin,
 }
 
 /// Runs `simulate`.
@@ -85,7 +87,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     // temporary file and renamed over FILE at the end: a failed or interrupted run leaves
     // FILE as it was.
     let mut dump = args.dump.as_deref().map(Sink::create).transpose()?;
-    let config = args.parallel.config();
+    let config = args.parallel.config()?;
     let mut sim = scene.simulate(args.scene.neighbors);
     let steps = match args.t_end {
         None => Steps::timed(args.steps),
@@ -144,6 +146,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         particle_steps_per_s: (n * sim.steps_done) as f64 / elapsed.wall_s,
         checksum: checksum_hex(&sim.state),
         simd: sim.simd(),
+        pin: args.parallel.pin,
     };
     print_report(&report, args.json)
 }
@@ -171,8 +174,8 @@ fn print_report(r: &Report, json: bool) -> anyhow::Result<()> {
     }
     let chunks = r.chunks.map_or_else(|| "n/a".to_owned(), |c| c.to_string());
     say(&format!(
-        "preset {}, {} neighbours, strategy {} (cores {}, chunks {chunks}), simd {}",
-        r.preset, r.neighbors, r.strategy, r.cores, r.simd
+        "preset {}, {} neighbours, strategy {} (cores {}, chunks {chunks}), simd {}, pin {}",
+        r.preset, r.neighbors, r.strategy, r.cores, r.simd, r.pin
     ))?;
     let walls = r
         .walls

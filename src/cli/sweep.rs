@@ -12,6 +12,7 @@ use crate::sph::params::Preset;
 use crate::sweep::params::SweepParams;
 use crate::sweep::range::{self, Axis};
 use crate::sweep::{Request, Target};
+use crate::topology::Pin;
 
 /// `--quick`: chunks, steps and trials of the README's first command.
 const QUICK_CHUNKS: &str = "10,45,90";
@@ -25,7 +26,7 @@ const QUICK_TRIALS: usize = 3;
 ///
 /// Not an `ArgGroup` that conflicts with `--resume`: clap's error for `--resume DIR --n 5`
 /// would then list every member of the group instead of naming `--n`.
-const NEW_SWEEP_ONLY: [&str; 16] = [
+const NEW_SWEEP_ONLY: [&str; 17] = [
     "cores",
     "chunks",
     "strategies",
@@ -42,6 +43,7 @@ const NEW_SWEEP_ONLY: [&str; 16] = [
     "fake_timings",
     "fake_contention",
     "shard",
+    "pin",
 ];
 
 /// Makes each of [`NEW_SWEEP_ONLY`] conflict with `--resume` (in place, keeping clap's order).
@@ -101,6 +103,11 @@ pub struct SweepArgs {
     /// directory.
     #[arg(long)]
     pub force: bool,
+    /// Thread placements to measure, comma-separated: none (the operating system decides),
+    /// compact (SMT siblings of one core first), spread (one thread per physical core
+    /// first). Each is a cell of every strategy but seq, which runs unpinned.
+    #[arg(long, value_name = "LIST", value_delimiter = ',', default_value = "none", value_parser = super::values::pin())]
+    pub pin: Vec<Pin>,
     /// Run only shard I of K of the plan (1 ≤ I ≤ K ≤ 1024), e.g. one node of a batch job:
     /// the plan's cells other than seq, dealt round-robin, plus the seq cell of every group
     /// it touches. Merge the K directories with `bench-sph merge`; the report comes after.
@@ -168,6 +175,12 @@ impl SweepArgs {
             simd: Some(crate::simd::current()),
             fake_timings: self.fake_timings.clone(),
             fake_contention: self.fake_contention.clone(),
+            pin: {
+                let mut pins = self.pin.clone();
+                pins.sort();
+                pins.dedup();
+                pins
+            },
             shard: self.shard,
         })
     }

@@ -15,6 +15,7 @@ use crate::output::claim::{self, Claimed, Owner};
 use crate::output::console;
 use crate::simd::SimdPath;
 use crate::solver::Simulation;
+use crate::topology::Pin;
 use crate::trace::files::{self, TOOL};
 use crate::trace::size::{self, Plan};
 use crate::trace::stats::{self, Stats};
@@ -71,6 +72,7 @@ struct Meta<'a> {
     checksum: String,
     timeline_steps: [usize; 2],
     simd: SimdPath,
+    pin: Pin,
 }
 
 /// Minimum and median of untraced and traced wall times.
@@ -87,7 +89,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
     if let Some(note) = args.scene.resolution_note() {
         console::warn(&note);
     }
-    let strategy_config = args.parallel.config();
+    let strategy_config = args.parallel.config()?;
     let cores = strategy_config.cores;
     Plan {
         strategy: args.parallel.strategy,
@@ -123,6 +125,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
         checksum: checksum_hex(&sim.state),
         timeline_steps: [args.steps + 1 - shown, args.steps],
         simd: sim.simd(),
+        pin: args.parallel.pin,
     };
     write_files(&paths, &run, &stats, &meta)?;
     let removed = claimed.remove_stale(&paths)?;

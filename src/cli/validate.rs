@@ -40,7 +40,7 @@ pub struct ValidateArgs {
 /// the failed verdicts, if any.
 pub fn run(args: &ValidateArgs) -> anyhow::Result<()> {
     let (claimed, paths) = claim_out(args)?;
-    let config = args.parallel.config();
+    let config = args.parallel.config()?;
     let v = validate::validate(args.resolution, args.parallel.strategy, &config)?;
     write_files(&paths, &v)?;
     claimed.remove_stale(&paths)?;

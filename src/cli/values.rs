@@ -13,6 +13,7 @@ use crate::render::scale::ColorBy;
 use crate::simd::SimdPath;
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
+use crate::topology::Pin;
 
 /// `--preset`'s values.
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -74,6 +75,27 @@ impl From<SimdArg> for SimdPath {
     }
 }
 
+/// `--pin`'s values.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum PinArg {
+    /// The operating system places the threads (the default, as the paper measured).
+    None,
+    /// Fill the SMT siblings of one physical core before the next core.
+    Compact,
+    /// One thread per physical core first; SMT siblings only after every core has one.
+    Spread,
+}
+
+impl From<PinArg> for Pin {
+    fn from(arg: PinArg) -> Pin {
+        match arg {
+            PinArg::None => Pin::None,
+            PinArg::Compact => Pin::Compact,
+            PinArg::Spread => Pin::Spread,
+        }
+    }
+}
+
 /// `--color`'s values.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum ColorArg {
@@ -105,6 +127,11 @@ pub(super) fn neighbors() -> impl TypedValueParser<Value = NeighborMode> {
 /// Parses a [`SimdPath`] by its command-line name, listing the paths in `--help`.
 pub(super) fn simd() -> impl TypedValueParser<Value = SimdPath> {
     EnumValueParser::<SimdArg>::new().map(SimdPath::from)
+}
+
+/// Parses a [`Pin`] by its command-line name, listing the placements in `--help`.
+pub(super) fn pin() -> impl TypedValueParser<Value = Pin> {
+    EnumValueParser::<PinArg>::new().map(Pin::from)
 }
 
 /// Parses a [`ColorBy`] by its command-line name, listing the quantities in `--help`.
@@ -169,6 +196,7 @@ mod tests {
             names::<NeighborsArg, NeighborMode>(),
             names::<ColorArg, ColorBy>(),
             names::<SimdArg, SimdPath>(),
+            names::<PinArg, Pin>(),
         ];
         for (cli, domain) in all.iter().flatten() {
             assert_eq!(cli, domain);
@@ -184,5 +212,6 @@ mod tests {
         );
         assert_eq!(ColorArg::value_variants().len(), ColorBy::ALL.len());
         assert_eq!(SimdArg::value_variants().len(), SimdPath::ALL.len());
+        assert_eq!(PinArg::value_variants().len(), Pin::ALL.len());
     }
 }

@@ -57,7 +57,7 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<()> {
         seed: args.seed,
         neighbors: args.neighbors,
         strategy: args.parallel.strategy,
-        config: args.parallel.config(),
+        config: args.parallel.config()?,
         every: args.every,
         color: args.color,
         width: args.width,

@@ -169,6 +169,7 @@ mod tests {
             simd: None,
             fake_timings: None,
             fake_contention: None,
+            pin: vec![crate::topology::Pin::None],
             shard: None,
         }
     }
@@ -209,6 +210,7 @@ mod tests {
                     foreign_cpu_s: None,
                     steal_s: None,
                     load1: None,
+                    pin: r.pin,
                 })
             })
             .collect();

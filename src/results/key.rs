@@ -8,6 +8,8 @@
 
 use sph_strategies::{Config, StrategyName};
 
+use crate::topology::Pin;
+
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
 
@@ -70,6 +72,8 @@ pub struct Cell {
     pub cores: usize,
     /// Requested chunks per pass; `None` for strategies without a chunks parameter.
     pub chunks: Option<usize>,
+    /// Where its threads run (`--pin`; [`Pin::None`], the operating system, for `seq`).
+    pub pin: Pin,
 }
 
 impl Cell {
@@ -83,6 +87,7 @@ impl Cell {
             strategy: StrategyName::Seq,
             cores: info.effective_cores(1),
             chunks: info.effective_chunks(1),
+            pin: Pin::None,
         }
     }
 
@@ -91,7 +96,8 @@ impl Cell {
         self.strategy == StrategyName::Seq
     }
 
-    /// The strategy configuration (strategies without chunks ignore `chunks`).
+    /// The strategy configuration (strategies without chunks ignore `chunks`), its threads
+    /// placed by the operating system: the runner places them as `pin` says.
     pub fn config(&self) -> Config {
         Config::new(self.cores, self.chunks.unwrap_or(1))
     }
@@ -110,12 +116,17 @@ impl Cell {
 
     /// The text that seeds the cell's bootstrap streams (the sweep's `bootstrap::rng_for`),
     /// frozen so that a display change never changes a results file (`rayon-chunks, 2 cores,
-    /// 10 chunks`, `seq, 1 core`).
+    /// 10 chunks`, `seq, 1 core`, `std-static, 4 cores, pin spread`; unpinned cells keep the
+    /// text they had before `--pin` existed).
     pub fn stream_key(&self) -> String {
         let cores = if self.cores == 1 { "core" } else { "cores" };
-        match self.chunks {
+        let unpinned = match self.chunks {
             Some(k) => format!("{}, {} {cores}, {k} chunks", self.strategy, self.cores),
             None => format!("{}, {} {cores}", self.strategy, self.cores),
+        };
+        match self.pin {
+            Pin::None => unpinned,
+            pin => format!("{unpinned}, pin {pin}"),
         }
     }
 
@@ -169,11 +180,20 @@ mod tests {
             strategy: StrategyName::RayonChunks,
             cores: 2,
             chunks: Some(10),
+            pin: Pin::None,
         };
         assert_eq!(
             cell.label_with_group(),
             "rayon-chunks, 2 cores, 10 chunks (preset seed, all-pairs, N = 1000, 1 step)"
         );
         assert!(!cell.is_reference());
+        let spread = Cell {
+            pin: Pin::Spread,
+            ..cell
+        };
+        assert_eq!(
+            spread.label(),
+            "rayon-chunks, 2 cores, 10 chunks, pin spread"
+        );
     }
 }

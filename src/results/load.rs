@@ -25,8 +25,8 @@ use super::files::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
 use super::key::Cell;
 use super::meta::Meta;
 use super::rows::{
-    LEGACY_SUMMARY_COLUMNS, LEGACY_TRIAL_COLUMNS, SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS,
-    TrialRow, UNSHARDED_SUMMARY_COLUMNS,
+    EARLIER_SUMMARY_WIDTHS, EARLIER_TRIAL_WIDTHS, LEGACY_SUMMARY_COLUMNS, LEGACY_TRIAL_COLUMNS,
+    SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow,
 };
 use super::validate;
 
@@ -145,18 +145,19 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
 /// Reads a `summary.csv` (this version's columns or the first release's): its rows, and a
 /// note for each line that is not one.
 pub fn read_summary(path: &Path) -> anyhow::Result<(Vec<SummaryRow>, Vec<String>)> {
-    read_csv(
-        path,
-        &SUMMARY_COLUMNS,
-        &[LEGACY_SUMMARY_COLUMNS, UNSHARDED_SUMMARY_COLUMNS],
-        "summary",
-    )
+    let widths = [
+        LEGACY_SUMMARY_COLUMNS,
+        EARLIER_SUMMARY_WIDTHS[0],
+        EARLIER_SUMMARY_WIDTHS[1],
+    ];
+    read_csv(path, &SUMMARY_COLUMNS, &widths, "summary")
 }
 
 /// Reads a `trials.csv` (this version's columns or the first release's), as
 /// [`read_summary`].
 pub fn read_trials(path: &Path) -> anyhow::Result<(Vec<TrialRow>, Vec<String>)> {
-    read_csv(path, &TRIAL_COLUMNS, &[LEGACY_TRIAL_COLUMNS], "trial")
+    let widths = [LEGACY_TRIAL_COLUMNS, EARLIER_TRIAL_WIDTHS[0]];
+    read_csv(path, &TRIAL_COLUMNS, &widths, "trial")
 }
 
 /// The rows of a results CSV whose header is `columns` or the first `w` of them for a width `w`

@@ -9,6 +9,7 @@ use super::shard::Shard;
 use crate::simd::SimdPath;
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
+use crate::topology::Pin;
 
 /// The parameters of a sweep, after parsing and expansion: the lists are sorted and free of
 /// repeats, so two sweeps with equal parameters have the same plan.
@@ -41,6 +42,10 @@ pub struct SweepParams {
     /// directories written before it was recorded. `--resume` runs the recorded path.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub simd: Option<SimdPath>,
+    /// Thread placements (`--pin`), each a cell dimension of every strategy but the `seq`
+    /// reference (which runs unpinned); `["none"]` in directories written before `--pin`.
+    #[serde(default = "unpinned")]
+    pub pin: Vec<Pin>,
     /// Which part of the plan this sweep runs (`--shard I/K`); absent for the whole plan.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shard: Option<Shard>,
@@ -50,6 +55,11 @@ pub struct SweepParams {
     /// Test only: foreign-CPU shares replacing the measured ones (see [`crate::sweep::timing`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fake_contention: Option<String>,
+}
+
+/// `--pin`'s default, and what sweeps written before it ran: the operating system's placement.
+fn unpinned() -> Vec<Pin> {
+    vec![Pin::None]
 }
 
 impl SweepParams {

@@ -22,9 +22,10 @@ use sph_strategies::StrategyName;
 use super::key::{Cell, Group};
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
+use crate::topology::Pin;
 
 /// The columns of `trials.csv`, in order.
-pub const TRIAL_COLUMNS: [&str; 17] = [
+pub const TRIAL_COLUMNS: [&str; 18] = [
     "strategy",
     "neighbors",
     "preset",
@@ -42,10 +43,11 @@ pub const TRIAL_COLUMNS: [&str; 17] = [
     "foreign_cpu_s",
     "steal_s",
     "load1",
+    "pin",
 ];
 
 /// The columns of `summary.csv`, in order.
-pub const SUMMARY_COLUMNS: [&str; 29] = [
+pub const SUMMARY_COLUMNS: [&str; 31] = [
     "strategy",
     "neighbors",
     "preset",
@@ -75,6 +77,8 @@ pub const SUMMARY_COLUMNS: [&str; 29] = [
     "foreign_cpu_mean_s",
     "contended",
     "reference_shard",
+    "pin",
+    "smt",
 ];
 
 /// How many leading columns of each file bench-sph 0.1.0 wrote before the contention and
@@ -82,9 +86,12 @@ pub const SUMMARY_COLUMNS: [&str; 29] = [
 pub const LEGACY_TRIAL_COLUMNS: usize = 14;
 /// See [`LEGACY_TRIAL_COLUMNS`].
 pub const LEGACY_SUMMARY_COLUMNS: usize = 22;
-/// The columns of `summary.csv` before `reference_shard` was appended (bench-sph 0.1.0 with
-/// the contention and interval columns): read as they are, and upgraded by `--resume`.
-pub const UNSHARDED_SUMMARY_COLUMNS: usize = 28;
+/// The widths of `summary.csv` that earlier versions wrote after the first release: before
+/// `reference_shard` (28) and before `pin` and `smt` (29). Read as they are (the missing
+/// columns empty), and upgraded to every column by `--resume`.
+pub const EARLIER_SUMMARY_WIDTHS: [usize; 2] = [28, 29];
+/// The width of `trials.csv` before `pin` (17): read as it is, upgraded by `--resume`.
+pub const EARLIER_TRIAL_WIDTHS: [usize; 1] = [17];
 
 /// Whether a cell's numbers can be used.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -139,6 +146,10 @@ pub struct TrialRow {
     /// The 1-minute load average when the trial started.
     #[serde(default)]
     pub load1: Option<f64>,
+    /// Where the cell's threads ran (`none`: wherever the operating system put them; empty in
+    /// files written before `--pin`, read as `none`).
+    #[serde(default, deserialize_with = "pin_or_none")]
+    pub pin: Pin,
 }
 
 /// One row of `summary.csv`: one cell. Its first columns repeat [`TrialRow`]'s cell key on
@@ -214,6 +225,22 @@ pub struct SummaryRow {
     /// measured it (empty in an unsharded sweep).
     #[serde(default)]
     pub reference_shard: Option<usize>,
+    /// Where the cell's threads ran (as in `trials.csv`).
+    #[serde(default, deserialize_with = "pin_or_none")]
+    pub pin: Pin,
+    /// Whether the cell put threads on SMT siblings: more threads than physical cores, no more
+    /// than hardware threads (empty where the topology is unknown).
+    #[serde(default)]
+    pub smt: Option<bool>,
+}
+
+/// A `pin` field: a placement name, or empty (files written before `--pin`) for `none`.
+fn pin_or_none<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Pin, D::Error> {
+    let text = String::deserialize(d)?;
+    if text.is_empty() {
+        return Ok(Pin::None);
+    }
+    text.parse().map_err(serde::de::Error::custom)
 }
 
 /// The columns that name a row's cell, shared by both files.
@@ -237,6 +264,7 @@ macro_rules! keyed {
                     strategy: self.strategy,
                     cores: self.cores,
                     chunks: self.chunks,
+                    pin: self.pin,
                 }
             }
         }
@@ -333,6 +361,8 @@ pub(crate) mod tests {
             foreign_cpu_mean_s: Some(0.0),
             contended: Some(false),
             reference_shard: None,
+            pin: Pin::None,
+            smt: Some(false),
         }
     }
 

@@ -195,6 +195,7 @@ mod tests {
             strategy: StrategyName::RayonChunks,
             cores: 2,
             chunks: Some(4),
+            pin: crate::topology::Pin::None,
         };
         let measured: Vec<Measured> = [0.5, 0.6, 0.7]
             .iter()

@@ -14,6 +14,7 @@ use std::ops::ControlFlow;
 use sph_strategies::{Config, Executor, Session, StrategyName};
 
 use crate::clock::{Elapsed, Stopwatch};
+use crate::placement::Pinned;
 use crate::solver::{Simulation, StepError, StepHooks};
 
 /// Why a run failed.
@@ -30,6 +31,9 @@ pub enum RunError {
     /// A step failed.
     #[error(transparent)]
     Step(#[from] StepError),
+    /// The run's threads could not be placed as `--pin` asked (see [`crate::placement`]).
+    #[error("{0:#}")]
+    Placement(anyhow::Error),
 }
 
 /// How a run lays out its steps.
@@ -131,7 +135,8 @@ impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
 }
 
 /// Runs `steps` of `sim` in one session of `strategy`, each phase and check through `hooks`,
-/// showing the simulation to `observer` after every segment.
+/// showing the simulation to `observer` after every segment. With a placement other than the
+/// operating system's, the calling thread is pinned for the run too ([`Pinned`]).
 pub fn run_steps<H: StepHooks + Send, O: Observer>(
     sim: &mut Simulation,
     strategy: StrategyName,
@@ -146,8 +151,10 @@ pub fn run_steps<H: StepHooks + Send, O: Observer>(
         hooks,
         observer,
     };
+    let pinned = Pinned::caller(config.placement).map_err(RunError::Placement)?;
     let result = sph_strategies::run(strategy, config, session)
         .map_err(|source| RunError::Build { strategy, source })?;
+    pinned.finish().map_err(RunError::Placement)?;
     Ok(result?)
 }
 

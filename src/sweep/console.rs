@@ -54,6 +54,44 @@ pub fn oversubscribed(plan: &Plan, hardware_threads: usize) -> (usize, Vec<usize
     (cells.len(), cores)
 }
 
+/// What the plan's cores mean on this machine's topology, and the placements measured:
+/// `None` when there is nothing to say (no SMT sibling used, placement by the OS only).
+pub fn placement_note(
+    params: &SweepParams,
+    topology: &crate::topology::Topology,
+) -> Option<String> {
+    use crate::topology::Pin;
+    let mut lines = Vec::new();
+    if params.pin != [Pin::None] {
+        let names: Vec<&str> = params.pin.iter().map(|p| p.as_str()).collect();
+        lines.push(format!(
+            "  placements: {} (each a cell; seq, the reference, runs unpinned)",
+            names.join(", ")
+        ));
+    }
+    let widest = params.cores.iter().copied().max().unwrap_or(1);
+    if let (Some(physical), Some(split)) = (topology.physical_cores, topology.split(widest))
+        && split.siblings > 0
+    {
+        let smt: Vec<String> = params
+            .cores
+            .iter()
+            .filter(|&&c| topology.is_smt(c) == Some(true))
+            .map(|c| c.to_string())
+            .collect();
+        lines.push(format!(
+            "  this machine has {physical} physical cores and {} hardware threads: cores {} use \
+             SMT siblings (smt=true in summary.csv); at {widest} cores, spread puts {} threads on \
+             physical cores and {} on siblings",
+            topology.logical_cpus,
+            smt.join(", "),
+            split.physical,
+            split.siblings
+        ));
+    }
+    (!lines.is_empty()).then(|| lines.join("\n"))
+}
+
 /// The warning printed when some cells ask for more threads than the machine has.
 pub fn oversubscription_warning(plan: &Plan, hardware_threads: usize) -> Option<String> {
     let (count, cores) = oversubscribed(plan, hardware_threads);
@@ -240,6 +278,7 @@ mod tests {
             simd: None,
             fake_timings: None,
             fake_contention: None,
+            pin: vec![crate::topology::Pin::None],
             shard: None,
         })
     }

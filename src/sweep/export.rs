@@ -77,6 +77,7 @@ mod tests {
             strategy: StrategyName::RayonChunks,
             cores: 2,
             chunks: Some(5),
+            pin: crate::topology::Pin::None,
         }
     }
 
@@ -130,8 +131,8 @@ mod tests {
             String::from_utf8(t).unwrap(),
             format!(
                 "{}\n\
-                 rayon-chunks,grid,seed,60,3,2,5,12,1,0.5,1.0,0123456789abcdef,ok,,0.01,0.0,0.5\n\
-                 rayon-chunks,grid,seed,60,3,2,5,12,2,0.25,0.5,0123456789abcdef,ok,,0.01,0.0,0.5\n",
+                 rayon-chunks,grid,seed,60,3,2,5,12,1,0.5,1.0,0123456789abcdef,ok,,0.01,0.0,0.5,none\n\
+                 rayon-chunks,grid,seed,60,3,2,5,12,2,0.25,0.5,0123456789abcdef,ok,,0.01,0.0,0.5,none\n",
                 TRIAL_COLUMNS.join(",")
             )
         );
@@ -143,7 +144,7 @@ mod tests {
             format!(
                 "{}\n\
                  rayon-chunks,grid,seed,60,3,2,5,12,2,0.375,{},0.25,0.375,0.5,0.75,2.0,1.0,0,\
-                 false,0123456789abcdef,ok,,0.25,0.5,1.5,3.0,0.01,false,\n",
+                 false,0123456789abcdef,ok,,0.25,0.5,1.5,3.0,0.01,false,,none,\n",
                 SUMMARY_COLUMNS.join(","),
                 0.03125f64.sqrt()
             )

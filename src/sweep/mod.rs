@@ -139,6 +139,10 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
         params.fake_timings.as_deref(),
         params.fake_contention.as_deref(),
     )?;
+    // A placement the operating system refuses stops the sweep before anything runs.
+    for &pin in &params.pin {
+        crate::placement::placement(pin).context("cannot place the sweep's threads")?;
+    }
     let plan = Plan::new(&params);
     let threshold = Threshold {
         hardware_threads,
@@ -500,10 +504,11 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
     for why in &repaired.rejected {
         console_warn(&format!("warning: dropped, will run again: {why}"));
     }
-    if repaired.upgraded_summary {
+    if repaired.upgraded {
         print(&format!(
-            "Upgraded '{}': appended the reference_shard column (empty: not a shard)",
-            dir.join(SUMMARY_FILE).display()
+            "Upgraded '{}': its CSV files were written by an earlier version; the columns it \
+             lacked (reference_shard, pin, smt) are appended, empty (pin empty = none)",
+            dir.display()
         ));
     }
     print(&format!(
@@ -610,6 +615,9 @@ fn print_plan(
     print(&text);
     if let Some(note) = console::resolution_note(params) {
         console_warn(&note);
+    }
+    if let Some(note) = console::placement_note(params, crate::placement::machine_topology()) {
+        print(&note);
     }
     if let Some(warning) = console::oversubscription_warning(plan, hardware_threads) {
         console_warn(&warning);

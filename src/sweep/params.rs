@@ -21,8 +21,12 @@ impl SweepParams {
             }
             Ok(())
         }
-        if self.strategies.is_empty() || self.presets.is_empty() || self.neighbors.is_empty() {
-            anyhow::bail!("strategies, presets and neighbors must each name at least one");
+        if self.strategies.is_empty()
+            || self.presets.is_empty()
+            || self.neighbors.is_empty()
+            || self.pin.is_empty()
+        {
+            anyhow::bail!("strategies, presets, neighbors and pin must each name at least one");
         }
         list("cores", &self.cores, limits::MAX_CORES)?;
         list("chunks", &self.chunks, limits::MAX_CHUNKS)?;
@@ -37,13 +41,14 @@ impl SweepParams {
             self.strategies.len(),
             self.cores.len(),
             self.chunks.len(),
+            self.pin.len(),
         ];
         let cells = lists.iter().try_fold(1usize, |a, &b| a.checked_mul(b));
         match cells {
             Some(c) if c <= limits::MAX_CELLS => {}
             _ => anyhow::bail!(
                 "the sweep would have more than {} cells (presets × neighbors × n × strategies \
-                 × cores × chunks); split it into smaller sweeps",
+                 × cores × chunks × pin); split it into smaller sweeps",
                 limits::MAX_CELLS
             ),
         }
@@ -92,6 +97,7 @@ mod tests {
             simd: None,
             fake_timings: None,
             fake_contention: None,
+            pin: vec![crate::topology::Pin::None],
             shard: None,
         }
     }

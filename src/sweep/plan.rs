@@ -7,7 +7,8 @@
 //! 1 core, measured whatever `--strategies` says: its mean is the denominator of speedup and
 //! its first run's checksum the one every other run of the group must reproduce. Then, for each
 //! other strategy in registry order and each cores value, one cell per chunks value for the
-//! strategies that use chunks, and one cell (chunks empty) for those that do not.
+//! strategies that use chunks, and one cell (chunks empty) for those that do not; each of those
+//! once per `--pin` placement, side by side (the reference runs unpinned).
 //!
 //! A **shard** I/K of the plan ([`Plan::shard`], `sweep --shard I/K`) runs the plan's
 //! non-reference cells whose position among them is ≡ I−1 (mod K), dealt round-robin in plan
@@ -72,16 +73,19 @@ impl Plan {
                 .filter(|&&s| s != StrategyName::Seq)
             {
                 for &cores in &params.cores {
-                    let cell = |chunks| Cell {
-                        group,
-                        strategy,
-                        cores,
-                        chunks,
-                    };
-                    if strategy.info().uses_chunks() {
-                        cells.extend(params.chunks.iter().map(|&k| cell(Some(k))));
+                    let chunks: Vec<Option<usize>> = if strategy.info().uses_chunks() {
+                        params.chunks.iter().map(|&k| Some(k)).collect()
                     } else {
-                        cells.push(cell(None));
+                        vec![None]
+                    };
+                    for chunks in chunks {
+                        cells.extend(params.pin.iter().map(|&pin| Cell {
+                            group,
+                            strategy,
+                            cores,
+                            chunks,
+                            pin,
+                        }));
                     }
                 }
             }
@@ -175,6 +179,7 @@ mod tests {
             simd: None,
             fake_timings: None,
             fake_contention: None,
+            pin: vec![crate::topology::Pin::None],
             shard: None,
         }
     }
@@ -284,6 +289,7 @@ mod tests {
             strategy: StrategyName::RayonChunks,
             cores: 2,
             chunks,
+            pin: crate::topology::Pin::None,
         };
         assert_eq!(cell(Some(10)).particles_per_chunk(), Some(100));
         assert_eq!(cell(Some(333)).particles_per_chunk(), Some(4));

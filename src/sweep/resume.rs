@@ -21,7 +21,8 @@ use anyhow::Context;
 use super::export::to_csv;
 use super::plan::Cell;
 use crate::results::rows::{
-    SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow, UNSHARDED_SUMMARY_COLUMNS,
+    EARLIER_SUMMARY_WIDTHS, EARLIER_TRIAL_WIDTHS, SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS,
+    TrialRow,
 };
 
 /// A results file whose header is not this version's.
@@ -56,9 +57,9 @@ pub struct Repaired {
     pub dropped_trial_rows: usize,
     /// Summary rows (or broken lines) dropped from `summary.csv`.
     pub dropped_summary_rows: usize,
-    /// Whether `summary.csv` had the columns of the version before `reference_shard` (its
-    /// repaired contents have every column: the upgrade).
-    pub upgraded_summary: bool,
+    /// Whether a file had the columns of an earlier version (`reference_shard`, `pin` or `smt`
+    /// missing): its repaired contents have every column, those empty (the upgrade).
+    pub upgraded: bool,
 }
 
 /// Repairs the contents of `trials.csv` and `summary.csv` (either may be empty: no file);
@@ -70,14 +71,14 @@ pub fn repair(
     summary: &[u8],
     check: &dyn Fn(&SummaryRow) -> Result<(), String>,
 ) -> Result<Repaired, UnexpectedColumns> {
-    let (summary_rows, mut dropped_summary_rows, older) = read_rows::<SummaryRow>(
+    let (summary_rows, mut dropped_summary_rows, older_summary) = read_rows::<SummaryRow>(
         summary,
         "summary.csv",
         &SUMMARY_COLUMNS,
-        Some(UNSHARDED_SUMMARY_COLUMNS),
+        &EARLIER_SUMMARY_WIDTHS,
     )?;
-    let (trial_rows, mut dropped_trial_rows, _) =
-        read_rows::<TrialRow>(trials, "trials.csv", &TRIAL_COLUMNS, None)?;
+    let (trial_rows, mut dropped_trial_rows, older_trials) =
+        read_rows::<TrialRow>(trials, "trials.csv", &TRIAL_COLUMNS, &EARLIER_TRIAL_WIDTHS)?;
 
     // The first summary row of each cell; the trial rows of each cell, once per number.
     let mut seen = HashSet::new();
@@ -136,18 +137,19 @@ pub fn repair(
         rejected,
         dropped_trial_rows,
         dropped_summary_rows,
-        upgraded_summary: older,
+        upgraded: older_summary || older_trials,
     })
 }
 
 /// The complete rows of a CSV file, the number of lines that were not (a last line without
 /// its newline, cut off by a kill, or a row that does not parse), and whether its header was
-/// the first `older` of `columns` (an earlier version's file, whose missing columns are empty).
+/// the first `w` of `columns` for a width `w` of `older` (an earlier version's file, whose
+/// missing columns are empty).
 fn read_rows<R: serde::de::DeserializeOwned>(
     bytes: &[u8],
     file: &'static str,
     columns: &[&str],
-    older: Option<usize>,
+    older: &[usize],
 ) -> Result<(Vec<R>, usize, bool), UnexpectedColumns> {
     let complete = match bytes.iter().rposition(|&b| b == b'\n') {
         Some(last) => &bytes[..=last],
@@ -164,7 +166,7 @@ fn read_rows<R: serde::de::DeserializeOwned>(
     let header = reader
         .headers()
         .map(|h| h.iter().collect::<Vec<_>>().join(","));
-    let is_older = |h: &str| older.is_some_and(|w| h == columns[..w].join(","));
+    let is_older = |h: &str| older.iter().any(|&w| h == columns[..w].join(","));
     let upgraded = match header {
         Ok(h) if h == columns.join(",") => false,
         Ok(h) if is_older(&h) => true,
@@ -232,6 +234,7 @@ mod tests {
             strategy: StrategyName::RayonIter,
             cores,
             chunks: None,
+            pin: crate::topology::Pin::None,
         }
     }
 
@@ -355,20 +358,29 @@ mod tests {
     }
 
     #[test]
-    fn a_summary_without_reference_shard_is_read_and_upgraded_to_every_column() {
+    fn files_of_earlier_versions_are_read_and_upgraded_to_every_column() {
         let (t, s) = two_cells();
-        let text = String::from_utf8(s.clone()).unwrap();
-        // The file as the version before `reference_shard` wrote it: one column fewer.
-        let older: String = text
-            .lines()
-            .map(|l| format!("{}\n", &l[..l.rfind(',').unwrap()]))
-            .collect();
-        assert!(older.starts_with(&SUMMARY_COLUMNS[..UNSHARDED_SUMMARY_COLUMNS].join(",")));
-        let r = repair(&t, older.as_bytes(), &|_| Ok(())).unwrap();
-        assert!(r.upgraded_summary);
-        assert_eq!(r.finished.len(), 2);
-        assert_eq!(r.summary_csv, s);
-        assert!(!repair(&t, &s, &|_| Ok(())).unwrap().upgraded_summary);
+        // A file as an earlier version wrote it: its last `fewer` columns missing.
+        let cut = |bytes: &[u8], fewer: usize| -> String {
+            String::from_utf8(bytes.to_vec())
+                .unwrap()
+                .lines()
+                .map(|l| {
+                    let keep: Vec<&str> = l.split(',').collect();
+                    format!("{}\n", keep[..keep.len() - fewer].join(","))
+                })
+                .collect()
+        };
+        for (summary_fewer, trial_fewer) in [(2, 1), (3, 1)] {
+            let older = cut(&s, summary_fewer);
+            let older_trials = cut(&t, trial_fewer);
+            let r = repair(older_trials.as_bytes(), older.as_bytes(), &|_| Ok(())).unwrap();
+            assert!(r.upgraded, "{summary_fewer} {trial_fewer}");
+            assert_eq!(r.finished.len(), 2);
+            assert_eq!(r.summary_csv, s);
+            assert_eq!(r.trials_csv, t);
+        }
+        assert!(!repair(&t, &s, &|_| Ok(())).unwrap().upgraded);
     }
 
     #[test]

@@ -45,6 +45,7 @@ pub fn trial_rows(cell: &Cell, measured: &[Measured], failure: Option<&str>) -> 
             foreign_cpu_s: m.elapsed.foreign.map(|f| f.cpu_s),
             steal_s: m.elapsed.foreign.and_then(|f| f.steal_s),
             load1: m.load1,
+            pin: cell.pin,
         })
         .collect()
 }
@@ -65,6 +66,8 @@ pub struct CellContext<'a> {
     pub resamples: usize,
     /// The shard this sweep is (its `reference_shard`), if it is one.
     pub shard: Option<usize>,
+    /// Whether the cell's threads use SMT siblings ([`crate::topology::Topology::is_smt`]).
+    pub smt: Option<bool>,
 }
 
 /// The summary row of a cell, against `ctx`; a failed cell has no statistics, speedup or
@@ -136,6 +139,8 @@ pub fn summary_row(
                 .any(|(&foreign, &wall)| ctx.threshold.exceeded(foreign, wall, cell.cores))
         }),
         reference_shard: ctx.shard,
+        pin: cell.pin,
+        smt: ctx.smt,
     }
 }
 
@@ -152,6 +157,7 @@ pub(crate) fn test_context(seq_walls: Option<&[f64]>, hardware_threads: usize) -
         seed: 1,
         resamples: 1000,
         shard: None,
+        smt: None,
     }
 }
 
@@ -177,6 +183,7 @@ mod tests {
             strategy,
             cores,
             chunks,
+            pin: crate::topology::Pin::None,
         }
     }
 

@@ -191,7 +191,10 @@ impl GroupInput {
     fn run_steps(&self, cell: &Cell, steps: usize) -> Result<Measured, String> {
         let mut sim = self.scene.clone().simulate(self.group.neighbors);
         let load1 = crate::contention::load1();
-        let elapsed = run_timed(&mut sim, cell.strategy, &cell.config(), steps)
+        let placement =
+            crate::placement::placement(cell.pin).map_err(|e| one_line(&format!("{e:#}")))?;
+        let config = cell.config().placed(placement);
+        let elapsed = run_timed(&mut sim, cell.strategy, &config, steps)
             .map_err(|e| one_line(&format!("{:#}", anyhow::Error::new(e))))?;
         Ok(Measured {
             elapsed,
@@ -390,6 +393,7 @@ impl<T: Write, S: Write> Runner<'_, T, S> {
             seed: self.seed,
             resamples: self.resamples,
             shard: self.shard,
+            smt: crate::placement::machine_topology().is_smt(cell.cores),
         };
         let summary = summary_row(&cell, measured, failure.as_deref(), &ctx);
         let trials = trial_rows(&cell, measured, failure.as_deref());
@@ -563,6 +567,7 @@ mod tests {
                     strategy,
                     cores: 2,
                     chunks: Some(3),
+                    pin: crate::topology::Pin::None,
                 };
                 input.run(&cell).unwrap().checksum
             })

@@ -9,10 +9,13 @@ use serde::{Deserialize, Serialize};
 use super::Topology;
 
 /// How worker threads are placed on logical CPUs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
 #[serde(rename_all = "lowercase")]
 pub enum Pin {
-    /// Not pinned: the OS scheduler places and moves threads.
+    /// Not pinned: the OS scheduler places and moves threads (the default).
+    #[default]
     None,
     /// Fill the SMT siblings of one physical core before the next core: the fewest cores,
     /// sharing their caches and execution units.

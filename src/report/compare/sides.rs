@@ -164,6 +164,7 @@ pub(crate) mod tests {
             simd: None,
             fake_timings: None,
             fake_contention: None,
+            pin: vec![crate::topology::Pin::None],
             shard: None,
         };
         let mut meta = Meta::new(params, rows.len(), session);
