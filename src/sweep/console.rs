@@ -10,6 +10,8 @@ use crate::results::params::SweepParams;
 use crate::results::rows::{Contended, Status, SummaryRow, fastest};
 use crate::scene::tank;
 use crate::sph::params::Preset;
+use crate::topology::Pin;
+use sph_strategies::StrategyName;
 
 /// A duration for people: `0.25 ms`, `12 ms`, `4.2 s`, `42 s`, `3 min 20 s`, `1 h 05 min`.
 pub fn duration(seconds: f64) -> String {
@@ -207,23 +209,31 @@ pub fn best_cells(plan: &Plan, rows: &[SummaryRow]) -> String {
             "Fastest cell per strategy ({}):",
             group.label(LabelStyle::Sweep)
         );
-        let _ = writeln!(
-            text,
-            "  {:<16} {:>5} {:>6} {:>10} {:>10} {:>8} {:>10}",
-            "strategy", "cores", "chunks", "mean s", "stddev s", "speedup", "efficiency"
-        );
-        let mut strategies: Vec<_> = plan
+        // With several placements, one row per (strategy, pin), named `strategy (pin)`.
+        let mut lines: Vec<(StrategyName, Pin)> = plan
             .cells
             .iter()
             .filter(|c| c.group == *group)
-            .map(|c| c.strategy)
+            .map(|c| (c.strategy, c.pin))
             .collect();
-        strategies.dedup();
-        for strategy in strategies {
+        lines.sort_by_key(|&(s, p)| (plan.cells.iter().position(|c| c.strategy == s), p));
+        lines.dedup();
+        let pinned = lines.iter().any(|&(_, p)| p != Pin::None);
+        let w = if pinned { 24 } else { 16 };
+        let _ = writeln!(
+            text,
+            "  {:<w$} {:>5} {:>6} {:>10} {:>10} {:>8} {:>10}",
+            "strategy", "cores", "chunks", "mean s", "stddev s", "speedup", "efficiency"
+        );
+        for (strategy, pin) in lines {
+            let name = match pin {
+                Pin::None => strategy.as_str().to_owned(),
+                pin => format!("{strategy} ({pin})"),
+            };
             let best = fastest(
                 plan.cells
                     .iter()
-                    .filter(|c| c.group == *group && c.strategy == strategy)
+                    .filter(|c| c.group == *group && c.strategy == strategy && c.pin == pin)
                     .filter_map(|c| by_key.get(c).copied()),
                 Contended::Compete,
             );
@@ -234,8 +244,8 @@ pub fn best_cells(plan: &Plan, rows: &[SummaryRow]) -> String {
                 Some(r) => {
                     let _ = writeln!(
                         text,
-                        "  {:<16} {:>5} {:>6} {:>10} {:>10} {:>8} {:>10}",
-                        strategy.as_str(),
+                        "  {:<w$} {:>5} {:>6} {:>10} {:>10} {:>8} {:>10}",
+                        name,
                         r.cores,
                         r.chunks.map_or_else(|| "-".to_owned(), |k| k.to_string()),
                         num(r.mean_s, places(r.mean_s.unwrap_or(0.0))),
@@ -245,7 +255,7 @@ pub fn best_cells(plan: &Plan, rows: &[SummaryRow]) -> String {
                     );
                 }
                 None => {
-                    let _ = writeln!(text, "  {:<16} (no successful cell)", strategy.as_str());
+                    let _ = writeln!(text, "  {name:<w$} (no successful cell)");
                 }
             }
         }
