@@ -15,6 +15,7 @@
 #                             strategy
 #   report/                   charts, REPORT.md and two traces (rayon-chunks, rayon-spawn)
 #   report/validation/        the wcsph dam break against Martin & Moyce (1952), R = 40
+#   results/pin/, report/pin/ every strategy unpinned and --pin spread (grid, N = 10 000)
 #   results/grid-50steps/     the grid sweep again at 50 steps (N = 1000, 10 000), and
 #   report/compare/           its comparison with results/grid (report --compare): a
 #                             stand-in for a second machine, labelled as one
@@ -54,6 +55,13 @@ mkdir -p report
 "$BIN" report results/paper results/grid results/all-pairs-small results/wcsph \
     --out report --force
 "$BIN" validate --resolution 40 --out report/validation --force
+# Placement (README, "Hyperthreading and placement"): every strategy unpinned and pinned
+# `spread`, reported on its own (its unpinned cells repeat results/grid's N = 10 000 group).
+"$BIN" sweep --preset seed --neighbors grid --n 10000 --steps 100 \
+    --cores "$CORES" --chunks 10,50 --pin none,spread --out results/pin --force --no-plots
+mkdir -p report/pin
+"$BIN" report results/pin --out report/pin --force
+
 # A stand-in for a second machine (README, "Comparing machines"): the grid study again at 50
 # steps on this machine, compared with --compare, whose banner says it is one machine.
 "$BIN" sweep --preset seed --neighbors grid --n 1000,10000 --steps 50 \
@@ -65,7 +73,8 @@ mkdir -p report/compare
 # The `contended` column by name: columns are appended over time (reference_shard follows it).
 contended=$(awk -F, 'FNR == 1 {for (i = 1; i <= NF; i++) if ($i == "contended") c = i; next}
     $c == "true" {n++} END {print n + 0}' results/paper/summary.csv results/grid/summary.csv \
-    results/all-pairs-small/summary.csv results/wcsph/summary.csv results/grid-50steps/summary.csv)
+    results/all-pairs-small/summary.csv results/wcsph/summary.csv results/grid-50steps/summary.csv \
+    results/pin/summary.csv)
 if [ "$contended" -gt 0 ]; then
     echo "warning: $contended contended cells (see report/REPORT.md): rerun on a quiet machine" >&2
     exit 1

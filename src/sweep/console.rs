@@ -293,6 +293,49 @@ mod tests {
         })
     }
 
+    #[test]
+    fn the_plan_says_which_cores_use_smt_siblings_on_an_smt_machine_and_nothing_without_smt() {
+        use crate::topology::{Topology, fake};
+        let mut params = SweepParams {
+            strategies: vec![StrategyName::RayonChunks],
+            presets: vec![Preset::Seed],
+            neighbors: vec![NeighborMode::Grid],
+            n: vec![60],
+            steps: 3,
+            cores: vec![1, 2, 4, 6, 8, 10],
+            chunks: vec![5],
+            trials: 1,
+            warmup: 0,
+            seed: 1,
+            simd: None,
+            fake_timings: None,
+            fake_contention: None,
+            pin: vec![Pin::Compact, Pin::Spread],
+            shard: None,
+        };
+        // 4 cores × 2 threads.
+        let smt = Topology::read(fake::smt_4x2().root(), &[0, 1, 2, 3, 4, 5, 6, 7]);
+        let note = placement_note(&params, &smt).unwrap();
+        assert!(note.contains("placements: compact, spread"), "{note}");
+        assert!(
+            note.contains("4 physical cores and 8 hardware threads"),
+            "{note}"
+        );
+        assert!(note.contains("cores 6, 8 use SMT siblings"), "{note}");
+        assert!(
+            note.contains("at 10 cores, spread puts 4 threads on physical cores and 4 on siblings"),
+            "{note}"
+        );
+        // Only the first core of each pair allowed: no siblings, nothing to say but the pins.
+        let no_smt = Topology::read(fake::smt_4x2().root(), &[0, 1, 2, 3]);
+        assert_eq!(
+            placement_note(&params, &no_smt).as_deref(),
+            Some("  placements: compact, spread (each a cell; seq, the reference, runs unpinned)")
+        );
+        params.pin = vec![Pin::None];
+        assert_eq!(placement_note(&params, &no_smt), None);
+    }
+
     fn row(cell: &Cell, walls: &[f64], failure: Option<&str>) -> SummaryRow {
         let m: Vec<Measured> = walls
             .iter()
