@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 mod common;
-use common::{assert_holds_all, run, scratch, sweep_into, text};
+use common::{assert_holds_all, png_size, run, scratch, sweep_into, text};
 
 const WIDTH: u32 = 1000;
 const HEIGHT: u32 = 650;
@@ -41,14 +41,6 @@ fn report_fails(args: &[&str], needle: &str) {
     assert!(!o.status.success(), "{all:?} succeeded");
     assert_eq!(err.lines().count(), 1, "{err}");
     assert!(err.starts_with("Error: ") && err.contains(needle), "{err}");
-}
-
-fn png_size(path: &Path) -> (u32, u32) {
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
-    let mut reader = decoder.read_info().expect("a PNG header");
-    let mut buf = vec![0; reader.output_buffer_size().expect("a buffer size")];
-    let info = reader.next_frame(&mut buf).expect("the PNG decodes");
-    (info.width, info.height)
 }
 
 fn pngs(dir: &Path) -> Vec<PathBuf> {

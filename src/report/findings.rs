@@ -8,6 +8,11 @@
 //! - A speedup above 1 at one core is labelled noise in the reference, never a win.
 //! - The Karp–Flatt serial fraction is given only where the speedup is above 1 on at least 2
 //!   cores, as a measurement at that core count, never extrapolated.
+//! - Each strategy at each placement (`sweep --pin`) is a series of its own
+//!   ([`series::SeriesKey`]), named `rayon-chunks (spread)` where pinned. Two placements of a
+//!   strategy are compared cell against cell, at the same cores and chunks ([`super::placements`]):
+//!   one is called faster at a core count only where their 95 % intervals of the mean are
+//!   apart, and each strategy gets one sentence per pair of placements, not one per cell.
 //!
 //! - Across workloads ([`super::rank_shift`]: the toy Müller model against wcsph at one core count),
 //!   a winner is named only when its interval overlaps no other's on both; a strategy has
@@ -19,10 +24,12 @@
 
 use super::numbers::{interval, percent, secs, times};
 use super::paper;
+use super::placements::{Placements, pin_name};
 use super::rank_shift::RankShift;
-use super::series::{self, Best, Group};
+use super::series::{self, Best, Group, SeriesKey};
 use crate::results::rows::SummaryRow;
 use crate::results::stats::Interval;
+use crate::topology::Pin;
 use sph_strategies::StrategyName;
 
 /// What the data of a group supports, decided before it is worded.
@@ -36,15 +43,16 @@ pub enum Finding {
     OneCoreNoise {
         /// The strategy.
         strategy: StrategyName,
-        /// Its speedup at 1 core.
-        speedup: f64,
-        /// The speedup's 95 % interval.
-        ci: Option<Interval>,
+        /// Per placement with such a speedup (in the order of [`series::pins`]): the
+        /// placement, its speedup at 1 core and the speedup's 95 % interval.
+        speedups: Vec<(Pin, f64, Option<Interval>)>,
     },
+    /// Two placements of a strategy, compared where both were measured.
+    Placements(Placements),
     /// Where more chunks stop paying for a chunked strategy.
     ChunkingStops {
-        /// The strategy.
-        strategy: StrategyName,
+        /// The strategy, at one placement.
+        series: SeriesKey,
         /// (chunks from which more stop paying, at this many cores), by cores.
         from: Vec<(usize, usize)>,
     },
@@ -92,6 +100,8 @@ pub struct PaperPoint {
     pub strategy: StrategyName,
     /// The paper's speedup at these cores.
     pub paper: f64,
+    /// Where its threads ran.
+    pub pin: Pin,
 }
 
 /// The findings for group `g` of `rows`.
@@ -100,9 +110,9 @@ pub fn findings(rows: &[SummaryRow], g: &Group) -> Vec<Finding> {
         .into_iter()
         .filter(|&s| s != StrategyName::Seq)
         .collect();
-    let bests: Vec<(StrategyName, Vec<Best>)> = strategies
-        .iter()
-        .map(|&s| (s, series::best_per_cores(rows, g, s)))
+    let bests: Vec<(StrategyName, Vec<Best>)> = series::series(rows, g)
+        .into_iter()
+        .map(|key| (key.strategy, series::best_per_cores(rows, g, key)))
         .collect();
     // A contended reference makes every speedup doubtful: none enters a finding then.
     let seq_trusted = !rows
@@ -122,6 +132,9 @@ pub fn findings(rows: &[SummaryRow], g: &Group) -> Vec<Finding> {
             out.extend(one_core_noise(&at));
         }
     }
+    out.extend(
+        super::placements::compare(rows, g, &strategies, seq_trusted).map(Finding::Placements),
+    );
     out.extend(chunking(rows, g, &strategies));
     if seq_trusted {
         out.extend(karp_flatt(&bests));
@@ -215,34 +228,47 @@ pub(super) fn apart(a: &Best, b: &Best) -> bool {
     }
 }
 
-/// A speedup above 1 at one core is the reference's noise.
+/// A speedup above 1 at one core is the reference's noise: one finding per strategy, over
+/// its placements (`at` holds a strategy's series in the order of [`series::series`]).
 fn one_core_noise(at: &[Entry]) -> Vec<Finding> {
-    at.iter()
-        .filter(|(_, b)| !b.contended)
-        .filter_map(|(s, b)| {
-            Some(Finding::OneCoreNoise {
+    let mut out: Vec<Finding> = Vec::new();
+    for (s, b) in at.iter().filter(|(_, b)| !b.contended) {
+        let Some(speedup) = b.speedup.filter(|&sp| sp > 1.0) else {
+            continue;
+        };
+        let one = (b.pin, speedup, b.speedup_ci);
+        match out.last_mut() {
+            Some(Finding::OneCoreNoise { strategy, speedups }) if strategy == s => {
+                speedups.push(one);
+            }
+            _ => out.push(Finding::OneCoreNoise {
                 strategy: *s,
-                speedup: b.speedup.filter(|&sp| sp > 1.0)?,
-                ci: b.speedup_ci,
-            })
-        })
-        .collect()
+                speedups: vec![one],
+            }),
+        }
+    }
+    out
 }
 
-/// Where more chunks stop paying, per chunked strategy.
+/// Where more chunks stop paying, per chunked strategy at each of its placements.
 fn chunking(rows: &[SummaryRow], g: &Group, strategies: &[StrategyName]) -> Vec<Finding> {
     let mut out = Vec::new();
     for &s in strategies
         .iter()
         .filter(|&&s| series::is_chunked(rows, g, s))
     {
-        let from: Vec<(usize, usize)> = series::chunk_table(rows, g, s)
-            .iter()
-            .filter(|(_, v)| v.len() > 1)
-            .filter_map(|(c, v)| Some((series::chunking_stops_paying(v)?, *c)))
-            .collect();
-        if !from.is_empty() {
-            out.push(Finding::ChunkingStops { strategy: s, from });
+        for key in series::pins(rows, g, s)
+            .into_iter()
+            .map(|p| SeriesKey::new(s, p))
+        {
+            let from: Vec<(usize, usize)> = series::chunk_table(rows, g, key)
+                .iter()
+                .filter(|(_, v)| v.len() > 1)
+                .filter_map(|(c, v)| Some((series::chunking_stops_paying(v)?, *c)))
+                .collect();
+            if !from.is_empty() {
+                out.push(Finding::ChunkingStops { series: key, from });
+            }
         }
     }
     out
@@ -284,15 +310,16 @@ fn against_paper(
             .iter()
             .filter_map(|(s, b)| Some((*s, b.iter().find(|b| b.cores == c)?)))
             .filter(|(_, b)| !b.contended)
-            .filter_map(|(s, b)| Some((s, b.speedup?, b.oversubscribed)))
+            .filter_map(|(s, b)| Some((s, b.speedup?, b.oversubscribed, b.pin)))
             .max_by(|a, b| a.1.total_cmp(&b.1));
-        if let Some((strategy, speedup, oversubscribed)) = best {
+        if let Some((strategy, speedup, oversubscribed, pin)) = best {
             points.push(PaperPoint {
                 cores: c,
                 oversubscribed,
                 speedup,
                 strategy,
                 paper: p.speedup,
+                pin,
             });
         }
     }
@@ -308,17 +335,35 @@ impl Finding {
                 paper is given as a finding."
                 .to_owned(),
             Finding::AtCores(at) => at.sentence(),
-            Finding::OneCoreNoise {
-                strategy,
-                speedup,
-                ci,
-            } => format!(
-                "{strategy}'s speedup of {}{} at 1 core is noise in the seq reference, not a \
-                 win: one worker runs the same passes as seq.",
-                times(*speedup),
-                interval(*ci)
-            ),
-            Finding::ChunkingStops { strategy, from } => {
+            Finding::OneCoreNoise { strategy, speedups } => match speedups.as_slice() {
+                [(pin, speedup, ci)] => format!(
+                    "{}'s speedup of {}{} at 1 core is noise in the seq reference, not a win: \
+                     one worker runs the same passes as seq.",
+                    SeriesKey::new(*strategy, *pin),
+                    times(*speedup),
+                    interval(*ci)
+                ),
+                several => format!(
+                    "{strategy}'s speedups of {} at 1 core are noise in the seq reference, not \
+                     a win: one worker runs the same passes as seq.",
+                    and_list(
+                        &several
+                            .iter()
+                            .map(|(pin, speedup, ci)| format!(
+                                "{}{} ({})",
+                                times(*speedup),
+                                interval(*ci),
+                                pin_name(*pin)
+                            ))
+                            .collect::<Vec<_>>()
+                    )
+                ),
+            },
+            Finding::Placements(p) => p.sentence(),
+            Finding::ChunkingStops {
+                series: strategy,
+                from,
+            } => {
                 let parts: Vec<String> = from
                     .iter()
                     .map(|(k, c)| format!("{k} chunks at {}", series::cores_label(*c)))
@@ -330,9 +375,10 @@ impl Finding {
                 )
             }
             Finding::SerialFraction { strategy, best, e } => format!(
-                "Karp–Flatt serial fraction of {strategy} at {} ({}{}): e = {}. It describes \
+                "Karp–Flatt serial fraction of {} at {} ({}{}): e = {}. It describes \
                  the runs measured here; from so few core counts it forecasts nothing about \
                  more cores.",
+                SeriesKey::new(*strategy, best.pin),
                 series::cores_label(best.cores),
                 times(best.speedup.unwrap_or(f64::NAN)),
                 interval(best.speedup_ci),
@@ -362,7 +408,7 @@ impl PaperPoint {
                 ""
             },
             times(self.speedup),
-            self.strategy,
+            SeriesKey::new(self.strategy, self.pin),
             times(self.paper)
         )
     }
@@ -452,10 +498,12 @@ pub(super) fn names(strategies: &[StrategyName]) -> String {
     and_list(&strategies.iter().map(|s| s.to_string()).collect::<Vec<_>>())
 }
 
-/// A cell as findings name it: `rayon-chunks with 45 chunks (0.412 s [0.40, 0.42])`.
+/// A cell as findings name it: `rayon-chunks with 45 chunks (0.412 s [0.40, 0.42])`, or
+/// pinned, `rayon-chunks (spread) with 45 chunks (…)`.
 pub(super) fn describe((s, b): &Entry) -> String {
     format!(
-        "{s}{} ({} s{})",
+        "{}{} ({} s{})",
+        SeriesKey::new(*s, b.pin),
         b.chunks
             .map_or_else(String::new, |k| format!(" with {k} chunks")),
         secs(b.mean_s),

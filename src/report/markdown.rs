@@ -7,10 +7,11 @@ use super::load::Sweep;
 use super::numbers::{interval, sig};
 use super::paper;
 use super::plan::ChartPlan;
-use super::series::{self, Best, Group};
+use super::series::{self, Best, Group, SeriesKey, SmtBand};
 use super::traces::TraceDir;
 use crate::results::key::LabelStyle;
 use crate::results::rows::{Status, SummaryRow};
+use crate::topology::Topology;
 use sph_strategies::StrategyName;
 
 /// A chart that does not apply, and why.
@@ -231,7 +232,11 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
         rule.push_str("---|");
     }
     let _ = writeln!(md, "{header}\n{rule}");
-    for (name, f) in machine_fields() {
+    let recorded = sweeps
+        .iter()
+        .any(|s| s.meta.machine.topology.logical_cpus > 0);
+    let topology = recorded.then(topology_fields).into_iter().flatten();
+    for (name, f) in machine_fields().into_iter().chain(topology) {
         let mut line = format!("| {name} |");
         for s in sweeps {
             let _ = write!(line, " {} |", f(s));
@@ -239,6 +244,80 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
         let _ = writeln!(md, "{line}");
     }
     md.push('\n');
+    smt_note(md, sweeps);
+}
+
+/// The recorded topology of the machine that measured group `g`: that of the first sweep
+/// with cells of `g` whose physical cores are known (pooled sweeps are one machine's).
+pub(super) fn topology_of<'a>(sweeps: &'a [Sweep], g: &Group) -> Option<&'a Topology> {
+    sweeps
+        .iter()
+        .filter(|s| s.rows.iter().any(|r| r.group() == *g))
+        .map(|s| &s.meta.machine.topology)
+        .find(|t| t.physical_cores.is_some())
+}
+
+/// The rows of the machine table from the recorded topology (`meta.json`'s
+/// `machine.topology`), shown where some sweep recorded one.
+fn topology_fields() -> [(&'static str, Field); 7] {
+    fn known<T: ToString>(v: Option<T>) -> String {
+        v.map_or_else(|| "unknown".to_owned(), |v| v.to_string())
+    }
+    fn kib(v: Option<u64>) -> String {
+        match v {
+            Some(k) if k >= 1024 && k % 1024 == 0 => format!("{} MiB", k / 1024),
+            Some(k) => format!("{k} KiB"),
+            None => "unknown".to_owned(),
+        }
+    }
+    [
+        ("physical cores", |s| {
+            known(s.meta.machine.topology.physical_cores)
+        }),
+        ("threads per core", |s| {
+            known(s.meta.machine.topology.threads_per_core)
+        }),
+        ("sockets", |s| known(s.meta.machine.topology.sockets)),
+        ("NUMA nodes", |s| known(s.meta.machine.topology.numa_nodes)),
+        ("caches (L1d / L2 / L3, per instance)", |s| {
+            let t = &s.meta.machine.topology;
+            format!("{} / {} / {}", kib(t.l1d_kib), kib(t.l2_kib), kib(t.l3_kib))
+        }),
+        ("frequency governor", |s| {
+            known(s.meta.machine.topology.governor.clone())
+        }),
+        ("turbo", |s| {
+            known(
+                s.meta
+                    .machine
+                    .topology
+                    .turbo
+                    .map(|on| if on { "on" } else { "off" }),
+            )
+        }),
+    ]
+}
+
+/// Under the machine table: how many cells put threads on SMT siblings (`smt = true`).
+fn smt_note(md: &mut String, sweeps: &[Sweep]) {
+    let smt: Vec<&SummaryRow> = sweeps
+        .iter()
+        .flat_map(|s| &s.rows)
+        .filter(|r| r.smt == Some(true))
+        .collect();
+    if smt.is_empty() {
+        return;
+    }
+    let cores: std::collections::BTreeSet<usize> = smt.iter().map(|r| r.cores).collect();
+    let cores: Vec<String> = cores.iter().map(usize::to_string).collect();
+    let _ = writeln!(
+        md,
+        "{} ran more threads than the machine's physical cores, no more than its logical \
+         CPUs (`smt = true` in summary.csv: at {} cores): their threads shared physical cores \
+         as SMT siblings, pinned or not.\n",
+        crate::output::console::plural(smt.len(), "cell", "cells"),
+        super::findings::and_list(&cores)
+    );
 }
 
 /// A row of the machine table: its name and its value for one sweep.
@@ -313,16 +392,35 @@ fn group(md: &mut String, rows: &[SummaryRow], g: &Group, input: &Input<'_>) {
         paper_context(md, g);
     }
     let _ = writeln!(md, "### Best cell per core count (Table 1 analogue)\n");
+    let smt =
+        topology_of(input.sweeps, g).and_then(|t| series::smt_band(t, &series::cores(rows, g)));
+    let columns = Columns {
+        pin: series::is_pinned(rows, g),
+        smt: smt.as_ref(),
+    };
     for s in series::strategies(rows, g)
         .into_iter()
         .filter(|&s| s != StrategyName::Seq)
     {
-        let best = series::best_per_cores(rows, g, s);
+        let mut best: Vec<Best> = series::pins(rows, g, s)
+            .into_iter()
+            .flat_map(|p| series::best_per_cores(rows, g, SeriesKey::new(s, p)))
+            .collect();
+        best.sort_by_key(|b| (b.cores, b.pin));
         if best.is_empty() {
             let _ = writeln!(md, "**{s}**: no successful cell.\n");
             continue;
         }
-        table(md, s, &best, comparable && series::is_chunked(rows, g, s));
+        table(
+            md,
+            s,
+            &best,
+            comparable && series::is_chunked(rows, g, s),
+            columns,
+        );
+    }
+    if let Some(band) = &smt {
+        smt_paragraph(md, band);
     }
     let _ = writeln!(md, "### Findings\n");
     for finding in super::findings::findings(rows, g) {
@@ -409,34 +507,91 @@ fn group_charts(md: &mut String, g: &Group, input: &Input<'_>) {
     }
 }
 
-// Over ~60 lines on purpose: the table with and without the paper's columns, row by row; the two
-// layouts share every row.
-fn table(md: &mut String, strategy: StrategyName, best: &[Best], with_paper: bool) {
+/// The optional columns of the Table 1 analogue.
+#[derive(Debug, Clone, Copy)]
+struct Columns<'a> {
+    /// A `pin` column (some cell of the group was pinned).
+    pin: bool,
+    /// An efficiency-per-physical-core column (some core counts used SMT siblings).
+    smt: Option<&'a SmtBand>,
+}
+
+/// Under the tables of a group with cells on SMT siblings: what the shading and the
+/// efficiency per physical core mean.
+fn smt_paragraph(md: &mut String, band: &SmtBand) {
+    let cores: Vec<String> = band.cores.iter().map(usize::to_string).collect();
+    let n = band.physical_cores;
+    let physical = crate::output::console::plural(n, "physical core", "physical cores");
+    let _ = writeln!(
+        md,
+        "At {} cores the threads outnumber the machine's {physical} but not its logical CPUs, so \
+         they share physical cores as SMT siblings (shaded in Charts 4 and 5). Efficiency \
+         S / p counts each sibling as a whole core, so it falls once p exceeds {n} even \
+         where the siblings add throughput; the efficiency per physical core, S / min(p, {n}), \
+         sets the speedup against the physical cores the threads had: above 1, the siblings \
+         gave more than {physical} could at best.\n",
+        super::findings::and_list(&cores),
+    );
+}
+
+// Over ~60 lines on purpose: the table with and without the paper's, the placement and the
+// physical-core columns, row by row; the layouts share every row.
+fn table(
+    md: &mut String,
+    strategy: StrategyName,
+    best: &[Best],
+    with_paper: bool,
+    columns: Columns<'_>,
+) {
     let _ = writeln!(md, "**{strategy}**\n");
+    let pin_head = if columns.pin { " pin |" } else { "" };
+    let pin_rule = if columns.pin { "---|" } else { "" };
+    let (smt_head, smt_rule) = match columns.smt {
+        Some(_) => (" efficiency per physical core |", "---:|"),
+        None => ("", ""),
+    };
     if with_paper {
         let _ = writeln!(
             md,
-            "| cores | best chunks | mean time (s) [95 % CI] | speedup [95 % CI] | efficiency | paper: best chunks | paper: time (s) | paper: speedup |\n\
-             |---:|---:|---:|---:|---:|---:|---:|---:|"
+            "| cores |{pin_head} best chunks | mean time (s) [95 % CI] | speedup [95 % CI] | efficiency |{smt_head} paper: best chunks | paper: time (s) | paper: speedup |\n\
+             |---:|{pin_rule}---:|---:|---:|---:|{smt_rule}---:|---:|---:|"
         );
     } else {
         let _ = writeln!(
             md,
-            "| cores | best chunks | mean time (s) [95 % CI] | speedup [95 % CI] | efficiency |\n|---:|---:|---:|---:|---:|"
+            "| cores |{pin_head} best chunks | mean time (s) [95 % CI] | speedup [95 % CI] | efficiency |{smt_head}\n|---:|{pin_rule}---:|---:|---:|---:|{smt_rule}"
         );
     }
-    let mut cores: Vec<usize> = best.iter().map(|b| b.cores).collect();
+    // One row per measured (cores, placement), and with the paper's columns one per core
+    // count of its table that was not measured.
+    let mut cells: Vec<(usize, Option<&Best>)> = best.iter().map(|b| (b.cores, Some(b))).collect();
     if with_paper {
-        cores.extend(paper::TABLE.iter().map(|r| r.cores));
-        cores.sort_unstable();
-        cores.dedup();
+        for r in paper::TABLE {
+            if !cells.iter().any(|(c, _)| *c == r.cores) {
+                cells.push((r.cores, None));
+            }
+        }
+        cells.sort_by_key(|(c, b)| (*c, b.map(|b| b.pin)));
     }
     let dash = || "—".to_owned();
-    for c in cores {
-        let ours = best.iter().find(|b| b.cores == c);
+    for (c, ours) in cells {
+        let pin = match ours {
+            Some(b) if columns.pin => format!(" {} |", b.pin),
+            None if columns.pin => " — |".to_owned(),
+            _ => String::new(),
+        };
+        let physical = match (columns.smt, ours) {
+            (Some(band), Some(b)) => format!(
+                " {} |",
+                b.speedup
+                    .map_or_else(dash, |s| sig(band.physical_efficiency(s, b.cores)))
+            ),
+            (Some(_), None) => " — |".to_owned(),
+            (None, _) => String::new(),
+        };
         let mut line = match ours {
             Some(b) => format!(
-                "| {}{}{} | {} | {}{} | {} | {} |",
+                "| {}{}{} |{pin} {} | {}{} | {} | {} |{physical}",
                 b.cores,
                 if b.oversubscribed {
                     format!(" {OVERSUBSCRIBED}")
@@ -455,7 +610,7 @@ fn table(md: &mut String, strategy: StrategyName, best: &[Best], with_paper: boo
                     .map_or_else(dash, |s| format!("{}{}", times(s), interval(b.speedup_ci))),
                 b.efficiency.map_or_else(dash, sig),
             ),
-            None => format!("| {c} | — | — | — | — |"),
+            None => format!("| {c} |{pin} — | — | — | — |{physical}"),
         };
         if with_paper {
             match paper::at(c) {
@@ -532,17 +687,72 @@ fn failed(md: &mut String, rows: &[SummaryRow]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::report::series::tests::pinned;
     use crate::results::rows::tests::row;
+    use crate::topology::Pin;
+
+    #[test]
+    fn a_pinned_group_has_a_pin_column_and_an_smt_group_the_efficiency_per_physical_core() {
+        let rows = [
+            row(StrategyName::RayonIter, 1, None, 4.0),
+            row(StrategyName::RayonIter, 2, None, 2.5),
+            pinned(row(StrategyName::RayonIter, 2, None, 2.0), Pin::Spread),
+        ];
+        let g = rows[0].group();
+        let mut best: Vec<Best> = [Pin::None, Pin::Spread]
+            .into_iter()
+            .flat_map(|p| {
+                series::best_per_cores(&rows, &g, SeriesKey::new(StrategyName::RayonIter, p))
+            })
+            .collect();
+        best.sort_by_key(|b| (b.cores, b.pin));
+        let band = SmtBand {
+            physical_cores: 1,
+            to: 2,
+            cores: vec![2],
+        };
+        let mut md = String::new();
+        let columns = Columns {
+            pin: true,
+            smt: Some(&band),
+        };
+        table(&mut md, StrategyName::RayonIter, &best, false, columns);
+        let lines: Vec<&str> = md.lines().collect();
+        assert_eq!(
+            lines[2],
+            "| cores | pin | best chunks | mean time (s) [95 % CI] | speedup [95 % CI] | \
+             efficiency | efficiency per physical core |"
+        );
+        assert_eq!(lines[3], "|---:|---|---:|---:|---:|---:|---:|");
+        // Speedup 2 at 2 cores: efficiency 1 per thread, 2 per physical core.
+        assert_eq!(
+            &lines[4..7],
+            [
+                "| 1 | none | — | 4.00 [3.92–4.08] | 1.00× [0.950–1.05] | 1.00 | 1.00 |",
+                "| 2 | none | — | 2.50 [2.45–2.55] | 1.60× [1.52–1.68] | 0.800 | 1.60 |",
+                "| 2 | spread | — | 2.00 [1.96–2.04] | 2.00× [1.90–2.10] | 1.00 | 2.00 |",
+            ]
+        );
+    }
 
     #[test]
     fn an_oversubscribed_best_cell_is_flagged_in_the_table() {
         let best = series::best_per_cores(
             &[row(StrategyName::RayonIter, 3, None, 2.0)],
             &row(StrategyName::Seq, 1, None, 1.0).group(),
-            StrategyName::RayonIter,
+            SeriesKey::unpinned(StrategyName::RayonIter),
         );
         let mut md = String::new();
-        table(&mut md, StrategyName::RayonIter, &best, false);
+        table(
+            &mut md,
+            StrategyName::RayonIter,
+            &best,
+            false,
+            Columns {
+                pin: false,
+                smt: None,
+            },
+        );
         assert!(
             md.contains(
                 "| 3 ⚠ oversubscribed | — | 2.00 [1.96–2.04] | 2.00× [1.90–2.10] | 0.667 |"

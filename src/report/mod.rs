@@ -16,6 +16,11 @@
 //! 4. every strategy's best speedup against cores, error bars from the trial spread;
 //! 5. efficiency and the Karp–Flatt serial fraction against cores;
 //!
+//! where a strategy was measured at several placements (`sweep --pin`), charts 3–5 draw one
+//! line per placement and charts 1–2 are drawn per placement ([`plan`]); where the sweep's
+//! recorded topology says some core counts put threads on SMT siblings, charts 4–5 shade them
+//! and the tables add the efficiency per physical core;
+//!
 //! and per preset, where both neighbour searches were measured:
 //! 6. all-pairs against grid, seconds per step against N.
 //!
@@ -35,6 +40,7 @@ pub mod findings;
 pub mod markdown;
 pub mod numbers;
 pub mod paper;
+pub mod placements;
 pub mod plan;
 pub mod rank_shift;
 pub mod series;
@@ -165,7 +171,7 @@ fn pooled(
     written: &mut Vec<PathBuf>,
 ) -> anyhow::Result<String> {
     let rows: Vec<_> = sweeps.iter().flat_map(|s| s.rows.clone()).collect();
-    let planned = plan::plan(&rows);
+    let planned = plan::plan(&rows, |g| markdown::topology_of(sweeps, g));
     for chart in &planned.charts {
         let path = claimed.check_writable(&chart.file)?;
         draw(&path, chart)?;
@@ -256,10 +262,14 @@ fn draw(path: &Path, chart: &plan::ChartPlan) -> anyhow::Result<()> {
             mark_min,
         } => charts::chunks::draw(path, title, subtitle, y_desc, lines, *mark_min),
         ChartKind::Best(data) => charts::best::draw(path, title, subtitle, data),
-        ChartKind::Speedup(lines) => charts::speedup::draw(path, title, subtitle, lines),
-        ChartKind::Efficiency { efficiency, serial } => {
-            charts::efficiency::draw(path, title, subtitle, efficiency, serial)
+        ChartKind::Speedup { lines, smt } => {
+            charts::speedup::draw(path, title, subtitle, lines, smt.as_ref())
         }
+        ChartKind::Efficiency {
+            efficiency,
+            serial,
+            smt,
+        } => charts::efficiency::draw(path, title, subtitle, (efficiency, serial), smt.as_ref()),
         ChartKind::Neighbors(lines) => charts::neighbors::draw(path, title, subtitle, lines),
     }
 }

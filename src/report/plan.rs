@@ -1,17 +1,25 @@
 //! Which charts a report draws, as data: for each chart its file name, caption, titles and
 //! series, and for each chart that does not apply, why. A pure function of the summary rows
-//! ([`plan`]); [`super::generate`] then only draws each [`ChartPlan`] and writes the text
-//! (criterion's "compute the series, then draw").
+//! and the machine's topology ([`plan`]); [`super::generate`] then only draws each
+//! [`ChartPlan`] and writes the text (criterion's "compute the series, then draw").
+//!
+//! Placements (`sweep --pin`): charts 3–5 draw one line per strategy and placement, the
+//! pinned ones in the strategy's colour, dashed (`spread`) or dotted (`compact`); charts 1–2
+//! are drawn once per strategy and placement (the unpinned one under its usual name, a
+//! pinned one with `-pin-spread` or `-pin-compact` added), since their lines are already the
+//! core counts. Where the topology says some core counts put threads on SMT siblings,
+//! charts 4–5 shade them.
 
 use sph_strategies::StrategyName;
 
 use super::charts::best::BestChart;
 use super::markdown::Skipped;
 use super::paper;
-use super::series::{self, Line, Metric};
+use super::series::{self, Line, Metric, SeriesKey, SmtBand};
 use crate::results::key::{Group, LabelStyle};
 use crate::results::rows::SummaryRow;
 use crate::sph::params::Preset;
+use crate::topology::{Pin, Topology};
 
 /// What a chart shows, with its series.
 #[derive(Debug, Clone)]
@@ -28,13 +36,20 @@ pub enum ChartKind {
     /// Chart 3: one strategy's best runtime and speedup against cores.
     Best(BestChart<'static>),
     /// Chart 4: every strategy's best speedup against cores.
-    Speedup(Vec<Line>),
+    Speedup {
+        /// One line per series.
+        lines: Vec<Line>,
+        /// The core counts to shade as SMT siblings.
+        smt: Option<SmtBand>,
+    },
     /// Chart 5: efficiency and the Karp–Flatt serial fraction against cores.
     Efficiency {
         /// Efficiency lines.
         efficiency: Vec<Line>,
         /// Serial-fraction lines.
         serial: Vec<Line>,
+        /// The core counts to shade as SMT siblings.
+        smt: Option<SmtBand>,
     },
     /// Chart 6: all-pairs against grid, seconds per step against N.
     Neighbors(Vec<Line>),
@@ -66,12 +81,17 @@ pub struct ReportPlan {
     pub skipped: Vec<Skipped>,
 }
 
-/// The charts of `rows` (see the module docs of [`super`] for the list).
-pub fn plan(rows: &[SummaryRow]) -> ReportPlan {
+/// The charts of `rows` (see the module docs of [`super`] for the list); `topology` gives
+/// the recorded topology of the machine that measured a group, where known.
+pub fn plan<'t>(
+    rows: &[SummaryRow],
+    topology: impl Fn(&Group) -> Option<&'t Topology>,
+) -> ReportPlan {
     let mut out = ReportPlan::default();
     for g in series::groups(rows) {
         chunk_charts(rows, &g, &mut out);
-        cores_charts(rows, &g, &mut out);
+        let smt = topology(&g).and_then(|t| series::smt_band(t, &series::cores(rows, &g)));
+        cores_charts(rows, &g, smt, &mut out);
     }
     for preset in series::presets(rows) {
         neighbor_chart(rows, preset, &mut out);
@@ -106,7 +126,7 @@ impl ReportPlan {
     }
 }
 
-/// Charts 1 and 2 for each chunked strategy of `g`.
+/// Charts 1 and 2 for each chunked strategy of `g`, at each of its placements.
 fn chunk_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
     let subtitle = g.label(LabelStyle::Report);
     let chunked: Vec<StrategyName> = series::strategies(rows, g)
@@ -120,32 +140,45 @@ fn chunk_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
              measured in this group.",
         );
     }
-    for s in chunked {
+    let keys = chunked.into_iter().flat_map(|s| {
+        series::pins(rows, g, s)
+            .into_iter()
+            .map(move |p| SeriesKey::new(s, p))
+    });
+    for key in keys {
         for (metric, n, what, y_desc) in [
             (Metric::Wall, 1, "runtime", "mean runtime (s)"),
             (Metric::Cpu, 2, "cpu", "mean CPU time, user + sys (s)"),
         ] {
-            let lines = series::chunk_lines(rows, g, s, metric);
+            let lines = series::chunk_lines(rows, g, key, metric);
             if lines.is_empty() {
                 continue;
             }
             let (title, caption) = match metric {
                 Metric::Wall => (
-                    format!("Runtime against chunks: {s}"),
+                    format!("Runtime against chunks: {key}"),
                     format!(
-                        "Chart 1: {s}, mean runtime against chunks per pass, one line per core \
+                        "Chart 1: {key}, mean runtime against chunks per pass, one line per core \
                          count, each line's minimum crossed (the paper's Figure 7); {subtitle}."
                     ),
                 ),
                 Metric::Cpu => (
-                    format!("CPU time against chunks: {s}"),
+                    format!("CPU time against chunks: {key}"),
                     format!(
-                        "Chart 2: {s}, mean CPU time (user + sys) against chunks per pass, \
+                        "Chart 2: {key}, mean CPU time (user + sys) against chunks per pass, \
                          one line per core count (the paper's Figure 8); {subtitle}."
                     ),
                 ),
             };
-            let file = format!("{}-{n}-{what}-vs-chunks-{s}.png", g.slug());
+            let pinned = match key.pin {
+                Pin::None => String::new(),
+                pin => format!("-pin-{pin}"),
+            };
+            let file = format!(
+                "{}-{n}-{what}-vs-chunks-{}{pinned}.png",
+                g.slug(),
+                key.strategy
+            );
             let mark_min = metric == Metric::Wall;
             let kind = ChartKind::Chunks {
                 y_desc,
@@ -158,12 +191,12 @@ fn chunk_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
 }
 
 /// Charts 3–5 of `g`, or why they are not drawn.
-fn cores_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
+fn cores_charts(rows: &[SummaryRow], g: &Group, smt: Option<SmtBand>, out: &mut ReportPlan) {
     let cores = series::cores(rows, g);
     match series::seq_mean(rows, g) {
         Some(seq_s) if cores.len() > 1 => {
             best_charts(rows, g, seq_s, out);
-            speedup_and_efficiency_charts(rows, g, out);
+            speedup_and_efficiency_charts(rows, g, smt, out);
         }
         Some(_) => match cores.first() {
             Some(&c) => out.skip(
@@ -186,7 +219,8 @@ fn cores_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
     }
 }
 
-/// Chart 3 for each strategy of `g` with at least two core counts.
+/// Chart 3 for each strategy of `g` with at least two core counts (at some placement), one
+/// line per placement.
 fn best_charts(rows: &[SummaryRow], g: &Group, seq_s: f64, out: &mut ReportPlan) {
     let subtitle = g.label(LabelStyle::Report);
     let comparable = paper::comparable(g);
@@ -195,29 +229,40 @@ fn best_charts(rows: &[SummaryRow], g: &Group, seq_s: f64, out: &mut ReportPlan)
         .into_iter()
         .filter(|&s| s != StrategyName::Seq)
     {
-        let best = series::best_per_cores(rows, g, s);
-        if best.len() < 2 {
+        let mut runtime = Vec::new();
+        let mut speedup = Vec::new();
+        for key in series::pins(rows, g, s)
+            .into_iter()
+            .map(|p| SeriesKey::new(s, p))
+        {
+            let best = series::best_per_cores(rows, g, key);
+            let line = speedups.iter().find(|l| l.series == Some(key));
+            if let (false, Some(line)) = (best.is_empty(), line) {
+                runtime.push(series::runtime_line(&best, key));
+                speedup.push(line.clone());
+            }
+        }
+        if runtime.iter().all(|l| l.points.len() < 2) {
             continue;
         }
-        let Some(speedup) = speedups.iter().find(|l| l.label == s.as_str()).cloned() else {
-            continue;
-        };
+        let keys: Vec<SeriesKey> = speedup.iter().filter_map(|l| l.series).collect();
         let data = BestChart {
             strategy: s.as_str(),
-            runtime: series::runtime_line(&best, s.as_str()),
+            runtime,
             speedup,
             seq_s,
             paper: comparable,
         };
         let caption = format!(
             "Chart 3: {s}, best runtime (above) and best speedup (below) against cores, \
-             bars: 95 % confidence intervals{} (the paper's Figures 9 and 10); {subtitle}.",
+             bars: 95 % confidence intervals{} (the paper's Figures 9 and 10){}; {subtitle}.",
             if comparable {
                 "; grey triangles: the paper's published speedups on its own machine, at the \
                  core counts measured here"
             } else {
                 ""
-            }
+            },
+            line_styles(&keys),
         );
         let file = format!("{}-3-best-{s}.png", g.slug());
         let title = format!("Best runtime and speedup against cores: {s}");
@@ -225,20 +270,43 @@ fn best_charts(rows: &[SummaryRow], g: &Group, seq_s: f64, out: &mut ReportPlan)
     }
 }
 
-/// Charts 4 and 5 of `g`.
-fn speedup_and_efficiency_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
+/// Charts 4 and 5 of `g`, with the core counts in `smt` shaded.
+fn speedup_and_efficiency_charts(
+    rows: &[SummaryRow],
+    g: &Group,
+    smt: Option<SmtBand>,
+    out: &mut ReportPlan,
+) {
     let subtitle = g.label(LabelStyle::Report);
+    let lines = series::speedup_lines(rows, g);
+    let keys: Vec<SeriesKey> = lines.iter().filter_map(|l| l.series).collect();
+    let styles = line_styles(&keys);
+    let shaded = smt.as_ref().map_or_else(String::new, |b| {
+        format!(
+            "; shaded: the core counts past the machine's {} that put threads on SMT \
+             siblings",
+            crate::output::console::plural(b.physical_cores, "physical core", "physical cores")
+        )
+    });
     out.chart(
         g,
         format!("{}-4-speedup.png", g.slug()),
         "Speedup against cores, every strategy".to_owned(),
         format!(
             "Chart 4: every strategy's best speedup against cores, error bars the 95 % \
-             bootstrap interval of the best cell's speedup; {subtitle}."
+             bootstrap interval of the best cell's speedup{styles}{shaded}; {subtitle}."
         ),
-        ChartKind::Speedup(series::speedup_lines(rows, g)),
+        ChartKind::Speedup {
+            lines,
+            smt: smt.clone(),
+        },
     );
     let (efficiency, serial) = series::efficiency_lines(rows, g);
+    let per_physical = if smt.is_some() {
+        " (the tables give the efficiency per physical core)"
+    } else {
+        ""
+    };
     out.chart(
         g,
         format!("{}-5-efficiency.png", g.slug()),
@@ -246,10 +314,31 @@ fn speedup_and_efficiency_charts(rows: &[SummaryRow], g: &Group, out: &mut Repor
         format!(
             "Chart 5: parallel efficiency S/p (above) and the Karp–Flatt serial fraction \
              e = (1/S − 1/p)/(1 − 1/p) (below, only where S > 1 and p > 1) against \
-             cores; {subtitle}."
+             cores{styles}{shaded}{per_physical}; {subtitle}."
         ),
-        ChartKind::Efficiency { efficiency, serial },
+        ChartKind::Efficiency {
+            efficiency,
+            serial,
+            smt,
+        },
     );
+}
+
+/// How a caption names the line styles of pinned series among `keys` (nothing where every
+/// series is unpinned): `; solid: unpinned, dashed: pinned spread`.
+fn line_styles(keys: &[SeriesKey]) -> String {
+    let pins: std::collections::BTreeSet<Pin> = keys.iter().map(|k| k.pin).collect();
+    if pins.iter().all(|&p| p == Pin::None) {
+        return String::new();
+    }
+    let parts: Vec<String> = pins
+        .iter()
+        .map(|&p| match p {
+            Pin::None => "solid: unpinned (`--pin none`)".to_owned(),
+            pin => format!("{}: pinned `{pin}`", super::charts::Dash::of(pin).as_str()),
+        })
+        .collect();
+    format!("; {}", parts.join(", "))
 }
 
 /// Chart 6 of `preset`, or why it is not drawn.
@@ -296,7 +385,7 @@ mod tests {
             row(StrategyName::RayonChunks, 2, Some(5), 2.5),
             row(StrategyName::RayonChunks, 2, Some(10), 2.2),
         ];
-        let p = plan(&rows);
+        let p = plan(&rows, |_| None);
         assert_eq!(
             files(&p),
             [
@@ -322,12 +411,103 @@ mod tests {
     }
 
     #[test]
+    fn a_pinned_placement_gets_its_own_chunks_charts_and_dashed_lines_in_charts_three_to_five() {
+        use crate::report::series::tests::pinned;
+        let rows = vec![
+            row(StrategyName::Seq, 1, None, 4.0),
+            row(StrategyName::RayonChunks, 1, Some(5), 4.1),
+            row(StrategyName::RayonChunks, 2, Some(5), 2.5),
+            pinned(row(StrategyName::RayonChunks, 1, Some(5), 4.0), Pin::Spread),
+            pinned(row(StrategyName::RayonChunks, 2, Some(5), 2.1), Pin::Spread),
+        ];
+        let p = plan(&rows, |_| None);
+        assert_eq!(
+            files(&p),
+            [
+                "seed-all-pairs-n60-s3-1-runtime-vs-chunks-rayon-chunks.png",
+                "seed-all-pairs-n60-s3-2-cpu-vs-chunks-rayon-chunks.png",
+                "seed-all-pairs-n60-s3-1-runtime-vs-chunks-rayon-chunks-pin-spread.png",
+                "seed-all-pairs-n60-s3-2-cpu-vs-chunks-rayon-chunks-pin-spread.png",
+                "seed-all-pairs-n60-s3-3-best-rayon-chunks.png",
+                "seed-all-pairs-n60-s3-4-speedup.png",
+                "seed-all-pairs-n60-s3-5-efficiency.png",
+            ]
+        );
+        assert_eq!(
+            p.charts[2].title,
+            "Runtime against chunks: rayon-chunks (spread)"
+        );
+        let ChartKind::Best(best) = &p.charts[4].kind else {
+            panic!("chart 3")
+        };
+        let labels: Vec<&str> = best.speedup.iter().map(|l| l.label.as_str()).collect();
+        assert_eq!(labels, ["rayon-chunks", "rayon-chunks (spread)"]);
+        assert_eq!(best.runtime[1].points[1].y, 2.1);
+        let ChartKind::Speedup { lines, smt } = &p.charts[5].kind else {
+            panic!("chart 4")
+        };
+        assert_eq!(lines.len(), 2);
+        assert_eq!(lines[1].pin(), Pin::Spread);
+        assert_eq!(*smt, None);
+        for c in &p.charts[4..] {
+            assert!(
+                c.caption
+                    .contains("; solid: unpinned (`--pin none`), dashed: pinned `spread`"),
+                "{}",
+                c.caption
+            );
+        }
+    }
+
+    #[test]
+    fn core_counts_on_smt_siblings_are_shaded_in_charts_four_and_five_only() {
+        let rows = vec![
+            row(StrategyName::Seq, 1, None, 4.0),
+            row(StrategyName::RayonIter, 1, None, 4.0),
+            row(StrategyName::RayonIter, 2, None, 2.5),
+        ];
+        let smt = Topology {
+            logical_cpus: 2,
+            physical_cores: Some(1),
+            threads_per_core: Some(2),
+            ..Topology::default()
+        };
+        let p = plan(&rows, |_| Some(&smt));
+        let band = |k: &ChartKind| match k {
+            ChartKind::Speedup { smt, .. } | ChartKind::Efficiency { smt, .. } => smt.clone(),
+            _ => None,
+        };
+        let bands: Vec<Option<SmtBand>> = p.charts.iter().map(|c| band(&c.kind)).collect();
+        let shaded = Some(SmtBand {
+            physical_cores: 1,
+            to: 2,
+            cores: vec![2],
+        });
+        assert_eq!(bands, [None, shaded.clone(), shaded]);
+        assert!(p.charts[1].caption.contains(
+            "shaded: the core counts past the machine's 1 physical core that put threads \
+             on SMT siblings"
+        ));
+        assert!(p.charts[2].caption.contains("efficiency per physical core"));
+        // Without a recorded topology, or one without siblings, nothing is shaded.
+        let flat = Topology {
+            logical_cpus: 2,
+            physical_cores: Some(2),
+            ..Topology::default()
+        };
+        for p in [plan(&rows, |_| None), plan(&rows, |_| Some(&flat))] {
+            assert!(p.charts.iter().all(|c| band(&c.kind).is_none()));
+            assert!(p.charts.iter().all(|c| !c.caption.contains("shaded")));
+        }
+    }
+
+    #[test]
     fn one_core_count_and_no_chunks_skip_their_charts_with_a_reason() {
         let rows = vec![
             row(StrategyName::Seq, 1, None, 4.0),
             row(StrategyName::RayonIter, 2, None, 2.0),
         ];
-        let p = plan(&rows);
+        let p = plan(&rows, |_| None);
         assert!(p.charts.is_empty(), "{:?}", files(&p));
         let notes: Vec<&str> = p.skipped.iter().map(|s| s.note.as_str()).collect();
         assert!(notes[0].contains("no strategy with chunks"), "{notes:?}");
@@ -340,7 +520,7 @@ mod tests {
             row(StrategyName::RayonIter, 2, None, 2.0),
             row(StrategyName::RayonIter, 3, None, 1.5),
         ];
-        let p = plan(&rows);
+        let p = plan(&rows, |_| None);
         assert!(p.charts.is_empty());
         assert!(p.skipped[1].note.contains("no usable seq reference"));
     }
@@ -351,7 +531,7 @@ mod tests {
         let mut grid = row(StrategyName::Seq, 1, None, 1.0);
         grid.neighbors = NeighborMode::Grid;
         rows.push(grid);
-        let p = plan(&rows);
+        let p = plan(&rows, |_| None);
         assert_eq!(files(&p), ["seed-6-neighbors.png"]);
         assert_eq!(p.charts[0].group, None);
         assert!(matches!(&p.charts[0].kind, ChartKind::Neighbors(lines) if lines.len() == 2));

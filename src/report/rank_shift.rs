@@ -207,7 +207,12 @@ mod tests {
         let r = with_ci(row(s, 2, None, mean), mean - half, mean + half);
         (
             s,
-            series::best_per_cores(std::slice::from_ref(&r), &r.group(), s).remove(0),
+            series::best_per_cores(
+                std::slice::from_ref(&r),
+                &r.group(),
+                series::SeriesKey::unpinned(s),
+            )
+            .remove(0),
         )
     }
 

@@ -3,8 +3,12 @@
 //!
 //! Only cells with `status = ok` and a mean enter a series; failed cells are listed by the
 //! report instead. Times are seconds.
+//!
+//! A series is one strategy at one placement ([`SeriesKey`]): pinned and unpinned cells of a
+//! strategy (`sweep --pin`) are never pooled into one line, one best cell or one table row.
 
 use std::collections::BTreeSet;
+use std::fmt;
 
 use crate::results::stats::Interval;
 
@@ -14,6 +18,7 @@ pub use crate::results::key::Group;
 use crate::results::rows::{Contended, SummaryRow, fastest};
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
+use crate::topology::{Pin, Topology};
 
 /// The groups of `rows`, in the order they first appear.
 pub fn groups(rows: &[SummaryRow]) -> Vec<Group> {
@@ -43,6 +48,75 @@ pub fn strategies(rows: &[SummaryRow], group: &Group) -> Vec<StrategyName> {
         }
     }
     out
+}
+
+/// One strategy's cells at one placement: what a line of the charts and a row of the tables
+/// are drawn from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct SeriesKey {
+    /// The strategy.
+    pub strategy: StrategyName,
+    /// Where its threads ran (`pin`).
+    pub pin: Pin,
+}
+
+impl SeriesKey {
+    /// `strategy` at placement `pin`.
+    pub fn new(strategy: StrategyName, pin: Pin) -> SeriesKey {
+        SeriesKey { strategy, pin }
+    }
+
+    /// `strategy`'s unpinned cells (`pin = none`).
+    pub fn unpinned(strategy: StrategyName) -> SeriesKey {
+        SeriesKey::new(strategy, Pin::None)
+    }
+
+    /// Whether a row belongs to the series (any group).
+    fn holds(&self, r: &SummaryRow) -> bool {
+        r.strategy == self.strategy && r.pin == self.pin
+    }
+}
+
+/// `rayon-chunks` unpinned, `rayon-chunks (spread)` pinned: legends, tables and findings.
+impl fmt::Display for SeriesKey {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.pin {
+            Pin::None => write!(f, "{}", self.strategy),
+            pin => write!(f, "{} ({pin})", self.strategy),
+        }
+    }
+}
+
+/// The placements `strategy` was measured at in `group`, `none` first, then `compact`,
+/// `spread`.
+pub fn pins(rows: &[SummaryRow], group: &Group, strategy: StrategyName) -> Vec<Pin> {
+    let set: BTreeSet<Pin> = rows
+        .iter()
+        .filter(|r| r.group() == *group && r.strategy == strategy)
+        .map(|r| r.pin)
+        .collect();
+    set.into_iter().collect()
+}
+
+/// The series of `group` (every strategy but `seq`): the strategies in the order they first
+/// appear, each at its placements in the order of [`pins`].
+pub fn series(rows: &[SummaryRow], group: &Group) -> Vec<SeriesKey> {
+    strategies(rows, group)
+        .into_iter()
+        .filter(|&s| s != StrategyName::Seq)
+        .flat_map(|s| {
+            pins(rows, group, s)
+                .into_iter()
+                .map(move |p| SeriesKey::new(s, p))
+        })
+        .collect()
+}
+
+/// Whether some cell of `group` was pinned (`seq` never is): the report then names each
+/// cell's placement.
+pub fn is_pinned(rows: &[SummaryRow], group: &Group) -> bool {
+    rows.iter()
+        .any(|r| r.group() == *group && r.pin != Pin::None)
 }
 
 /// Whether `strategy` has cells with a chunks value in `group`.
@@ -108,9 +182,26 @@ pub struct Line {
     pub label: String,
     /// Points by increasing x.
     pub points: Vec<Point>,
+    /// The strategy and placement it shows, where it shows one (its colour and line style);
+    /// `None` for lines of core counts or neighbour searches.
+    pub series: Option<SeriesKey>,
 }
 
 impl Line {
+    /// A line that shows no series (see [`Line::series`]).
+    pub fn new(label: impl Into<String>, points: Vec<Point>) -> Line {
+        Line {
+            label: label.into(),
+            points,
+            series: None,
+        }
+    }
+
+    /// The placement of its series (`none` for a line without one): how it is dashed.
+    pub fn pin(&self) -> Pin {
+        self.series.map_or(Pin::None, |k| k.pin)
+    }
+
     /// The index of the lowest point (the first one on ties).
     pub fn min_index(&self) -> Option<usize> {
         (0..self.points.len()).min_by(|&a, &b| self.points[a].y.total_cmp(&self.points[b].y))
@@ -131,12 +222,12 @@ pub enum Metric {
     Cpu,
 }
 
-/// One line per core count: `metric` against chunks, for a chunked `strategy` in `group`
-/// (Figures 7 and 8 of the paper).
+/// One line per core count: `metric` against chunks, for the series `key` of a chunked
+/// strategy in `group` (Figures 7 and 8 of the paper).
 pub fn chunk_lines(
     rows: &[SummaryRow],
     group: &Group,
-    strategy: StrategyName,
+    key: SeriesKey,
     metric: Metric,
 ) -> Vec<Line> {
     let ok = ok_rows(rows, group);
@@ -144,7 +235,7 @@ pub fn chunk_lines(
     for c in cores(rows, group) {
         let mut points: Vec<Point> = ok
             .iter()
-            .filter(|r| r.strategy == strategy && r.cores == c)
+            .filter(|r| key.holds(r) && r.cores == c)
             .filter_map(|r| {
                 let x = r.chunks? as f64;
                 let (y, lo, hi) = match metric {
@@ -175,10 +266,7 @@ pub fn chunk_lines(
             continue;
         }
         points.sort_by(|a, b| a.x.total_cmp(&b.x));
-        out.push(Line {
-            label: cores_label(c),
-            points,
-        });
+        out.push(Line::new(cores_label(c), points));
     }
     out
 }
@@ -195,6 +283,8 @@ pub struct Best {
     pub cores: usize,
     /// Chunks of the fastest cell (`None` for strategies without chunks).
     pub chunks: Option<usize>,
+    /// Where its threads ran.
+    pub pin: Pin,
     /// Mean wall seconds.
     pub mean_s: f64,
     /// Sample standard deviation (`None` for one trial).
@@ -218,43 +308,47 @@ pub struct Best {
 }
 
 impl Best {
+    /// A usable cell's numbers (`None` without a mean).
+    pub fn of(r: &SummaryRow) -> Option<Best> {
+        let mean_s = r.mean_s?;
+        Some(Best {
+            cores: r.cores,
+            chunks: r.chunks,
+            pin: r.pin,
+            mean_s,
+            stddev_s: r.stddev_s,
+            min_s: r.min_s.unwrap_or(mean_s),
+            max_s: r.max_s.unwrap_or(mean_s),
+            speedup: r.speedup,
+            efficiency: r.efficiency,
+            oversubscribed: r.oversubscribed,
+            mean_ci: interval(r.mean_ci_low_s, r.mean_ci_high_s),
+            speedup_ci: interval(r.speedup_ci_low, r.speedup_ci_high),
+            contended: r.contended == Some(true),
+        })
+    }
+
     /// The Karp–Flatt serial fraction at this cell (see [`karp_flatt`]).
     pub fn serial_fraction(&self) -> Option<f64> {
         karp_flatt(self.speedup?, self.cores)
     }
 }
 
-/// The fastest usable cell of `strategy` in `group` at each core count, by cores.
-pub fn best_per_cores(rows: &[SummaryRow], group: &Group, strategy: StrategyName) -> Vec<Best> {
+/// The fastest usable cell of the series `key` in `group` at each core count, by cores.
+pub fn best_per_cores(rows: &[SummaryRow], group: &Group, key: SeriesKey) -> Vec<Best> {
     let ok = ok_rows(rows, group);
     let mut set: BTreeSet<usize> = BTreeSet::new();
-    for r in ok.iter().filter(|r| r.strategy == strategy) {
+    for r in ok.iter().filter(|r| key.holds(r)) {
         set.insert(r.cores);
     }
     set.into_iter()
         .filter_map(|c| {
             // The fastest trustworthy cell; a contended one only when all of them are.
             let r = fastest(
-                ok.iter()
-                    .copied()
-                    .filter(|r| r.strategy == strategy && r.cores == c),
+                ok.iter().copied().filter(|r| key.holds(r) && r.cores == c),
                 Contended::LastResort,
             )?;
-            let mean_s = r.mean_s?;
-            Some(Best {
-                cores: c,
-                chunks: r.chunks,
-                mean_s,
-                stddev_s: r.stddev_s,
-                min_s: r.min_s.unwrap_or(mean_s),
-                max_s: r.max_s.unwrap_or(mean_s),
-                speedup: r.speedup,
-                efficiency: r.efficiency,
-                oversubscribed: r.oversubscribed,
-                mean_ci: interval(r.mean_ci_low_s, r.mean_ci_high_s),
-                speedup_ci: interval(r.speedup_ci_low, r.speedup_ci_high),
-                contended: r.contended == Some(true),
-            })
+            Best::of(r)
         })
         .collect()
 }
@@ -277,17 +371,16 @@ pub fn karp_flatt(speedup: f64, p: usize) -> Option<f64> {
     Some((1.0 / speedup - 1.0 / p) / (1.0 - 1.0 / p))
 }
 
-/// Best lines per strategy for `group` (every strategy but `seq`): speedup against cores,
-/// with the best cell's 95 % interval of the speedup.
+/// Best lines per series of `group` ([`series`]: every strategy but `seq`, at each of its
+/// placements): speedup against cores, with the best cell's 95 % interval of the speedup.
 pub fn speedup_lines(rows: &[SummaryRow], group: &Group) -> Vec<Line> {
     let Some(seq) = seq_mean(rows, group) else {
         return Vec::new();
     };
-    strategies(rows, group)
+    series(rows, group)
         .into_iter()
-        .filter(|&s| s != StrategyName::Seq)
-        .filter_map(|s| {
-            let points: Vec<Point> = best_per_cores(rows, group, s)
+        .filter_map(|key| {
+            let points: Vec<Point> = best_per_cores(rows, group, key)
                 .iter()
                 .map(|b| {
                     let y = seq / b.mean_s;
@@ -302,17 +395,19 @@ pub fn speedup_lines(rows: &[SummaryRow], group: &Group) -> Vec<Line> {
                 })
                 .collect();
             (!points.is_empty()).then_some(Line {
-                label: s.to_string(),
+                label: key.to_string(),
                 points,
+                series: Some(key),
             })
         })
         .collect()
 }
 
-/// Best runtime against cores for one strategy (bars: 95 % interval of the mean).
-pub fn runtime_line(best: &[Best], label: &str) -> Line {
+/// Best runtime against cores for one series (bars: 95 % interval of the mean).
+pub fn runtime_line(best: &[Best], key: SeriesKey) -> Line {
     Line {
-        label: label.to_owned(),
+        label: key.to_string(),
+        series: Some(key),
         points: best
             .iter()
             .map(|b| Point {
@@ -344,6 +439,7 @@ pub fn efficiency_lines(rows: &[SummaryRow], group: &Group) -> (Vec<Line>, Vec<L
         eff.push(Line {
             label: line.label.clone(),
             points: line.points.iter().map(|p| point(p, p.y / p.x)).collect(),
+            series: line.series,
         });
         let k: Vec<Point> = line
             .points
@@ -355,6 +451,7 @@ pub fn efficiency_lines(rows: &[SummaryRow], group: &Group) -> (Vec<Line>, Vec<L
             kf.push(Line {
                 label: line.label,
                 points: k,
+                series: line.series,
             });
         }
     }
@@ -425,7 +522,7 @@ pub fn neighbor_lines(rows: &[SummaryRow], preset: Preset) -> Option<Vec<Line>> 
         ] {
             points.sort_by(|a, b| a.x.total_cmp(&b.x));
             if !points.is_empty() {
-                lines.push(Line { label, points });
+                lines.push(Line::new(label, points));
             }
         }
     }
@@ -459,12 +556,12 @@ pub fn chunking_stops_paying(line: &[ChunkCell]) -> Option<usize> {
         .map(|i| line[i].0)
 }
 
-/// The chunks lines of a strategy in a form for [`chunking_stops_paying`]: per core count,
+/// The chunks lines of a series in a form for [`chunking_stops_paying`]: per core count,
 /// `(cores, [(chunks, mean, stddev)])`.
 pub fn chunk_table(
     rows: &[SummaryRow],
     group: &Group,
-    strategy: StrategyName,
+    key: SeriesKey,
 ) -> Vec<(usize, Vec<ChunkCell>)> {
     let ok = ok_rows(rows, group);
     cores(rows, group)
@@ -472,7 +569,7 @@ pub fn chunk_table(
         .map(|c| {
             let mut v: Vec<ChunkCell> = ok
                 .iter()
-                .filter(|r| r.strategy == strategy && r.cores == c)
+                .filter(|r| key.holds(r) && r.cores == c)
                 .filter(|r| r.contended != Some(true))
                 .filter_map(|r| Some((r.chunks?, r.mean_s?, r.stddev_s.unwrap_or(0.0))))
                 .collect();
@@ -483,8 +580,50 @@ pub fn chunk_table(
         .collect()
 }
 
+/// The core counts of a group whose threads outnumber the machine's physical cores but not
+/// its logical CPUs ([`Topology::is_smt`]): there, threads share physical cores as SMT
+/// siblings. The charts shade the core counts past `physical_cores` up to `to`; the tables
+/// add the efficiency per physical core.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SmtBand {
+    /// The machine's physical cores (of the CPUs the sweep could use): the band starts here.
+    pub physical_cores: usize,
+    /// The band's end: the most cores measured, at most the logical CPUs.
+    pub to: usize,
+    /// The measured core counts in the band, ascending.
+    pub cores: Vec<usize>,
+}
+
+impl SmtBand {
+    /// Speedup `s` at `cores` over the physical cores those threads had at most:
+    /// `S / min(cores, physical cores)`, equal to `S / cores` below the band.
+    pub fn physical_efficiency(&self, speedup: f64, cores: usize) -> f64 {
+        speedup / cores.min(self.physical_cores).max(1) as f64
+    }
+}
+
+/// Where `topology` says some of the measured `cores` put threads on SMT siblings, the band
+/// that shows them; `None` where none does or the physical cores are unknown.
+pub fn smt_band(topology: &Topology, cores: &[usize]) -> Option<SmtBand> {
+    let physical_cores = topology.physical_cores?;
+    let smt: Vec<usize> = cores
+        .iter()
+        .copied()
+        .filter(|&c| topology.is_smt(c) == Some(true))
+        .collect::<BTreeSet<usize>>()
+        .into_iter()
+        .collect();
+    let last = *smt.last()?;
+    let most = cores.iter().copied().max().unwrap_or(last);
+    Some(SmtBand {
+        physical_cores,
+        to: most.min(topology.logical_cpus).max(last),
+        cores: smt,
+    })
+}
+
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::results::rows::Status;
     use crate::results::rows::tests::row;
@@ -518,7 +657,7 @@ mod tests {
     fn the_best_cell_per_cores_is_the_fastest_usable_one() {
         let rows = sample();
         let g = rows[0].group();
-        let best = best_per_cores(&rows, &g, StrategyName::RayonChunks);
+        let best = best_per_cores(&rows, &g, SeriesKey::unpinned(StrategyName::RayonChunks));
         assert_eq!(best.len(), 2);
         assert_eq!(
             (best[0].cores, best[0].chunks, best[0].mean_s),
@@ -535,13 +674,23 @@ mod tests {
     fn chunk_lines_have_one_line_per_cores_sorted_by_chunks_with_their_minimum() {
         let rows = sample();
         let g = rows[0].group();
-        let lines = chunk_lines(&rows, &g, StrategyName::RayonChunks, Metric::Wall);
+        let lines = chunk_lines(
+            &rows,
+            &g,
+            SeriesKey::unpinned(StrategyName::RayonChunks),
+            Metric::Wall,
+        );
         assert_eq!(lines.len(), 2);
         assert_eq!(lines[0].label, "1 core");
         assert_eq!(lines[0].points[0].x, 5.0);
         assert_eq!(lines[0].min_index(), Some(0));
         assert_eq!(lines[1].min_index(), Some(1));
-        let cpu = chunk_lines(&rows, &g, StrategyName::RayonChunks, Metric::Cpu);
+        let cpu = chunk_lines(
+            &rows,
+            &g,
+            SeriesKey::unpinned(StrategyName::RayonChunks),
+            Metric::Cpu,
+        );
         assert_eq!(cpu[1].points[1].y, 4.4);
     }
 
@@ -591,5 +740,117 @@ mod tests {
         assert_eq!(lines[0].label, "all-pairs, seq (1 core)");
         assert_eq!(lines[0].points[0].y, 4.0 / 3.0);
         assert_eq!(lines[1].points[0].y, 2.0 / 3.0);
+    }
+
+    /// `r` placed by `pin`.
+    pub(crate) fn pinned(mut r: SummaryRow, pin: Pin) -> SummaryRow {
+        r.pin = pin;
+        r
+    }
+
+    #[test]
+    fn pinned_cells_are_series_of_their_own_and_never_a_strategys_best_cell() {
+        use StrategyName::{RayonChunks, RayonIter};
+        let rows = vec![
+            row(StrategyName::Seq, 1, None, 4.0),
+            row(RayonChunks, 2, Some(10), 2.2),
+            // Faster, but pinned: not the unpinned series' best cell.
+            pinned(row(RayonChunks, 2, Some(10), 1.9), Pin::Spread),
+            pinned(row(RayonChunks, 2, Some(5), 2.0), Pin::Compact),
+            pinned(row(RayonChunks, 1, Some(5), 4.1), Pin::Spread),
+            row(RayonIter, 2, None, 2.0),
+        ];
+        let g = rows[0].group();
+        assert_eq!(
+            series(&rows, &g),
+            [
+                SeriesKey::unpinned(RayonChunks),
+                SeriesKey::new(RayonChunks, Pin::Compact),
+                SeriesKey::new(RayonChunks, Pin::Spread),
+                SeriesKey::unpinned(RayonIter),
+            ]
+        );
+        assert!(is_pinned(&rows, &g));
+        assert!(!is_pinned(&rows[..2], &g));
+        let none = best_per_cores(&rows, &g, SeriesKey::unpinned(RayonChunks));
+        assert_eq!(none.len(), 1);
+        assert_eq!((none[0].mean_s, none[0].pin), (2.2, Pin::None));
+        let spread = best_per_cores(&rows, &g, SeriesKey::new(RayonChunks, Pin::Spread));
+        assert_eq!(
+            spread
+                .iter()
+                .map(|b| (b.cores, b.mean_s))
+                .collect::<Vec<_>>(),
+            [(1, 4.1), (2, 1.9)]
+        );
+
+        let lines = speedup_lines(&rows, &g);
+        let labels: Vec<&str> = lines.iter().map(|l| l.label.as_str()).collect();
+        assert_eq!(
+            labels,
+            [
+                "rayon-chunks",
+                "rayon-chunks (compact)",
+                "rayon-chunks (spread)",
+                "rayon-iter"
+            ]
+        );
+        let pins: Vec<Pin> = lines.iter().map(Line::pin).collect();
+        assert_eq!(pins, [Pin::None, Pin::Compact, Pin::Spread, Pin::None]);
+        assert_eq!(lines[0].points[0].y, 4.0 / 2.2);
+        assert_eq!(lines[2].points[1].y, 4.0 / 1.9);
+        let (eff, _) = efficiency_lines(&rows, &g);
+        assert_eq!(eff[2].series, lines[2].series);
+
+        // A chunks chart per placement: the spread one holds only spread cells.
+        let wall = chunk_lines(
+            &rows,
+            &g,
+            SeriesKey::new(RayonChunks, Pin::Spread),
+            Metric::Wall,
+        );
+        let ys: Vec<f64> = wall
+            .iter()
+            .flat_map(|l| l.points.iter().map(|p| p.y))
+            .collect();
+        assert_eq!(ys, [4.1, 1.9]);
+        assert!(wall.iter().all(|l| l.series.is_none()));
+    }
+
+    #[test]
+    fn the_smt_band_holds_the_core_counts_past_the_physical_cores_up_to_the_logical_cpus() {
+        let t = Topology {
+            logical_cpus: 8,
+            physical_cores: Some(4),
+            threads_per_core: Some(2),
+            ..Topology::default()
+        };
+        let band = smt_band(&t, &[1, 2, 4, 6, 8, 10]).unwrap();
+        assert_eq!(
+            band,
+            SmtBand {
+                physical_cores: 4,
+                to: 8,
+                cores: vec![6, 8],
+            }
+        );
+        // S / min(p, 4): the same as S / p up to the physical cores.
+        assert_eq!(band.physical_efficiency(3.0, 2), 1.5);
+        assert_eq!(band.physical_efficiency(5.0, 8), 1.25);
+        // No core count past the physical cores, or only past the logical CPUs: no band.
+        assert_eq!(smt_band(&t, &[1, 2, 4]), None);
+        assert_eq!(smt_band(&t, &[4, 9]), None);
+        // One thread per core (no siblings), or unknown cores: no band.
+        let flat = Topology {
+            logical_cpus: 2,
+            physical_cores: Some(2),
+            ..Topology::default()
+        };
+        assert_eq!(smt_band(&flat, &[1, 2]), None);
+        let unknown = Topology {
+            logical_cpus: 8,
+            ..Topology::default()
+        };
+        assert_eq!(smt_band(&unknown, &[1, 8]), None);
     }
 }

@@ -8,7 +8,9 @@
 //! with the same neighbour search whose N is nearest (by absolute difference; then the nearest
 //! step count; then the first listed), and at every core count measured in both the strategies
 //! are ranked by their best cell there ([`series::best_per_cores`]: the lowest mean, a
-//! contended cell only where a strategy has nothing else, the rule of the report's tables). [`super::rank_shift::rank_shift`] decides what
+//! contended cell only where a strategy has nothing else, the rule of the report's tables),
+//! of its unpinned cells (`pin = none`: placements are compared in the groups' own
+//! sections). [`super::rank_shift::rank_shift`] decides what
 //! the intervals support; [`markdown`] writes the section.
 //!
 //! [`section`] is pure: rows in, [`Section`] out; `None` when the rows lack either workload,
@@ -134,7 +136,7 @@ fn entries(rows: &[SummaryRow], g: &Group, cores: usize) -> Vec<Entry> {
         .into_iter()
         .filter(|&s| s != StrategyName::Seq)
         .filter_map(|s| {
-            let best = series::best_per_cores(rows, g, s);
+            let best = series::best_per_cores(rows, g, series::SeriesKey::unpinned(s));
             Some((s, best.into_iter().find(|b| b.cores == cores)?))
         })
         .collect();

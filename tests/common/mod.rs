@@ -191,6 +191,16 @@ pub fn names(dir: &Path) -> Vec<String> {
     v
 }
 
+/// A PNG's (width, height) in pixels, decoding the whole image; fails the test if it does not
+/// decode.
+pub fn png_size(path: &Path) -> (u32, u32) {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().expect("a PNG header");
+    let mut buf = vec![0; reader.output_buffer_size().expect("a buffer size")];
+    let info = reader.next_frame(&mut buf).expect("the PNG decodes");
+    (info.width, info.height)
+}
+
 /// The number in `row`'s `column`; fails the test, showing the row, if it is not one.
 pub fn num(row: &Row, column: &str) -> f64 {
     row[column]

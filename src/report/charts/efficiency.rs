@@ -1,6 +1,7 @@
 //! Chart 5: parallel efficiency `S / p` (above) and the Karp–Flatt serial fraction
 //! `e = (1/S − 1/p) / (1 − 1/p)` (below, from 2 cores and only where S > 1) against cores, one
-//! line per strategy; the serial-fraction axis is clipped to [−0.5, 1] and says when it clips.
+//! line per strategy and placement; the serial-fraction axis is clipped to [−0.5, 1] and says
+//! when it clips. Core counts on SMT siblings are shaded in both panels.
 
 use std::path::Path;
 
@@ -8,42 +9,48 @@ use plotters::prelude::*;
 
 use super::{
     Area, DrawResult, LegendEntry, Mark, cores_panel, cores_range, draw_dashed, draw_line,
-    oversubscribed_entry, strategy_color, y_max,
+    draw_smt_band, line_color, oversubscribed_entry, series_entry, smt_entry, y_max,
 };
-use crate::report::series::Line;
+use crate::report::series::{Line, SmtBand};
 
-/// Draws efficiency and serial-fraction lines into `path`.
+/// Draws efficiency and serial-fraction lines into `path`, `smt` shaded.
 pub fn draw(
     path: &Path,
     title: &str,
     subtitle: &str,
-    efficiency: &[Line],
-    serial: &[Line],
+    (efficiency, serial): (&[Line], &[Line]),
+    smt: Option<&SmtBand>,
 ) -> anyhow::Result<()> {
-    let mut legend: Vec<LegendEntry> = efficiency
-        .iter()
-        .map(|l| LegendEntry::new(l.label.clone(), Mark::Line(strategy_color(&l.label))))
-        .collect();
+    let mut legend: Vec<LegendEntry> = efficiency.iter().map(series_entry).collect();
     legend.push(LegendEntry::new(
         "ideal: efficiency 1,\nserial fraction 0",
         Mark::Dashed(RGBColor(90, 90, 90)),
     ));
     legend.extend(oversubscribed_entry(efficiency));
+    legend.extend(smt_entry(smt));
     super::render(path, title, subtitle, &legend, |area| {
-        plot(area, efficiency, serial)
+        plot(area, efficiency, serial, smt)
     })
 }
 
-fn plot(area: &Area<'_>, efficiency: &[Line], serial: &[Line]) -> DrawResult {
+fn plot(
+    area: &Area<'_>,
+    efficiency: &[Line],
+    serial: &[Line],
+    smt: Option<&SmtBand>,
+) -> DrawResult {
     let (top, bottom) = area.split_vertically(area.dim_in_pixel().1 / 2);
     let grey = RGBColor(90, 90, 90);
     let (x0, x1) = cores_range(efficiency);
 
     let y1 = y_max(efficiency).max(1.0) * 1.1;
     let mut ch = cores_panel(&top, (x0, x1), 0f64..y1, 70, "efficiency S / p")?;
+    if let Some(band) = smt {
+        draw_smt_band(&mut ch, band, (x0, x1), (0.0, y1))?;
+    }
     draw_dashed(&mut ch, vec![(x0, 1.0), (x1, 1.0)], grey)?;
     for line in efficiency {
-        draw_line(&mut ch, line, strategy_color(&line.label), false)?;
+        draw_line(&mut ch, line, line_color(line), false)?;
     }
 
     // The axis is clipped to [SERIAL_MIN, 1] so one pathological strategy cannot stretch
@@ -65,9 +72,12 @@ fn plot(area: &Area<'_>, efficiency: &[Line], serial: &[Line]) -> DrawResult {
         70,
         "serial fraction e",
     )?;
+    if let Some(band) = smt {
+        draw_smt_band(&mut ch, band, (x0, x1), (lo - pad, hi + pad))?;
+    }
     draw_dashed(&mut ch, vec![(x0, 0.0), (x1, 0.0)], grey)?;
     for line in serial {
-        draw_line(&mut ch, line, strategy_color(&line.label), false)?;
+        draw_line(&mut ch, line, line_color(line), false)?;
     }
     if any_clipped {
         let style = TextStyle::from((crate::plot::font::FAMILY, 14).into_font())

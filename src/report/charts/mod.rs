@@ -2,6 +2,9 @@
 //! [`super::series`]. Every chart is a PNG of [`WIDTH`] × [`HEIGHT`] pixels in the bundled
 //! font, with its legend in a panel right of the plot so that it never covers data.
 //! Oversubscribed points (more threads than the machine has) are hollow; the legend says so.
+//! A strategy's lines keep its colour at every placement: solid unpinned, dashed pinned
+//! `spread`, dotted pinned `compact` ([`Dash`]). Core counts that put threads on SMT
+//! siblings are shaded ([`draw_smt_band`]).
 
 pub mod best;
 pub mod chunks;
@@ -17,8 +20,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::series::{Line, Point};
+use super::series::{Line, Point, SmtBand};
 use crate::plot::font;
+use crate::topology::Pin;
 
 /// Width of every chart, pixels (the results directory's schema knows it: a chart is
 /// recognised by its size).
@@ -103,11 +107,117 @@ pub fn strategy_color(name: &str) -> RGBColor {
     color(i)
 }
 
+/// A line's colour: its strategy's where it shows a series, else by its label (a strategy's
+/// name, or anything else, grey).
+pub fn line_color(line: &Line) -> RGBColor {
+    match line.series {
+        Some(key) => strategy_color(key.strategy.as_str()),
+        None => strategy_color(&line.label),
+    }
+}
+
+/// How a line's segments are drawn: by the placement of its series.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Dash {
+    /// Unbroken (unpinned, and every line without a series).
+    Solid,
+    /// Long dashes (pinned `spread`).
+    Dashed,
+    /// Short dashes, dots at this width (pinned `compact`).
+    Dotted,
+}
+
+impl Dash {
+    /// The style of a series at placement `pin`.
+    pub fn of(pin: Pin) -> Dash {
+        match pin {
+            Pin::None => Dash::Solid,
+            Pin::Spread => Dash::Dashed,
+            Pin::Compact => Dash::Dotted,
+        }
+    }
+
+    /// How captions name it.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Dash::Solid => "solid",
+            Dash::Dashed => "dashed",
+            Dash::Dotted => "dotted",
+        }
+    }
+
+    /// (dash, gap) in pixels; `None` for solid.
+    fn pattern(self) -> Option<(i32, i32)> {
+        match self {
+            Dash::Solid => None,
+            Dash::Dashed => Some((9, 5)),
+            Dash::Dotted => Some((3, 4)),
+        }
+    }
+}
+
+/// The legend entry of a line that shows a series: its label, in its colour and style.
+pub fn series_entry(line: &Line) -> LegendEntry {
+    LegendEntry::new(line.label.clone(), series_mark(line, line_color(line)))
+}
+
+/// The legend mark of `line` in colour `c`: a solid line with a dot, or the line's dashes.
+pub fn series_mark(line: &Line, c: RGBColor) -> Mark {
+    match Dash::of(line.pin()) {
+        Dash::Solid => Mark::Line(c),
+        dash => Mark::Styled(c, dash),
+    }
+}
+
+/// The colour of the SMT band, laid over the plot translucent so that the grid shows
+/// through.
+pub const SMT_FILL: RGBColor = RGBColor(255, 170, 60);
+/// The opacity of the SMT band.
+const SMT_ALPHA: f64 = 0.22;
+
+/// The legend entry of the SMT band, where there is one.
+pub fn smt_entry(band: Option<&SmtBand>) -> Option<LegendEntry> {
+    band.map(|_| {
+        LegendEntry::new(
+            "SMT siblings: more threads\nthan physical cores",
+            Mark::Band(SMT_FILL),
+        )
+    })
+}
+
+/// Shades the core counts past the physical cores up to `band.to`, from half a core past
+/// the physical cores to half a core past `band.to` (so that the shade holds exactly the
+/// points on SMT siblings), clipped to the x range `x0..x1`, over the y range `y0..y1`,
+/// behind whatever is drawn next.
+pub fn draw_smt_band<Y>(
+    chart: &mut ChartContext<'_, BitMapBackend<'_>, Cartesian2d<CoresAxis, Y>>,
+    band: &SmtBand,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> DrawResult
+where
+    Y: Ranged<ValueType = f64>,
+{
+    let from = (band.physical_cores as f64 + 0.5).clamp(x0, x1);
+    let to = (band.to as f64 + 0.5).clamp(x0, x1);
+    if to > from {
+        chart.draw_series(std::iter::once(Rectangle::new(
+            [(from, y0), (to, y1)],
+            SMT_FILL.mix(SMT_ALPHA).filled(),
+        )))?;
+    }
+    Ok(())
+}
+
 /// How a legend entry is drawn.
 #[derive(Debug, Clone, Copy)]
 pub enum Mark {
     /// A solid line with a filled dot.
     Line(RGBColor),
+    /// A dashed or dotted line with a filled dot (a pinned series).
+    Styled(RGBColor, Dash),
+    /// A translucent filled square (a shaded region).
+    Band(RGBColor),
     /// A dashed line.
     Dashed(RGBColor),
     /// A hollow dot (oversubscribed).
@@ -241,6 +351,22 @@ fn draw_legend(area: &Area<'_>, entries: &[LegendEntry]) -> DrawResult {
                         c.stroke_width(2),
                     ))?;
                 }
+            }
+            Mark::Styled(c, dash) => {
+                let (on, off) = dash.pattern().unwrap_or((x1 - x0, 0));
+                for s in (x0..x1).step_by((on + off) as usize) {
+                    area.draw(&PathElement::new(
+                        vec![(s, y), ((s + on).min(x1), y)],
+                        c.stroke_width(2),
+                    ))?;
+                }
+                area.draw(&Circle::new((cx, y), 4, c.filled()))?;
+            }
+            Mark::Band(c) => {
+                area.draw(&Rectangle::new(
+                    [(x0 + 6, y - 8), (x1 - 6, y + 8)],
+                    c.mix(SMT_ALPHA).filled(),
+                ))?;
             }
             Mark::Hollow(c) => area.draw(&Circle::new((cx, y), 5, c.stroke_width(2)))?,
             Mark::Ring => area.draw(&Circle::new((cx, y), 9, CONTENDED.stroke_width(2)))?,
@@ -385,8 +511,8 @@ impl Ranged for CoresAxis {
     }
 }
 
-/// A plotted line: segments, dots (hollow when oversubscribed) and, with `bars`, vertical
-/// error bars over the spread. `dashed` draws the segments dashed.
+/// A plotted line: segments (solid, or dashed or dotted as its placement says: [`Dash`]),
+/// dots (hollow when oversubscribed) and, with `bars`, vertical error bars over the spread.
 pub fn draw_line<X, Y>(
     chart: &mut ChartContext<'_, BitMapBackend<'_>, Cartesian2d<X, Y>>,
     line: &Line,
@@ -398,7 +524,14 @@ where
     Y: Ranged<ValueType = f64>,
 {
     let pts: Vec<(f64, f64)> = line.points.iter().map(|p| (p.x, p.y)).collect();
-    chart.draw_series(LineSeries::new(pts, c.stroke_width(2)))?;
+    match Dash::of(line.pin()).pattern() {
+        None => {
+            chart.draw_series(LineSeries::new(pts, c.stroke_width(2)))?;
+        }
+        Some((on, off)) => {
+            chart.draw_series(DashedLineSeries::new(pts, on, off, c.stroke_width(2)))?;
+        }
+    }
     if bars {
         chart.draw_series(
             line.points

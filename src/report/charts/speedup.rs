@@ -1,5 +1,6 @@
 //! Chart 4: every strategy's best speedup against cores, error bars the 95 % bootstrap interval of
-//! the best cell (`T_seq / slowest` to `T_seq / fastest`), with the ideal `S = p`.
+//! the best cell (`T_seq / slowest` to `T_seq / fastest`), with the ideal `S = p`; one line per
+//! strategy and placement, and the core counts on SMT siblings shaded.
 
 use std::path::Path;
 
@@ -7,16 +8,20 @@ use plotters::prelude::*;
 
 use super::{
     Area, CoresAxis, DrawResult, LegendEntry, Mark, axis_styles, cores_range, draw_dashed,
-    draw_line, integer_label, oversubscribed_entry, strategy_color, tick_label, y_max,
+    draw_line, draw_smt_band, integer_label, line_color, oversubscribed_entry, series_entry,
+    smt_entry, tick_label, y_max,
 };
-use crate::report::series::Line;
+use crate::report::series::{Line, SmtBand};
 
-/// Draws `lines` (one per strategy) into `path`.
-pub fn draw(path: &Path, title: &str, subtitle: &str, lines: &[Line]) -> anyhow::Result<()> {
-    let mut legend: Vec<LegendEntry> = lines
-        .iter()
-        .map(|l| LegendEntry::new(l.label.clone(), Mark::Line(strategy_color(&l.label))))
-        .collect();
+/// Draws `lines` (one per strategy and placement) into `path`, `smt` shaded.
+pub fn draw(
+    path: &Path,
+    title: &str,
+    subtitle: &str,
+    lines: &[Line],
+    smt: Option<&SmtBand>,
+) -> anyhow::Result<()> {
+    let mut legend: Vec<LegendEntry> = lines.iter().map(series_entry).collect();
     legend.push(LegendEntry::new(
         "ideal: S = p",
         Mark::Dashed(RGBColor(90, 90, 90)),
@@ -26,10 +31,13 @@ pub fn draw(path: &Path, title: &str, subtitle: &str, lines: &[Line]) -> anyhow:
         Mark::Line(BLACK),
     ));
     legend.extend(oversubscribed_entry(lines));
-    super::render(path, title, subtitle, &legend, |area| plot(area, lines))
+    legend.extend(smt_entry(smt));
+    super::render(path, title, subtitle, &legend, |area| {
+        plot(area, lines, smt)
+    })
 }
 
-fn plot(area: &Area<'_>, lines: &[Line]) -> DrawResult {
+fn plot(area: &Area<'_>, lines: &[Line], smt: Option<&SmtBand>) -> DrawResult {
     let (x0, x1) = cores_range(lines);
     let y1 = y_max(lines).max(x1 - 0.4) * 1.08;
     let mut chart = ChartBuilder::on(area)
@@ -48,13 +56,16 @@ fn plot(area: &Area<'_>, lines: &[Line]) -> DrawResult {
         .label_style(labels)
         .axis_desc_style(descs)
         .draw()?;
+    if let Some(band) = smt {
+        draw_smt_band(&mut chart, band, (x0, x1), (0.0, y1))?;
+    }
     draw_dashed(
         &mut chart,
         vec![(x0 + 0.4, x0 + 0.4), (x1 - 0.4, x1 - 0.4)],
         RGBColor(90, 90, 90),
     )?;
     for line in lines {
-        draw_line(&mut chart, line, strategy_color(&line.label), true)?;
+        draw_line(&mut chart, line, line_color(line), true)?;
     }
     Ok(())
 }

@@ -13,14 +13,16 @@
 //! Every value is each cores value's best cell ([`series::best_per_cores`], the report's one
 //! "best cell" rule: the lowest mean, a contended cell only where nothing else was measured)
 //! and its 95 % interval where the sweep recorded one; speedups are over each side's own
-//! `seq`.
+//! `seq`. Machines are compared on their unpinned cells (`pin = none`, where the operating
+//! system places the threads): placements (`sweep --pin`) are compared within each machine's
+//! own report.
 
 use sph_strategies::StrategyName;
 
 use super::sides::{Side, names};
 use crate::report::charts::compare::MachineLines;
 use crate::report::findings::{self, Entry, Verdict};
-use crate::report::series::{self, Best, Group, Line, Point};
+use crate::report::series::{self, Best, Group, Line, Point, SeriesKey};
 use crate::results::files::COMPARE_CHART_PREFIX;
 use crate::results::key::LabelStyle;
 use crate::results::rows::SummaryRow;
@@ -173,11 +175,11 @@ pub fn match_groups(per_side: &[Vec<Group>]) -> Matching {
     out
 }
 
-/// A strategy's best cell in a group over every cores value: the best cell of each cores
-/// value ([`series::best_per_cores`]), and of those the lowest mean, a contended one only
-/// where every one is.
+/// A strategy's best unpinned cell in a group over every cores value: the best cell of each
+/// cores value ([`series::best_per_cores`]), and of those the lowest mean, a contended one
+/// only where every one is.
 pub fn strategy_best(rows: &[SummaryRow], g: &Group, s: StrategyName) -> Option<Best> {
-    series::best_per_cores(rows, g, s)
+    series::best_per_cores(rows, g, SeriesKey::unpinned(s))
         .into_iter()
         .min_by(|a, b| {
             a.contended
@@ -383,7 +385,9 @@ fn compare(sides: &[Side<'_>], names: &[String], matched: Matched) -> Compared {
         let lines: Vec<MachineLines> = speedups
             .iter()
             .filter_map(|(i, lines)| {
-                let speedup = lines.iter().find(|l| l.label == s.as_str())?;
+                let speedup = lines
+                    .iter()
+                    .find(|l| l.series == Some(SeriesKey::unpinned(s)))?;
                 Some(MachineLines {
                     side: *i,
                     legend: wrap(&format!("{}: {}", sides[*i].tag, names[*i]), LEGEND_CHARS),
@@ -443,6 +447,7 @@ pub fn wrap(text: &str, width: usize) -> String {
 pub fn efficiency_of(speedup: &Line) -> Line {
     Line {
         label: speedup.label.clone(),
+        series: speedup.series,
         points: speedup
             .points
             .iter()
