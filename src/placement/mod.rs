@@ -116,11 +116,13 @@ impl Pinned {
         }
     }
 
+    /// Restores the saved mask; kept (for `Drop` to try again) if that fails.
     fn restore(&mut self) -> anyhow::Result<()> {
-        match self.restore.take() {
-            Some(mask) => os::set_current(&mask),
-            None => Ok(()),
+        if let Some(mask) = &self.restore {
+            os::set_current(mask)?;
+            self.restore = None;
         }
+        Ok(())
     }
 }
 

@@ -44,7 +44,9 @@ pub struct SweepParams {
     pub simd: Option<SimdPath>,
     /// Thread placements (`--pin`), each a cell dimension of every strategy but the `seq`
     /// reference (which runs unpinned); `["none"]` in directories written before `--pin`.
-    #[serde(default = "unpinned")]
+    /// Not written when it is `["none"]`, so that an unpinned sweep's `meta.json`, and the plan
+    /// fingerprint of shards written before `--pin`, stay as they were.
+    #[serde(default = "unpinned", skip_serializing_if = "is_unpinned")]
     pub pin: Vec<Pin>,
     /// Which part of the plan this sweep runs (`--shard I/K`); absent for the whole plan.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -60,6 +62,11 @@ pub struct SweepParams {
 /// `--pin`'s default, and what sweeps written before it ran: the operating system's placement.
 fn unpinned() -> Vec<Pin> {
     vec![Pin::None]
+}
+
+/// Whether `pin` is [`unpinned`]'s.
+fn is_unpinned(pin: &[Pin]) -> bool {
+    pin == [Pin::None]
 }
 
 impl SweepParams {

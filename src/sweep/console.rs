@@ -72,15 +72,16 @@ pub fn placement_note(
         ));
     }
     let widest = params.cores.iter().copied().max().unwrap_or(1);
+    let smt: Vec<String> = params
+        .cores
+        .iter()
+        .filter(|&&c| topology.is_smt(c) == Some(true))
+        .map(|c| c.to_string())
+        .collect();
     if let (Some(physical), Some(split)) = (topology.physical_cores, topology.split(widest))
         && split.siblings > 0
+        && !smt.is_empty()
     {
-        let smt: Vec<String> = params
-            .cores
-            .iter()
-            .filter(|&&c| topology.is_smt(c) == Some(true))
-            .map(|c| c.to_string())
-            .collect();
         lines.push(format!(
             "  this machine has {physical} physical cores and {} hardware threads: cores {} use \
              SMT siblings (smt=true in summary.csv); at {widest} cores, spread puts {} threads on \

@@ -121,7 +121,12 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
     let hardware_threads = machine.hardware_threads;
     let session = Session::start(request.command_line.clone(), machine);
     let mut opened = match &request.target {
-        Target::New { params, out, force } => start_new(params, out.as_deref(), *force, session)?,
+        Target::New { params, out, force } => {
+            // A placement the operating system refuses stops a new sweep before its directory
+            // is made.
+            check_placements(params)?;
+            start_new(params, out.as_deref(), *force, session)?
+        }
         Target::Resume { dir } => reopen(dir, session)?,
     };
     let params = opened.meta.params.clone();
@@ -139,10 +144,8 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
         params.fake_timings.as_deref(),
         params.fake_contention.as_deref(),
     )?;
-    // A placement the operating system refuses stops the sweep before anything runs.
-    for &pin in &params.pin {
-        crate::placement::placement(pin).context("cannot place the sweep's threads")?;
-    }
+    // A resumed sweep's placements, on this machine.
+    check_placements(&params)?;
     let plan = Plan::new(&params);
     let threshold = Threshold {
         hardware_threads,
@@ -191,6 +194,15 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
     };
     let outcome = measure(runner, &todo, &mut references)?;
     conclude(opened, plan, outcome.rows, outcome.interrupted)
+}
+
+/// Refuses, before anything runs, a placement of `params.pin` that the operating system
+/// refuses (see [`crate::placement`]).
+fn check_placements(params: &SweepParams) -> anyhow::Result<()> {
+    for &pin in &params.pin {
+        crate::placement::placement(pin).context("cannot place the sweep's threads")?;
+    }
+    Ok(())
 }
 
 /// Runs the cells `todo` under a progress bar measured in estimated milliseconds (see

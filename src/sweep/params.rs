@@ -162,6 +162,21 @@ mod tests {
     }
 
     #[test]
+    fn an_unpinned_plan_has_the_fingerprint_it_had_before_pin_existed() {
+        let p = example();
+        let json = serde_json::to_string(&p).unwrap();
+        assert!(!json.contains("\"pin\""), "{json}");
+        let mut pinned = example();
+        pinned.pin = vec![crate::topology::Pin::None, crate::topology::Pin::Spread];
+        assert!(
+            serde_json::to_string(&pinned)
+                .unwrap()
+                .contains("\"pin\":[\"none\",\"spread\"]")
+        );
+        assert_ne!(p.fingerprint(), pinned.fingerprint());
+    }
+
+    #[test]
     fn the_fingerprint_ignores_the_shard_and_nothing_else() {
         use crate::results::shard::Shard;
         let p = example();
