@@ -90,12 +90,7 @@ while getopts ':k:o:S:frnh' opt; do
 done
 shift $((OPTIND - 1))
 
-[[ -n "$OUT" ]] || die "-o RESULTS_DIR is required (try -h)"
-((!(FORCE && RESUME))) ||
-    die "-f and -r exclude each other: -f starts the sweep over, -r continues it"
-# Absolute: the hosts and the shards' meta.json see the same path.
-[[ "$OUT" == /* ]] || OUT="$PWD/$OUT"
-while [[ "$OUT" == */ && "$OUT" != / ]]; do OUT=${OUT%/}; done
+settle_plan "$@"
 if [[ -n "$HOSTS" ]]; then
     IFS=, read -r -a HOST_LIST <<<"$HOSTS"
     for host in "${HOST_LIST[@]}"; do
@@ -105,21 +100,6 @@ if [[ -n "$HOSTS" ]]; then
     done
 fi
 
-if ((RESUME)); then
-    [[ -z "$K" ]] || die "-r takes K from $OUT/$PLAN_FILE: leave out -k"
-    (($# == 0)) || die "-r takes the plan from $OUT/$PLAN_FILE: give no sweep options"
-    read_plan_file "$OUT"
-    MODE=resume
-else
-    [[ -n "$K" ]] || die "-k K is required (try -h)"
-    check_shard_count "$K" "-k"
-    SHARDS=$((10#$K))
-    PLAN=("$@")
-    check_plan "${PLAN[@]+"${PLAN[@]}"}"
-    check_results_dir "$OUT" "$FORCE" "$SHARDS"
-    MODE=new
-    if ((FORCE)); then MODE=force; fi
-fi
 CPUS=""
 if CORES=$(plan_value --cores "${PLAN[@]+"${PLAN[@]}"}"); then
     CPUS=$(max_cores "$CORES")

@@ -198,6 +198,34 @@ check_results_dir() {
     fi
 }
 
+# Settles the options both drivers share once getopts is done (OUT, K, FORCE, RESUME set; the
+# plan options in "$@"): OUT made absolute (the jobs and the shards' meta.json see one path),
+# -f and -r exclusive, and SHARDS, PLAN and MODE (new, force, resume) from -k and the plan
+# options, or from the plan file with -r.
+# shellcheck disable=SC2034,SC2153 # MODE is read by the drivers; they set FORCE, RESUME, K, OUT
+settle_plan() {
+    [[ -n "$OUT" ]] || die "-o RESULTS_DIR is required (try -h)"
+    ((!(FORCE && RESUME))) ||
+        die "-f and -r exclude each other: -f starts the sweep over, -r continues it"
+    [[ "$OUT" == /* ]] || OUT="$PWD/$OUT"
+    while [[ "$OUT" == */ && "$OUT" != / ]]; do OUT=${OUT%/}; done
+    if ((RESUME)); then
+        [[ -z "$K" ]] || die "-r takes K from $OUT/$PLAN_FILE: leave out -k"
+        (($# == 0)) || die "-r takes the plan from $OUT/$PLAN_FILE: give no sweep options"
+        read_plan_file "$OUT"
+        MODE=resume
+    else
+        [[ -n "$K" ]] || die "-k K is required (try -h)"
+        check_shard_count "$K" "-k"
+        SHARDS=$((10#$K))
+        PLAN=("$@")
+        check_plan "${PLAN[@]+"${PLAN[@]}"}"
+        check_results_dir "$OUT" "$FORCE" "$SHARDS"
+        MODE=new
+        if ((FORCE)); then MODE=force; fi
+    fi
+}
+
 # Writes the plan file of results directory $1: shard count $2, then the plan options, one a
 # line ($PLAN_DRIVER names the script that wrote it).
 write_plan_file() {

@@ -97,12 +97,7 @@ while getopts ':k:o:p:t:C:frnh' opt; do
 done
 shift $((OPTIND - 1))
 
-[[ -n "$OUT" ]] || die "-o RESULTS_DIR is required (try -h)"
-((!(FORCE && RESUME))) ||
-    die "-f and -r exclude each other: -f starts the sweep over, -r continues it"
-# Absolute: the jobs run elsewhere.
-[[ "$OUT" == /* ]] || OUT="$PWD/$OUT"
-while [[ "$OUT" == */ && "$OUT" != / ]]; do OUT=${OUT%/}; done
+settle_plan "$@"
 [[ -z "$PARTITION" || "$PARTITION" =~ ^[A-Za-z0-9_.,-]+$ ]] ||
     die "-p '$PARTITION' is not a partition name"
 TIME_RE='^([0-9]+-)?[0-9]+(:[0-9]+){0,2}$|^(UNLIMITED|INFINITE|unlimited|infinite)$'
@@ -114,21 +109,8 @@ MERGE_TIME=${MERGE_TIME:-30}
 
 JOB_BIN="$OUT/slurm/bench-sph"
 if ((RESUME)); then
-    [[ -z "$K" ]] || die "-r takes K from $OUT/$PLAN_FILE: leave out -k"
-    (($# == 0)) || die "-r takes the plan from $OUT/$PLAN_FILE: give no sweep options"
-    read_plan_file "$OUT"
     [[ -x "$JOB_BIN" ]] ||
         die "there is no '$JOB_BIN': -r continues a sweep that this script submitted"
-    MODE=resume
-else
-    [[ -n "$K" ]] || die "-k K is required (try -h)"
-    check_shard_count "$K" "-k"
-    SHARDS=$((10#$K))
-    PLAN=("$@")
-    check_plan "${PLAN[@]+"${PLAN[@]}"}"
-    check_results_dir "$OUT" "$FORCE" "$SHARDS"
-    MODE=new
-    if ((FORCE)); then MODE=force; fi
 fi
 CORES=$(plan_value --cores "${PLAN[@]+"${PLAN[@]}"}") ||
     die "give the plan's --cores: each task needs --cpus-per-task, and without --cores" \

@@ -80,15 +80,6 @@ fn copy_dir(from: &Path, to: &Path) {
     }
 }
 
-/// Edits `dir/meta.json` with `edit`.
-fn edit_meta(dir: &Path, edit: impl FnOnce(&mut serde_json::Value)) {
-    let path = dir.join("meta.json");
-    let mut meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-    edit(&mut meta);
-    std::fs::write(&path, serde_json::to_string_pretty(&meta).unwrap()).unwrap();
-}
-
 #[test]
 fn three_shards_run_one_after_another_merge_into_exactly_the_unsharded_plans_cells_and_trials() {
     let _alone = alone();
@@ -279,11 +270,8 @@ fn merging_refuses_shards_from_another_machine_or_another_build() {
 
     let elsewhere = tmp.path().join("elsewhere");
     copy_dir(&parts[1], &elsewhere);
-    edit_meta(&elsewhere, |m| {
-        m["machine"]["cpu_model"] = "Another CPU".into();
-        for s in m["sessions"].as_array_mut().unwrap() {
-            s["machine"]["cpu_model"] = "Another CPU".into();
-        }
+    set_in_meta(&elsewhere, |m| {
+        m["machine"]["cpu_model"] = "Another CPU".into()
     });
     let mixed = [parts[0].clone(), elsewhere, parts[2].clone()];
     merge_fails(
@@ -294,12 +282,7 @@ fn merging_refuses_shards_from_another_machine_or_another_build() {
 
     let rebuilt = tmp.path().join("rebuilt");
     copy_dir(&parts[1], &rebuilt);
-    edit_meta(&rebuilt, |m| {
-        m["git_commit"] = "0123456789ab".into();
-        for s in m["sessions"].as_array_mut().unwrap() {
-            s["git_commit"] = "0123456789ab".into();
-        }
-    });
+    set_in_meta(&rebuilt, |m| m["git_commit"] = "0123456789ab".into());
     let mixed = [parts[0].clone(), rebuilt, parts[2].clone()];
     merge_fails(&mixed, &out, &["0123456789ab", "different builds"]);
 }

@@ -40,14 +40,7 @@ fn sweep(dir: &Path, timings: &str, set: &[(&str, &str)]) {
 
 /// Makes the sweep in `dir` look measured on a machine whose CPU is `cpu`.
 fn move_to_machine(dir: &Path, cpu: &str) {
-    let path = dir.join("meta.json");
-    let mut meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-    meta["machine"]["cpu_model"] = cpu.into();
-    for s in meta["sessions"].as_array_mut().unwrap() {
-        s["machine"]["cpu_model"] = cpu.into();
-    }
-    std::fs::write(&path, serde_json::to_string_pretty(&meta).unwrap()).unwrap();
+    common::set_in_meta(dir, |m| m["machine"]["cpu_model"] = cpu.into());
 }
 
 /// The label of the machine in `dir`'s meta.json, as the report names it.

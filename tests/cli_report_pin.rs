@@ -50,14 +50,7 @@ fn set_topology(dir: &Path, physical: usize, threads: usize) {
         "governor": "performance",
         "turbo": null,
     });
-    let path = dir.join("meta.json");
-    let mut meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
-    meta["machine"]["topology"] = topology.clone();
-    for s in meta["sessions"].as_array_mut().unwrap() {
-        s["machine"]["topology"] = topology.clone();
-    }
-    std::fs::write(&path, serde_json::to_string_pretty(&meta).unwrap()).unwrap();
+    common::set_in_meta(dir, |m| m["machine"]["topology"] = topology.clone());
 
     let path = dir.join("summary.csv");
     let mut reader = csv::Reader::from_path(&path).unwrap();

@@ -151,26 +151,13 @@ mod tests {
     use crate::results::params::SweepParams;
     use crate::results::rows::Status;
     use crate::sph::neighbors::NeighborMode;
-    use crate::sph::params::Preset;
     use sph_strategies::StrategyName;
 
     fn params() -> SweepParams {
         SweepParams {
             strategies: vec![StrategyName::RayonChunks, StrategyName::StdStatic],
-            presets: vec![Preset::Seed],
             neighbors: vec![NeighborMode::Grid],
-            n: vec![60],
-            steps: 3,
-            cores: vec![1, 2],
-            chunks: vec![2, 5],
-            trials: 2,
-            warmup: 0,
-            seed: 1,
-            simd: None,
-            fake_timings: None,
-            fake_contention: None,
-            pin: vec![crate::topology::Pin::None],
-            shard: None,
+            ..SweepParams::small()
         }
     }
 

@@ -14,13 +14,12 @@
 pub mod assemble;
 pub mod check;
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
 use crate::output::console::plural;
-use crate::results::load::{read_summary, read_trials};
+use crate::results::load::{believed, read_summary, read_trials};
 use crate::results::meta::{Merge, MergedShard, Meta, SweepStatus};
 use crate::results::rows::{SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow};
 use crate::results::{LOCK_FILE, META_FILE, REFERENCES_FILE, SUMMARY_FILE, TRIALS_FILE};
@@ -169,25 +168,12 @@ fn read_shard(dir: &Path) -> anyhow::Result<Read> {
         .with_context(|| format!("cannot merge '{}'", dir.display()))?;
     let (trials, _) = read_trials(&dir.join(TRIALS_FILE))
         .with_context(|| format!("cannot merge '{}'", dir.display()))?;
-    let mut by_cell: HashMap<_, Vec<TrialRow>> = HashMap::new();
-    for t in trials {
-        by_cell.entry(t.key()).or_default().push(t);
-    }
-    let mut rows = Vec::new();
-    let mut kept = Vec::new();
-    for row in summary {
-        let mut of_cell = by_cell.remove(&row.key()).unwrap_or_default();
-        of_cell.sort_by_key(|t| t.trial);
-        if crate::results::validate::cell(&row, &of_cell).is_ok() {
-            kept.extend(of_cell);
-            rows.push(row);
-        }
-    }
+    let believed = believed(summary, Some(trials));
     Ok(Read {
         dir: dir.to_path_buf(),
         meta,
-        rows,
-        trials: kept,
+        rows: believed.rows,
+        trials: believed.trials,
         _lock: lock,
     })
 }

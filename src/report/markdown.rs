@@ -591,7 +591,7 @@ fn table(
         };
         let mut line = match ours {
             Some(b) => format!(
-                "| {}{}{} |{pin} {} | {}{} | {} | {} |{physical}",
+                "| {}{}{} |{pin} {} |{physical}",
                 b.cores,
                 if b.oversubscribed {
                     format!(" {OVERSUBSCRIBED}")
@@ -603,12 +603,7 @@ fn table(
                 } else {
                     String::new()
                 },
-                b.chunks.map_or_else(dash, |k| k.to_string()),
-                secs(b.mean_s),
-                interval(b.mean_ci),
-                b.speedup
-                    .map_or_else(dash, |s| format!("{}{}", times(s), interval(b.speedup_ci))),
-                b.efficiency.map_or_else(dash, sig),
+                best_cells(b),
             ),
             None => format!("| {c} |{pin} — | — | — | — |{physical}"),
         };
@@ -684,6 +679,21 @@ fn failed(md: &mut String, rows: &[SummaryRow]) {
     md.push('\n');
 }
 
+/// A best cell's chunks, mean time, speedup and efficiency as table cells (`10 | 0.0430
+/// [0.0425–0.0437] | 1.82× [1.79–1.86] | 0.912`; a dash where undefined), shared by the
+/// study's tables and the comparison's.
+pub(super) fn best_cells(b: &Best) -> String {
+    let dash = || "—".to_owned();
+    format!(
+        "{} | {}{} | {} | {}",
+        b.chunks.map_or_else(dash, |k| k.to_string()),
+        secs(b.mean_s),
+        interval(b.mean_ci),
+        b.speedup
+            .map_or_else(dash, |s| format!("{}{}", times(s), interval(b.speedup_ci))),
+        b.efficiency.map_or_else(dash, sig),
+    )
+}
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -105,27 +105,9 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
     } else {
         None
     };
-    let mut by_cell: HashMap<Cell, Vec<TrialRow>> = HashMap::new();
-    for t in trials.iter().flatten() {
-        by_cell.entry(t.key()).or_default().push(t.clone());
-    }
-    let mut seen = HashSet::new();
-    let mut rows = Vec::new();
-    for row in summary {
-        let checked = if !seen.insert(row.key()) {
-            Err("a second summary row of the same cell".to_owned())
-        } else if trials.is_some() {
-            let mut of_cell = by_cell.remove(&row.key()).unwrap_or_default();
-            of_cell.sort_by_key(|t| t.trial);
-            validate::cell(&row, &of_cell)
-        } else {
-            validate::summary_alone(&row)
-        };
-        match checked {
-            Ok(()) => rows.push(row),
-            Err(why) => dropped.push(format!("{}: {why}", row.key().label_with_group())),
-        }
-    }
+    let believed = believed(summary, trials);
+    dropped.extend(believed.dropped);
+    let rows = believed.rows;
     if rows.is_empty() {
         bail!(
             "'{}' has no usable cells ({} dropped; the first: {})",
@@ -140,6 +122,52 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
         rows,
         dropped,
     })
+}
+
+/// The cells of a results directory that can be believed, with their trial rows.
+#[derive(Debug, Clone, Default)]
+pub struct Believed {
+    /// Summary rows that passed the checks, in file order.
+    pub rows: Vec<SummaryRow>,
+    /// Their trial rows, cell by cell, in trial order (empty without a `trials.csv`).
+    pub trials: Vec<TrialRow>,
+    /// Each row left out, with why.
+    pub dropped: Vec<String>,
+}
+
+/// The cells of `summary` that pass the checks: a cell's first row only, and its statistics
+/// those of its rows in `trials` ([`validate::cell`]) or, without a `trials.csv` (`None`),
+/// possible on their own ([`validate::summary_alone`]).
+pub fn believed(summary: Vec<SummaryRow>, trials: Option<Vec<TrialRow>>) -> Believed {
+    let have_trials = trials.is_some();
+    let mut by_cell: HashMap<Cell, Vec<TrialRow>> = HashMap::new();
+    for t in trials.into_iter().flatten() {
+        by_cell.entry(t.key()).or_default().push(t);
+    }
+    let mut seen = HashSet::new();
+    let mut out = Believed::default();
+    for row in summary {
+        let mut of_cell = Vec::new();
+        let checked = if !seen.insert(row.key()) {
+            Err("a second summary row of the same cell".to_owned())
+        } else if have_trials {
+            of_cell = by_cell.remove(&row.key()).unwrap_or_default();
+            of_cell.sort_by_key(|t| t.trial);
+            validate::cell(&row, &of_cell)
+        } else {
+            validate::summary_alone(&row)
+        };
+        match checked {
+            Ok(()) => {
+                out.trials.extend(of_cell);
+                out.rows.push(row);
+            }
+            Err(why) => out
+                .dropped
+                .push(format!("{}: {why}", row.key().label_with_group())),
+        }
+    }
+    out
 }
 
 /// Reads a `summary.csv` (this version's columns or the first release's): its rows, and a

@@ -82,3 +82,29 @@ impl SweepParams {
         format!("{:016x}", crate::checksum::fingerprint(&json))
     }
 }
+
+#[cfg(test)]
+impl SweepParams {
+    /// A small sweep for unit tests, which change what they test: rayon-chunks, the `seed`
+    /// preset, all-pairs, N = 60, 3 steps, cores 1 and 2, chunks 2 and 5, 2 trials, no warm-up,
+    /// seed 1, unpinned, the whole plan.
+    pub(crate) fn small() -> SweepParams {
+        SweepParams {
+            strategies: vec![StrategyName::RayonChunks],
+            presets: vec![Preset::Seed],
+            neighbors: vec![NeighborMode::AllPairs],
+            n: vec![60],
+            steps: 3,
+            cores: vec![1, 2],
+            chunks: vec![2, 5],
+            trials: 2,
+            warmup: 0,
+            seed: 1,
+            simd: None,
+            fake_timings: None,
+            fake_contention: None,
+            pin: unpinned(),
+            shard: None,
+        }
+    }
+}

@@ -269,28 +269,14 @@ mod tests {
     use super::*;
     use crate::clock::Elapsed;
     use crate::sph::neighbors::NeighborMode;
-    use crate::sph::params::Preset;
     use crate::sweep::params::SweepParams;
     use crate::sweep::rows::{Measured, summary_row};
-    use sph_strategies::StrategyName;
 
     fn plan() -> Plan {
         Plan::new(&SweepParams {
-            strategies: vec![StrategyName::RayonChunks],
-            presets: vec![Preset::Seed],
-            neighbors: vec![NeighborMode::AllPairs],
-            n: vec![60],
-            steps: 3,
             cores: vec![1, 2, 3],
-            chunks: vec![2, 5],
-            trials: 2,
             warmup: 1,
-            seed: 1,
-            simd: None,
-            fake_timings: None,
-            fake_contention: None,
-            pin: vec![crate::topology::Pin::None],
-            shard: None,
+            ..SweepParams::small()
         })
     }
 
@@ -298,21 +284,12 @@ mod tests {
     fn the_plan_says_which_cores_use_smt_siblings_on_an_smt_machine_and_nothing_without_smt() {
         use crate::topology::{Topology, fake};
         let mut params = SweepParams {
-            strategies: vec![StrategyName::RayonChunks],
-            presets: vec![Preset::Seed],
             neighbors: vec![NeighborMode::Grid],
-            n: vec![60],
-            steps: 3,
             cores: vec![1, 2, 4, 6, 8, 10],
             chunks: vec![5],
             trials: 1,
-            warmup: 0,
-            seed: 1,
-            simd: None,
-            fake_timings: None,
-            fake_contention: None,
             pin: vec![Pin::Compact, Pin::Spread],
-            shard: None,
+            ..SweepParams::small()
         };
         // 4 cores × 2 threads.
         let smt = Topology::read(fake::smt_4x2().root(), &[0, 1, 2, 3, 4, 5, 6, 7]);

@@ -88,17 +88,8 @@ mod tests {
             presets: vec![Preset::Seed, Preset::Cpp],
             neighbors: vec![NeighborMode::Grid],
             n: vec![60, 1000],
-            steps: 3,
-            cores: vec![1, 2],
-            chunks: vec![2, 5],
-            trials: 2,
-            warmup: 0,
             seed: 7,
-            simd: None,
-            fake_timings: None,
-            fake_contention: None,
-            pin: vec![crate::topology::Pin::None],
-            shard: None,
+            ..SweepParams::small()
         }
     }
 

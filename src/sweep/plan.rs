@@ -167,20 +167,10 @@ mod tests {
     fn params(strategies: &[StrategyName]) -> SweepParams {
         SweepParams {
             strategies: strategies.to_vec(),
-            presets: vec![Preset::Seed],
             neighbors: vec![NeighborMode::AllPairs, NeighborMode::Grid],
-            n: vec![60],
-            steps: 3,
             cores: vec![1, 2, 4],
-            chunks: vec![2, 5],
-            trials: 2,
             warmup: 1,
-            seed: 1,
-            simd: None,
-            fake_timings: None,
-            fake_contention: None,
-            pin: vec![crate::topology::Pin::None],
-            shard: None,
+            ..SweepParams::small()
         }
     }
 

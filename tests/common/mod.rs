@@ -240,3 +240,17 @@ pub fn no_panic(o: &Output) {
     let err = text(&o.stderr);
     assert!(!err.contains("panicked"), "panicked:\n{err}");
 }
+
+/// Rewrites `dir/meta.json` so that `set` holds for its top level (the first session's
+/// machine and build) and for every session: `set` gets each of those JSON objects in turn.
+/// How tests make a sweep look measured on another machine or by another build.
+pub fn set_in_meta(dir: &Path, mut set: impl FnMut(&mut serde_json::Value)) {
+    let path = dir.join("meta.json");
+    let mut meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    set(&mut meta);
+    for s in meta["sessions"].as_array_mut().unwrap() {
+        set(s);
+    }
+    std::fs::write(&path, serde_json::to_string_pretty(&meta).unwrap()).unwrap();
+}

@@ -16,7 +16,7 @@ use super::sides::{Side, SideRule, same_hardware_sets};
 use crate::report::findings::Entry;
 use crate::report::load::Sweep;
 use crate::report::markdown::{CONTENDED, OVERSUBSCRIBED, banners, test_data_banner};
-use crate::report::numbers::{interval, secs, sig, times};
+use crate::report::numbers::{interval, secs};
 use crate::report::series::{Best, Group};
 use crate::results::key::LabelStyle;
 use crate::results::rows::{Status, SummaryRow};
@@ -238,17 +238,7 @@ fn best_row(md: &mut String, tag: &str, b: &MachineBest) {
 
 /// The cores, chunks, time, speedup and efficiency columns of a best cell.
 fn cells(b: &Best) -> String {
-    let dash = || "—".to_owned();
-    format!(
-        "{} | {} | {}{} | {} | {}",
-        b.cores,
-        b.chunks.map_or_else(dash, |k| k.to_string()),
-        secs(b.mean_s),
-        interval(b.mean_ci),
-        b.speedup
-            .map_or_else(dash, |s| format!("{}{}", times(s), interval(b.speedup_ci))),
-        b.efficiency.map_or_else(dash, sig),
-    )
+    format!("{} | {}", b.cores, crate::report::markdown::best_cells(b))
 }
 
 /// `⚠ oversubscribed`, `⚠ contended`, both, or `—`.

@@ -135,8 +135,6 @@ pub(crate) mod tests {
     use crate::results::meta::{Meta, Session, SweepStatus};
     use crate::results::params::SweepParams;
     use crate::results::rows::tests::row;
-    use crate::sph::neighbors::NeighborMode;
-    use crate::sph::params::Preset;
     use sph_strategies::StrategyName;
 
     /// A sweep in `dir` on a machine with `cpu` and `threads`, holding `rows`.
@@ -152,20 +150,9 @@ pub(crate) mod tests {
         let session = Session::start(vec!["bench-sph".to_owned()], machine);
         let params = SweepParams {
             strategies: vec![StrategyName::RayonChunks, StrategyName::RayonIter],
-            presets: vec![Preset::Seed],
-            neighbors: vec![NeighborMode::AllPairs],
-            n: vec![60],
-            steps: 3,
-            cores: vec![1, 2],
             chunks: vec![5, 10],
             trials: 3,
-            warmup: 0,
-            seed: 1,
-            simd: None,
-            fake_timings: None,
-            fake_contention: None,
-            pin: vec![crate::topology::Pin::None],
-            shard: None,
+            ..SweepParams::small()
         };
         let mut meta = Meta::new(params, rows.len(), session);
         meta.finish(SweepStatus::Complete, rows.len());
