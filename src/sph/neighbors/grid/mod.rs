@@ -9,6 +9,10 @@
 
 use sph_strategies::{Executor, KernelPanic};
 
+mod sort;
+
+use sort::CellSort;
+
 use super::list::written_zeros;
 use super::{Bounds, Neighbors, distance_squared};
 use crate::simd::Lanes;
@@ -38,6 +42,8 @@ pub struct Grid {
     sorted_y: Vec<f64>,
     /// Each particle's cell, from the last rebuild.
     cell_of: Vec<u32>,
+    /// The counting sort's scratch.
+    sort: CellSort,
 }
 
 impl Grid {
@@ -70,6 +76,7 @@ impl Grid {
             sorted_x: written_zeros(n),
             sorted_y: written_zeros(n),
             cell_of: written_zeros(n),
+            sort: CellSort::new(n, cells),
         }
     }
 
@@ -78,6 +85,7 @@ impl Grid {
     pub fn heap_bytes(&self) -> usize {
         4 * (self.start.capacity() + self.order.capacity() + self.cell_of.capacity())
             + 8 * (self.sorted_x.capacity() + self.sorted_y.capacity())
+            + self.sort.heap_bytes()
     }
 }
 
@@ -117,9 +125,8 @@ impl Shape {
 }
 
 impl Neighbors for Grid {
-    /// Cell numbers (per particle) and the gather of sorted positions (per slot) run on the
-    /// executor; the counting sort between them is sequential: one increment per particle
-    /// and one addition per cell.
+    /// Cell numbers (per particle), the counting sort ([`CellSort`]) and the gather of sorted
+    /// positions (per slot) run on the executor.
     fn rebuild<E: Executor>(&mut self, exec: &E, pos: Positions<'_>) -> Result<(), KernelPanic> {
         let n = pos.len();
         let shape = self.shape;
@@ -129,24 +136,9 @@ impl Neighbors for Grid {
                 *c = shape.cell_of(pos.x[first + k], pos.y[first + k]);
             }
         })?;
-        self.start.fill(0);
-        for &c in &self.cell_of {
-            self.start[c as usize] += 1;
-        }
-        // Inclusive prefix sums: start[c] is now where cell c ends.
-        let mut sum = 0;
-        for s in &mut self.start {
-            sum += *s;
-            *s = sum;
-        }
-        // Scatter from the last particle down, filling each cell from its end: each cell keeps
-        // its particles in increasing index, and start[c] ends up where cell c begins.
         self.order.resize(n, 0);
-        for (i, &c) in self.cell_of.iter().enumerate().rev() {
-            let slot = &mut self.start[c as usize];
-            *slot -= 1;
-            self.order[*slot as usize] = i as u32;
-        }
+        self.sort
+            .run(exec, &self.cell_of, &mut self.start, &mut self.order)?;
         self.sorted_x.resize(n, 0.0);
         self.sorted_y.resize(n, 0.0);
         let order = &self.order;
