@@ -325,14 +325,14 @@ fn an_init_line_over_4_kib_is_refused_with_its_number_and_a_directory_as_a_direc
 fn a_run_larger_than_the_available_memory_is_refused_before_allocating() {
     let o = bench_sph()
         .args(["simulate", "--n", "100000000", "--neighbors", "grid"])
-        .env("BENCH_SPH_FAKE_MEM_AVAILABLE", "21000000000")
+        .env("BENCH_SPH_FAKE_MEM_AVAILABLE", "9000000000")
         .output()
         .unwrap();
     assert!(!o.status.success());
     assert_eq!(
         stderr(&o),
-        "Error: --n 100000000 needs about 23 GB of memory (grid search); \
-         this machine has 21 GB available\n"
+        "Error: --n 100000000 needs about 14 GB of memory (grid search); \
+         this machine has 9.0 GB available\n"
     );
     fails_with(
         &["simulate", "--n", "18446744073709551615"],

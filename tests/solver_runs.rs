@@ -115,6 +115,23 @@ fn a_crowd_beyond_the_grids_buffers_gives_the_same_bits_as_all_pairs() {
 }
 
 #[test]
+fn neighbours_behind_a_pile_of_more_candidates_than_a_grid_key_counts_give_all_pairs_bits() {
+    // 300 particles piled in one cell row, and a few in the row above, out of the pile's
+    // reach: their lists would fit, but the grid names their neighbours by keys past 255
+    // (the pile comes first among their candidates), so the force pass searches again.
+    let (mut x, mut y): (Vec<f64>, Vec<f64>) = (0..300)
+        .map(|k| (600.0 + (k % 20) as f64 * 0.2, 401.0 + (k / 20) as f64 * 0.2))
+        .unzip();
+    x.extend([601.0, 603.0, 605.0, 607.0]);
+    y.extend([425.0, 426.0, 427.0, 425.5]);
+    let n = x.len();
+    let state = State::from_kinematics(x, y, vec![0.0; n], vec![0.0; n]);
+    let grid = one_step(state.clone(), NeighborMode::Grid);
+    assert_eq!(grid, one_step(state, NeighborMode::AllPairs));
+    assert!(grid.first_non_finite().is_none());
+}
+
+#[test]
 fn the_reference_run_stays_finite_and_inside_the_walls() {
     let domain = dam_break::domain(Preset::Seed, 1000);
     let s = run(Preset::Seed, 1000, 1000, NeighborMode::AllPairs);

@@ -3,7 +3,8 @@
 //!
 //! The estimate counts the arrays that grow with N, from the sizes of their element types:
 //! - the particle state: [`FIELD_NAMES`]`.len()` arrays of `f64` (64 B per particle);
-//! - the neighbour lists: a count and [`SLOTS`] slots per particle, `u32` each (132 B);
+//! - the neighbour lists: a `u32` count and [`SLOTS`] slots per particle, a `u8` key each with
+//!   the grid (36 B), a `u32` index with all-pairs (132 B);
 //! - with `--neighbors grid`, the cell list: particle order and cell (`u32` each), sorted
 //!   positions (`f64` × 2), and one `u32` start per cell of the tank, which widens with N
 //!   (see [`crate::scene::dam_break`]).
@@ -71,7 +72,14 @@ pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
         }
     };
     let n64 = n as u64;
-    let per_particle = FIELD_NAMES.len() * size_of::<f64>() + (1 + lists_of) * size_of::<u32>();
+    // A list's count, and its slots in the search's keys: `u8` for the grid, `u32` for
+    // all-pairs.
+    let key_bytes = match neighbors {
+        NeighborMode::Grid => size_of::<u8>(),
+        NeighborMode::AllPairs => size_of::<u32>(),
+    };
+    let per_particle =
+        FIELD_NAMES.len() * size_of::<f64>() + size_of::<u32>() + lists_of * key_bytes;
     let mut bytes = n64
         .saturating_mul(per_particle as u64)
         .saturating_add(fluid_scratch);
@@ -79,10 +87,10 @@ pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
         let grid_per_particle = 2 * size_of::<u32>() + 2 * size_of::<f64>();
         let bounds = physics.search_bounds(domain);
         let h = physics.search_radius();
-        // As `Grid::new` sizes it: floor(extent / h) + 1 cells along each axis, and one start
-        // more than there are cells. Float-to-int casts saturate.
-        let cols = (bounds.width() / h) as u64 + 1;
-        let rows = (bounds.height() / h) as u64 + 1;
+        // As `Grid::new` sizes it: floor(extent / h) + 1 cells along each axis plus a ring of
+        // empty cells, and one start more than there are cells. Float-to-int casts saturate.
+        let cols = (bounds.width() / h) as u64 + 1 + 2;
+        let rows = (bounds.height() / h) as u64 + 1 + 2;
         let starts = cols.saturating_mul(rows).saturating_add(1);
         bytes = bytes
             .saturating_add(n64.saturating_mul(grid_per_particle as u64))
@@ -189,9 +197,9 @@ mod tests {
     }
 
     #[test]
-    fn a_billion_particles_on_the_grid_need_about_230_gb_and_are_refused_on_21() {
+    fn a_billion_particles_on_the_grid_need_about_140_gb_and_are_refused_on_21() {
         let needs = estimate(Preset::Seed, NeighborMode::Grid, 1_000_000_000);
-        assert_eq!(human_bytes(needs), "230 GB");
+        assert_eq!(human_bytes(needs), "140 GB");
         // The hard limit comes first; below it the same rule gives the same sentence.
         assert_eq!(
             check(Preset::Seed, NeighborMode::Grid, 1_000_000_000, None),
@@ -205,7 +213,7 @@ mod tests {
         };
         assert_eq!(
             err.to_string(),
-            "--n 1000000000 needs about 230 GB of memory (grid search); \
+            "--n 1000000000 needs about 140 GB of memory (grid search); \
              this machine has 21 GB available"
         );
     }

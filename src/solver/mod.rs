@@ -16,7 +16,7 @@ use sph_strategies::{Executor, KernelPanic};
 
 use crate::simd::{self, AnyLanes, SimdPath};
 use crate::sph::neighbors::{
-    self, AnyNeighbors, NeighborLists, NeighborMode, Neighbors, WCSPH_SLOTS,
+    self, AnyNeighbors, NeighborMode, Neighbors, SLOTS, Searched, WCSPH_SLOTS,
 };
 use crate::sph::physics::Physics;
 use crate::sph::state::{Domain, Positions, State};
@@ -74,7 +74,6 @@ pub struct Simulation {
     pub time_s: f64,
     neighbors: AnyNeighbors,
     lanes: AnyLanes,
-    lists: NeighborLists,
     wcsph: schedule::wcsph::Scratch,
 }
 
@@ -141,13 +140,20 @@ impl Pass {
     }
 }
 
-/// Runs `$body` with `$nb` bound to the concrete search inside `$any`, so that the code in
-/// `$body` is monomorphised per search (picked once per call, not per particle).
+/// Runs `$body` with `$nb` bound to the concrete search inside `$any` (a `&mut AnyNeighbors`)
+/// and `$lists` to its lists, so that the code in `$body` is monomorphised per search (picked
+/// once per call, not per particle).
 macro_rules! with_search {
-    ($any:expr, $nb:ident => $body:expr) => {
+    ($any:expr, ($nb:ident, $lists:ident) => $body:expr) => {
         match $any {
-            AnyNeighbors::AllPairs($nb) => $body,
-            AnyNeighbors::Grid($nb) => $body,
+            AnyNeighbors::AllPairs(Searched {
+                search: $nb,
+                lists: $lists,
+            }) => $body,
+            AnyNeighbors::Grid(Searched {
+                search: $nb,
+                lists: $lists,
+            }) => $body,
         }
     };
 }
@@ -156,10 +162,16 @@ macro_rules! with_search {
 /// SIMD path for all-pairs; the portable lanes for the grid, which tests its few candidates
 /// per row one by one (its passes compiled for AVX-512 measured 8–15 % slower here).
 macro_rules! with_search_lanes {
-    ($any:expr, $lanes:expr, ($nb:ident, $l:ident) => $body:expr) => {
+    ($any:expr, $lanes:expr, ($nb:ident, $lists:ident, $l:ident) => $body:expr) => {
         match $any {
-            AnyNeighbors::AllPairs($nb) => with_lanes!($lanes, $l => $body),
-            AnyNeighbors::Grid($nb) => {
+            AnyNeighbors::AllPairs(Searched {
+                search: $nb,
+                lists: $lists,
+            }) => with_lanes!($lanes, $l => $body),
+            AnyNeighbors::Grid(Searched {
+                search: $nb,
+                lists: $lists,
+            }) => {
                 let $l = simd::Portable;
                 $body
             }
@@ -178,7 +190,12 @@ impl Simulation {
         let physics = physics.into();
         let (fluid, state_len) = (physics.fluid(state.len()), state.len());
         let bounds = physics.search_bounds(domain);
-        let neighbors = neighbors::build(mode, bounds, physics.search_radius(), state.len());
+        let lists = match physics {
+            Physics::Mueller(_) => (fluid, SLOTS),
+            Physics::Wcsph(_) => (state_len, WCSPH_SLOTS),
+        };
+        let radius = physics.search_radius();
+        let neighbors = neighbors::build(mode, bounds, radius, state_len, lists);
         let wcsph = match physics {
             Physics::Mueller(_) => schedule::wcsph::Scratch::new(0),
             Physics::Wcsph(_) => schedule::wcsph::Scratch::new(fluid),
@@ -193,10 +210,6 @@ impl Simulation {
             lanes: simd::current()
                 .lanes()
                 .expect("the current SIMD path was checked available"),
-            lists: match physics {
-                Physics::Mueller(_) => NeighborLists::new(fluid),
-                Physics::Wcsph(_) => NeighborLists::with_slots(state_len, WCSPH_SLOTS),
-            },
             wcsph,
         }
     }
@@ -212,14 +225,14 @@ impl Simulation {
     }
 
     /// The same simulation with `width` neighbour slots per particle instead of its model's
-    /// (see [`NeighborLists`]): the results are the same bits, only speed and memory differ
+    /// (see [`neighbors::NeighborLists`]): the results are the same bits, only speed and memory differ
     /// (tests and benchmarks use it to show that).
     ///
     /// # Panics
     /// If `width` is 0 (the last slot is scratch).
     pub fn with_list_slots(mut self, width: usize) -> Self {
         assert!(width >= 1, "a neighbour list needs its scratch slot");
-        self.lists = NeighborLists::with_slots(self.lists.count.len(), width);
+        self.neighbors.with_list_slots(width);
         self
     }
 
@@ -265,7 +278,7 @@ impl Simulation {
             x: &self.state.x,
             y: &self.state.y,
         };
-        with_search!(&mut self.neighbors, nb => nb.rebuild(exec, pos))
+        with_search!(&mut self.neighbors, (nb, _lists) => nb.rebuild(exec, pos))
     }
 
     /// Brings the neighbour search up to date with the current positions, on this thread.
@@ -283,18 +296,13 @@ impl Simulation {
     /// If `pass` is not one of the model's passes.
     pub fn run_pass<E: Executor>(&mut self, exec: &E, pass: Pass) -> Result<(), KernelPanic> {
         use schedule::{mueller, wcsph};
-        let (s, lists, nb, lanes) = (
-            &mut self.state,
-            &mut self.lists,
-            &self.neighbors,
-            self.lanes,
-        );
+        let (s, nb, lanes) = (&mut self.state, &mut self.neighbors, self.lanes);
         match (&self.physics, pass) {
             (Physics::Mueller(prm), Pass::Density) => {
-                with_search_lanes!(nb, lanes, (nb, l) => mueller::density(exec, l, nb, lists, s, prm))
+                with_search_lanes!(nb, lanes, (nb, lists, l) => mueller::density(exec, l, &*nb, lists, s, prm))
             }
             (Physics::Mueller(prm), Pass::Forces) => {
-                with_search_lanes!(nb, lanes, (nb, l) => mueller::forces(exec, l, nb, lists, s, prm))
+                with_search_lanes!(nb, lanes, (nb, lists, l) => mueller::forces(exec, l, &*nb, lists, s, prm))
             }
             (Physics::Mueller(prm), Pass::Integrate) => {
                 mueller::integrate(exec, s, prm, self.domain)
@@ -303,16 +311,16 @@ impl Simulation {
                 wcsph::max_speed(exec, s, &mut self.wcsph, prm)
             }
             (Physics::Wcsph(prm), Pass::Neighbors) => {
-                with_search_lanes!(nb, lanes, (nb, l) => wcsph::neighbors(exec, l, nb, lists, s, prm))
+                with_search_lanes!(nb, lanes, (nb, lists, l) => wcsph::neighbors(exec, l, &*nb, lists, s, prm))
             }
             (Physics::Wcsph(prm), Pass::Walls) => {
-                with_search!(nb, nb => wcsph::walls(exec, nb, lists, s, prm))
+                with_search!(nb, (nb, lists) => wcsph::walls(exec, &*nb, lists, s, prm))
             }
             (Physics::Wcsph(prm), Pass::Momentum) => {
-                with_search!(nb, nb => wcsph::momentum(exec, nb, lists, s, prm))
+                with_search!(nb, (nb, lists) => wcsph::momentum(exec, &*nb, lists, s, prm))
             }
             (Physics::Wcsph(prm), Pass::Continuity) => {
-                with_search!(nb, nb => wcsph::continuity(exec, nb, lists, s, &mut self.wcsph, prm))
+                with_search!(nb, (nb, lists) => wcsph::continuity(exec, &*nb, lists, s, &mut self.wcsph, prm))
             }
             (Physics::Wcsph(prm), Pass::Integrate) => wcsph::integrate(exec, s, &self.wcsph, prm),
             (physics, pass) => panic!(
@@ -326,11 +334,6 @@ impl Simulation {
     /// Bytes held by the neighbour search, lists and the model's scratch arrays, for memory
     /// reports.
     pub fn neighbor_heap_bytes(&self) -> usize {
-        self.lists.heap_bytes()
-            + self.wcsph.heap_bytes()
-            + match &self.neighbors {
-                AnyNeighbors::AllPairs(_) => 0,
-                AnyNeighbors::Grid(g) => g.heap_bytes(),
-            }
+        self.neighbors.heap_bytes() + self.wcsph.heap_bytes()
     }
 }

@@ -6,7 +6,7 @@
 
 use glam::DVec2;
 
-use super::neighbors::{Neighbors, distance_squared};
+use super::neighbors::{ListWriter, Neighbors, distance_squared};
 use super::params::{Integrator, Params};
 use super::state::{Domain, Fields, Positions};
 use crate::simd::Lanes;
@@ -16,29 +16,32 @@ use crate::simd::Lanes;
 /// neighbours j ≠ i. Candidates are tested in `lanes` (every path finds the same).
 ///
 /// Contributions `(MASS·POLY6) · ((u·u)·u)`, `u = HSQ − r2`, are summed in index order from 0.
-/// The neighbours are written to `slots` in index order, as many as fit before its last
-/// entry (which is scratch); the returned count is the true number.
+/// The neighbours j ≠ i are written to `list` in index order; the returned count is its
+/// [`ListWriter::finish`].
 #[inline(always)]
-pub fn density_pressure(
+pub fn density_pressure<N: Neighbors>(
     i: usize,
     lanes: impl Lanes,
     pos: Positions<'_>,
-    nb: &impl Neighbors,
+    nb: &N,
     prm: &Params,
-    slots: &mut [u32],
+    mut list: ListWriter<'_, N::Key>,
 ) -> (f64, f64, u32) {
     let mut rho = 0.0;
-    let mut count = 0usize;
-    // No branch per neighbour: every hit is written at the next free slot (or the scratch
-    // slot once the list is full) and only j ≠ i advances the count.
-    let scratch = slots.len() - 1;
-    nb.for_each_within(lanes, i, pos, prm.hsq, |j, r2| {
-        let u = prm.hsq - r2;
-        rho += prm.mass_poly6 * ((u * u) * u);
-        slots[count.min(scratch)] = j as u32;
-        count += usize::from(j != i);
-    });
-    (rho, prm.gas_const * (rho - prm.rest_density), count as u32)
+    nb.for_each_within(
+        lanes,
+        i,
+        pos,
+        prm.hsq,
+        #[inline(always)]
+        |j, r2, key| {
+            let u = prm.hsq - r2;
+            rho += prm.mass_poly6 * ((u * u) * u);
+            list.push(key, j != i);
+        },
+    );
+    let count = list.finish();
+    (rho, prm.gas_const * (rho - prm.rest_density), count)
 }
 
 /// Force on particle `i` from this step's densities and pressures in `input`: pressure (Müller 2003 eq. 10 with the spiky gradient, eq. 21) plus
@@ -51,12 +54,12 @@ pub fn density_pressure(
 /// `neighbors` is particle i's list from the density pass when it fit in its slots; without
 /// it the search is asked again. Both give the same j in the same order.
 #[inline(always)]
-pub fn force(
+pub fn force<N: Neighbors>(
     i: usize,
     lanes: impl Lanes,
     input: &Fields<'_>,
-    neighbors: Option<&[u32]>,
-    nb: &impl Neighbors,
+    neighbors: Option<&[N::Key]>,
+    nb: &N,
     prm: &Params,
 ) -> DVec2 {
     let me = Particle {
@@ -66,14 +69,17 @@ pub fn force(
     };
     let mut acc = (DVec2::ZERO, DVec2::ZERO);
     match neighbors {
-        Some(list) => {
-            for &j in list {
-                let j = j as usize;
+        Some(list) => nb.for_each_listed(
+            i,
+            input.pos,
+            list,
+            #[inline(always)]
+            |j| {
                 let r2 = distance_squared(me.x.x, me.x.y, input.pos.x[j], input.pos.y[j]);
                 add_pair_force(&mut acc, &me, j, r2, input, prm);
-            }
-        }
-        None => nb.for_each_within(lanes, i, input.pos, prm.hsq, |j, r2| {
+            },
+        ),
+        None => nb.for_each_within(lanes, i, input.pos, prm.hsq, |j, r2, _| {
             if j != i {
                 add_pair_force(&mut acc, &me, j, r2, input, prm);
             }

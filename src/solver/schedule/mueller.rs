@@ -14,7 +14,7 @@ pub fn density<E: Executor, N: Neighbors, L: Lanes>(
     exec: &E,
     lanes: L,
     nb: &N,
-    lists: &mut NeighborLists,
+    lists: &mut NeighborLists<N::Key>,
     s: &mut State,
     prm: &Params,
 ) -> Result<(), KernelPanic> {
@@ -39,7 +39,7 @@ pub fn forces<E: Executor, N: Neighbors, L: Lanes>(
     exec: &E,
     lanes: L,
     nb: &N,
-    lists: &NeighborLists,
+    lists: &NeighborLists<N::Key>,
     s: &mut State,
     prm: &Params,
 ) -> Result<(), KernelPanic> {

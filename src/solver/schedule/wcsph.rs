@@ -70,7 +70,7 @@ pub fn neighbors<E: Executor, N: Neighbors, L: Lanes>(
     exec: &E,
     lanes: L,
     nb: &N,
-    lists: &mut NeighborLists,
+    lists: &mut NeighborLists<N::Key>,
     s: &State,
     prm: &WcParams,
 ) -> Result<(), KernelPanic> {
@@ -91,7 +91,7 @@ pub fn neighbors<E: Executor, N: Neighbors, L: Lanes>(
 pub fn walls<E: Executor, N: Neighbors>(
     exec: &E,
     nb: &N,
-    lists: &NeighborLists,
+    lists: &NeighborLists<N::Key>,
     s: &mut State,
     prm: &WcParams,
 ) -> Result<(), KernelPanic> {
@@ -110,7 +110,7 @@ pub fn walls<E: Executor, N: Neighbors>(
 pub fn momentum<E: Executor, N: Neighbors>(
     exec: &E,
     nb: &N,
-    lists: &NeighborLists,
+    lists: &NeighborLists<N::Key>,
     s: &mut State,
     prm: &WcParams,
 ) -> Result<(), KernelPanic> {
@@ -128,7 +128,7 @@ pub fn momentum<E: Executor, N: Neighbors>(
 pub fn continuity<E: Executor, N: Neighbors>(
     exec: &E,
     nb: &N,
-    lists: &NeighborLists,
+    lists: &NeighborLists<N::Key>,
     s: &State,
     scratch: &mut Scratch,
     prm: &WcParams,

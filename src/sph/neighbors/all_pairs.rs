@@ -10,7 +10,9 @@ use crate::sph::state::Positions;
 #[derive(Debug, Clone, Copy, Default)]
 pub struct AllPairs;
 
+/// A list names a neighbour by its index.
 impl Neighbors for AllPairs {
+    type Key = u32;
     fn rebuild<E: Executor>(&mut self, _exec: &E, _pos: Positions<'_>) -> Result<(), KernelPanic> {
         Ok(())
     }
@@ -22,7 +24,7 @@ impl Neighbors for AllPairs {
         i: usize,
         pos: Positions<'_>,
         hsq: f64,
-        mut visit: impl FnMut(usize, f64),
+        mut visit: impl FnMut(usize, f64, u32),
     ) {
         let (xi, yi) = (pos.x[i], pos.y[i]);
         // Eight candidates at a time: their squared distances and a mask of those in reach,
@@ -35,14 +37,28 @@ impl Neighbors for AllPairs {
             while mask != 0 {
                 let k = mask.trailing_zeros() as usize;
                 mask &= mask - 1;
-                visit(b * 8 + k, near.r2[k]);
+                let j = b * 8 + k;
+                visit(j, near.r2[k], j as u32);
             }
         }
         for j in pos.x.len() - x_tail.len()..pos.x.len() {
             let r2 = distance_squared(xi, yi, pos.x[j], pos.y[j]);
             if r2 < hsq {
-                visit(j, r2);
+                visit(j, r2, j as u32);
             }
+        }
+    }
+
+    #[inline(always)]
+    fn for_each_listed(
+        &self,
+        _i: usize,
+        _pos: Positions<'_>,
+        list: &[u32],
+        mut visit: impl FnMut(usize),
+    ) {
+        for &j in list {
+            visit(j as usize);
         }
     }
 }

@@ -1,40 +1,129 @@
 //! Each particle's neighbours, found once per step by the density pass and reused by the force
 //! pass, so a step scans for candidates once instead of twice.
 //!
+//! A list names its neighbours by the search's keys ([`ListKey`]): all-pairs by index (`u32`),
+//! the grid by position among the particle's candidates (`u8`, a quarter of the memory, see
+//! [`crate::sph::neighbors::Neighbors::for_each_listed`]).
+//!
 //! A particle has a fixed number of slots ([`SLOTS`] for Müller's presets,
 //! [`WCSPH_SLOTS`] for `wcsph`, whose kernel reaches about 21 fluid neighbours and as many
-//! wall particles in a corner). Its count is the true number of neighbours (j ≠ i within the
+//! wall particles in a corner). Its count is the number of neighbours listed (j ≠ i within the
 //! search radius); the list holds at most `slots - 1` of them (the last slot is scratch, so a
-//! pass can write every hit without branching). When the count is higher the list is
-//! incomplete and the passes that read it ask the search again for that particle. Either
-//! way the same j are visited in the same order.
+//! pass can write every hit without branching). When there are more, or a neighbour's key does
+//! not fit the list's key type, the list is not used: the passes that read it ask the search
+//! again for that particle. Either way the same j are visited in the same order.
 
 use sph_strategies::Split;
 
-/// Neighbour slots per particle of Müller's presets (128 bytes). Dam-break particles have
-/// about 5–15 neighbours; piles in the corners can have more, and take the slower path.
+/// Neighbour slots per particle of Müller's presets (32 bytes with the grid's keys, 128 with
+/// all-pairs'). Dam-break particles have about 5–15 neighbours; piles in the corners can have
+/// more, and take the slower path.
 ///
-/// Narrower lists were measured (8 and 16 slots from 10⁵ particles on, 36 or 68 bytes): a
-/// 10⁶-particle dam at rest stepped 30 % faster, but a 10⁵-particle dam in motion (200 steps)
-/// 45 % slower, its many particles with more neighbours than slots searched twice a step.
+/// Narrower lists of `u32` indices were measured (8 and 16 slots from 10⁵ particles on, 36 or
+/// 68 bytes): a 10⁶-particle dam at rest stepped 30 % faster, but a 10⁵-particle dam in motion
+/// (200 steps) 45 % slower, its many particles with more neighbours than slots searched twice
+/// a step. One-byte keys keep 32 slots in the bytes 8 indices took.
 pub const SLOTS: usize = 32;
 
-/// Neighbour slots per particle of the `wcsph` preset (256 bytes).
+/// Neighbour slots per particle of the `wcsph` preset.
 pub const WCSPH_SLOTS: usize = 64;
 
-/// Every particle's neighbour count and slots.
+/// A count that marks a list as not usable (a key did not fit).
+const UNLISTED: u32 = u32::MAX;
+
+/// How a list names a neighbour: a key that the search hands out with each hit and turns
+/// back into the neighbour's index.
+pub trait ListKey: Copy + Default + std::fmt::Debug + Send + Sync + 'static {
+    /// The largest key this type holds.
+    const MAX: u32;
+
+    /// `key` as this type (truncated: only keys up to [`ListKey::MAX`] are ever read back).
+    fn truncate(key: u32) -> Self;
+
+    /// The key.
+    fn get(self) -> u32;
+}
+
+impl ListKey for u8 {
+    const MAX: u32 = u8::MAX as u32;
+
+    #[inline(always)]
+    fn truncate(key: u32) -> Self {
+        key as u8
+    }
+
+    #[inline(always)]
+    fn get(self) -> u32 {
+        self.into()
+    }
+}
+
+impl ListKey for u32 {
+    const MAX: u32 = u32::MAX;
+
+    #[inline(always)]
+    fn truncate(key: u32) -> Self {
+        key
+    }
+
+    #[inline(always)]
+    fn get(self) -> u32 {
+        self
+    }
+}
+
+/// Writes one particle's list: every hit goes to the next free slot (or the scratch slot once
+/// the list is full), without a branch, and only those kept advance the count.
+#[derive(Debug)]
+pub struct ListWriter<'a, K> {
+    slots: &'a mut [K],
+    len: usize,
+    fits: bool,
+}
+
+impl<'a, K: ListKey> ListWriter<'a, K> {
+    /// Writes into `slots` (at least one: the scratch slot).
+    #[inline(always)]
+    pub fn new(slots: &'a mut [K]) -> Self {
+        ListWriter {
+            slots,
+            len: 0,
+            fits: true,
+        }
+    }
+
+    /// Writes `key`; it stays in the list only when `keep` (the next write goes over it
+    /// otherwise).
+    #[inline(always)]
+    pub fn push(&mut self, key: u32, keep: bool) {
+        let scratch = self.slots.len() - 1;
+        self.slots[self.len.min(scratch)] = K::truncate(key);
+        self.fits &= !keep | (key <= K::MAX);
+        self.len += usize::from(keep);
+    }
+
+    /// The count to store: the neighbours kept, or a count no list holds when a key did not
+    /// fit.
+    #[inline(always)]
+    pub fn finish(self) -> u32 {
+        if self.fits { self.len as u32 } else { UNLISTED }
+    }
+}
+
+/// Every particle's neighbour count and slots, in keys of type `K`.
 #[derive(Debug, Clone, Default)]
-pub struct NeighborLists {
-    /// Neighbours of particle i (excluding i), possibly more than the slots hold.
+pub struct NeighborLists<K> {
+    /// Neighbours of particle i (excluding i) listed, possibly more than the slots hold, or
+    /// more than any list holds when the list is not usable.
     pub count: Vec<u32>,
-    /// Particle i's neighbours are `slots[i * width..][..count[i]]`, increasing, when
-    /// `count[i] < width`.
-    pub slots: Vec<u32>,
+    /// Particle i's neighbours are `slots[i * width..][..count[i]]`, in increasing index,
+    /// when `count[i] < width`.
+    pub slots: Vec<K>,
     /// Slots per particle.
     width: usize,
 }
 
-impl NeighborLists {
+impl<K: ListKey> NeighborLists<K> {
     /// Room for `n` particles of [`SLOTS`] slots each.
     pub fn new(n: usize) -> Self {
         Self::with_slots(n, SLOTS)
@@ -51,7 +140,7 @@ impl NeighborLists {
 
     /// The counts and the slots, to be cut per particle in lockstep with other per-particle
     /// outputs.
-    pub fn split_mut(&mut self) -> (&mut [u32], SlotsMut<'_>) {
+    pub fn split_mut(&mut self) -> (&mut [u32], SlotsMut<'_, K>) {
         let slots = SlotsMut {
             slots: &mut self.slots,
             width: self.width,
@@ -59,9 +148,10 @@ impl NeighborLists {
         (&mut self.count, slots)
     }
 
-    /// Particle i's neighbours in increasing index, or `None` when they did not fit.
+    /// Particle i's neighbours (their keys) in increasing index, or `None` when they did
+    /// not fit.
     #[inline]
-    pub fn of(&self, i: usize) -> Option<&[u32]> {
+    pub fn of(&self, i: usize) -> Option<&[K]> {
         let count = self.count[i] as usize;
         let w = self.width;
         (count < w).then(|| &self.slots[i * w..i * w + count])
@@ -70,27 +160,27 @@ impl NeighborLists {
     /// Heap bytes held (capacity): what `scene::memory::estimate` must predict (its test
     /// compares the two).
     pub fn heap_bytes(&self) -> usize {
-        4 * (self.count.capacity() + self.slots.capacity())
+        4 * self.count.capacity() + size_of::<K>() * self.slots.capacity()
     }
 }
 
 /// The slots of a run of consecutive particles, split per particle in lockstep with other
 /// per-particle outputs.
 #[derive(Debug)]
-pub struct SlotsMut<'a> {
-    slots: &'a mut [u32],
+pub struct SlotsMut<'a, K> {
+    slots: &'a mut [K],
     width: usize,
 }
 
-impl SlotsMut<'_> {
-    /// The slots of the k-th particle of this run.
+impl<K: ListKey> SlotsMut<'_, K> {
+    /// A writer of the k-th particle's list of this run.
     #[inline]
-    pub fn particle(&mut self, k: usize) -> &mut [u32] {
-        &mut self.slots[k * self.width..(k + 1) * self.width]
+    pub fn particle(&mut self, k: usize) -> ListWriter<'_, K> {
+        ListWriter::new(&mut self.slots[k * self.width..(k + 1) * self.width])
     }
 }
 
-impl Split for SlotsMut<'_> {
+impl<K: ListKey> Split for SlotsMut<'_, K> {
     fn len(&self) -> usize {
         self.slots.len() / self.width
     }

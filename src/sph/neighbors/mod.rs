@@ -10,7 +10,7 @@ pub mod list;
 
 pub use all_pairs::AllPairs;
 pub use grid::Grid;
-pub use list::{NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS};
+pub use list::{ListKey, ListWriter, NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS};
 
 use serde::Serialize;
 use sph_strategies::{Executor, KernelPanic};
@@ -50,22 +50,50 @@ impl std::fmt::Display for NeighborMode {
 
 /// A neighbour search over a set of positions.
 pub trait Neighbors: Sync {
+    /// How a neighbour list names a particle this search found: see
+    /// [`Neighbors::for_each_listed`].
+    type Key: ListKey;
+
     /// Brings the search up to date with `pos` (called once per step, before the passes);
     /// per-particle parts of the work run on `exec`.
     fn rebuild<E: Executor>(&mut self, exec: &E, pos: Positions<'_>) -> Result<(), KernelPanic>;
 
-    /// Calls `visit(j, r2)` for every particle j (including `i` itself) whose squared
+    /// Calls `visit(j, r2, key)` for every particle j (including `i` itself) whose squared
     /// distance `r2 = dx*dx + dy*dy` (with `d = x_j − x_i`) is below `hsq`, in increasing j,
     /// testing candidates in `lanes` where the search uses them (all-pairs does, the grid does
     /// not); every path finds the same j with the same r2.
+    ///
+    /// `key` names j in a list of i's neighbours ([`Neighbors::for_each_listed`]); it may
+    /// exceed [`ListKey::MAX`] (the grid's, among more candidates than a key counts), and such
+    /// a list is not used.
     fn for_each_within<L: Lanes>(
         &self,
         lanes: L,
         i: usize,
         pos: Positions<'_>,
         hsq: f64,
-        visit: impl FnMut(usize, f64),
+        visit: impl FnMut(usize, f64, u32),
     );
+
+    /// Calls `visit(j)` for the neighbour each key of `list` names, in order: `list` holds keys
+    /// that [`Neighbors::for_each_within`] gave for particle `i` since the last rebuild, with
+    /// `pos` unchanged.
+    fn for_each_listed(
+        &self,
+        i: usize,
+        pos: Positions<'_>,
+        list: &[Self::Key],
+        visit: impl FnMut(usize),
+    );
+}
+
+/// A search and the neighbour lists the passes write in its keys.
+#[derive(Debug, Clone)]
+pub struct Searched<N: Neighbors> {
+    /// The search.
+    pub search: N,
+    /// Every particle's neighbours, in the search's keys.
+    pub lists: NeighborLists<N::Key>,
 }
 
 /// Squared distance exactly as the sources compute it: `d = x_j − x_i`, `d.x*d.x + d.y*d.y`.
@@ -111,19 +139,54 @@ impl Bounds {
     }
 }
 
-/// Builds the search for `mode` over `bounds` with search radius `radius` (the cell edge).
-pub fn build(mode: NeighborMode, bounds: Bounds, radius: f64, n: usize) -> AnyNeighbors {
+/// Builds the search for `mode` over `bounds` with search radius `radius` (the cell edge) for
+/// `n` particles, with lists of `width` slots for the first `listed` of them.
+pub fn build(
+    mode: NeighborMode,
+    bounds: Bounds,
+    radius: f64,
+    n: usize,
+    (listed, width): (usize, usize),
+) -> AnyNeighbors {
     match mode {
-        NeighborMode::AllPairs => AnyNeighbors::AllPairs(AllPairs),
-        NeighborMode::Grid => AnyNeighbors::Grid(Grid::new(bounds, radius, n)),
+        NeighborMode::AllPairs => AnyNeighbors::AllPairs(Searched {
+            search: AllPairs,
+            lists: NeighborLists::with_slots(listed, width),
+        }),
+        NeighborMode::Grid => AnyNeighbors::Grid(Searched {
+            search: Grid::new(bounds, radius, n),
+            lists: NeighborLists::with_slots(listed, width),
+        }),
     }
 }
 
-/// One of the searches, chosen once per run.
+/// One of the searches, with its lists, chosen once per run.
 #[derive(Debug, Clone)]
 pub enum AnyNeighbors {
     /// See [`AllPairs`].
-    AllPairs(AllPairs),
+    AllPairs(Searched<AllPairs>),
     /// See [`Grid`].
-    Grid(Grid),
+    Grid(Searched<Grid>),
+}
+
+impl AnyNeighbors {
+    /// The same search with lists of `width` slots each (for as many particles).
+    pub fn with_list_slots(&mut self, width: usize) {
+        match self {
+            AnyNeighbors::AllPairs(s) => {
+                s.lists = NeighborLists::with_slots(s.lists.count.len(), width);
+            }
+            AnyNeighbors::Grid(s) => {
+                s.lists = NeighborLists::with_slots(s.lists.count.len(), width)
+            }
+        }
+    }
+
+    /// Bytes held by the search and its lists (capacity).
+    pub fn heap_bytes(&self) -> usize {
+        match self {
+            AnyNeighbors::AllPairs(s) => s.lists.heap_bytes(),
+            AnyNeighbors::Grid(s) => s.search.heap_bytes() + s.lists.heap_bytes(),
+        }
+    }
 }

@@ -9,7 +9,7 @@ use crate::simd::{Lanes, Portable};
 use glam::DVec2;
 
 use super::params::WcParams;
-use crate::sph::neighbors::{Neighbors, distance_squared};
+use crate::sph::neighbors::{ListWriter, Neighbors, distance_squared};
 use crate::sph::state::{Fields, Positions};
 
 /// The largest squared speed among the given velocities (0 for none), m²/s². `max` is exact
@@ -24,50 +24,57 @@ pub fn max_speed_squared(vx: &[f64], vy: &[f64]) -> f64 {
 /// Particle `i`'s neighbours within the kernel support, in index order: for a fluid particle
 /// every other particle, for a wall particle the fluid ones only (walls never read walls).
 ///
-/// They are written to `slots` as many as fit before its last entry (scratch); the returned
-/// count is the true number (see [`crate::sph::neighbors::NeighborLists`]).
+/// They are written to `list`; the returned count is its [`ListWriter::finish`] (see
+/// [`crate::sph::neighbors::NeighborLists`]).
 #[inline(always)]
-pub fn neighbors(
+pub fn neighbors<N: Neighbors>(
     i: usize,
     lanes: impl Lanes,
     pos: Positions<'_>,
-    nb: &impl Neighbors,
+    nb: &N,
     prm: &WcParams,
-    slots: &mut [u32],
+    mut list: ListWriter<'_, N::Key>,
 ) -> u32 {
-    let scratch = slots.len() - 1;
-    let mut count = 0usize;
     let limit = if i < prm.fluid { usize::MAX } else { prm.fluid };
-    nb.for_each_within(lanes, i, pos, prm.support_sq, |j, _| {
-        slots[count.min(scratch)] = j as u32;
-        count += usize::from(j != i && j < limit);
-    });
-    count as u32
+    nb.for_each_within(
+        lanes,
+        i,
+        pos,
+        prm.support_sq,
+        #[inline(always)]
+        |j, _, key| {
+            list.push(key, j != i && j < limit);
+        },
+    );
+    list.finish()
 }
 
 /// Calls `pair(b, r2)` for each of particle `i`'s neighbours ([`neighbors`]) in index order:
 /// from its list when it fit, else by asking the search again.
 #[inline(always)]
-fn for_each_neighbor(
+fn for_each_neighbor<N: Neighbors>(
     i: usize,
     pos: Positions<'_>,
-    list: Option<&[u32]>,
-    nb: &impl Neighbors,
+    list: Option<&[N::Key]>,
+    nb: &N,
     prm: &WcParams,
     mut pair: impl FnMut(usize, f64),
 ) {
     let (xi, yi) = (pos.x[i], pos.y[i]);
     match list {
-        Some(list) => {
-            for &b in list {
-                let b = b as usize;
+        Some(list) => nb.for_each_listed(
+            i,
+            pos,
+            list,
+            #[inline(always)]
+            |b| {
                 pair(b, distance_squared(xi, yi, pos.x[b], pos.y[b]));
-            }
-        }
+            },
+        ),
         None => {
             let limit = if i < prm.fluid { usize::MAX } else { prm.fluid };
             // A list too long for its slots is rare: the portable lanes serve (same hits).
-            nb.for_each_within(Portable, i, pos, prm.support_sq, |b, r2| {
+            nb.for_each_within(Portable, i, pos, prm.support_sq, |b, r2, _| {
                 if b != i && b < limit {
                     pair(b, r2);
                 }
@@ -80,11 +87,11 @@ fn for_each_neighbor(
 /// rest): p_w = Σ_f (p_f + ρ_f g·r_wf) W_wf / Σ_f W_wf over the fluid neighbours, clipped at
 /// ≥ 0 (0 with no fluid near), and ρ_w from the inverse equation of state. Returns (ρ_w, p_w).
 #[inline]
-pub fn wall_state(
+pub fn wall_state<N: Neighbors>(
     w: usize,
     f: &Fields<'_>,
-    list: Option<&[u32]>,
-    nb: &impl Neighbors,
+    list: Option<&[N::Key]>,
+    nb: &N,
     prm: &WcParams,
 ) -> (f64, f64) {
     let xw = f.pos.at(w);
@@ -104,11 +111,11 @@ pub fn wall_state(
 /// viscosity Π_ab = −α c0 μ_ab / ρ̄_ab, μ_ab = h v_ab·r_ab / (r² + 0.01 h²), where
 /// v_ab·r_ab < 0, between fluid particles only.
 #[inline]
-pub fn acceleration(
+pub fn acceleration<N: Neighbors>(
     a: usize,
     f: &Fields<'_>,
-    list: Option<&[u32]>,
-    nb: &impl Neighbors,
+    list: Option<&[N::Key]>,
+    nb: &N,
     prm: &WcParams,
 ) -> DVec2 {
     let me = Me::of(a, f);
@@ -193,11 +200,11 @@ impl ContinuityInputs<'_> {
 /// ψ_ab = 2 (ρ_a − ρ_b) r_ab / |r_ab|² (Molteni & Colagrossi 2009) over fluid neighbours
 /// only; since r_ab·r_ab = |r_ab|², ψ_ab·∇_a W_ab = 2 (ρ_a − ρ_b) g(r). kg/(m³ s).
 #[inline]
-pub fn density_rate(
+pub fn density_rate<N: Neighbors>(
     a: usize,
     input: &ContinuityInputs<'_>,
-    list: Option<&[u32]>,
-    nb: &impl Neighbors,
+    list: Option<&[N::Key]>,
+    nb: &N,
     prm: &WcParams,
 ) -> f64 {
     let f = &input.fields;

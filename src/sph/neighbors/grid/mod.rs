@@ -2,10 +2,15 @@
 //! counting sort of the particle indices by cell: O(N + cells), deterministic, no hashing of
 //! floats.
 //!
-//! Candidates of particle i are the particles in the 3×3 cells around it. Within one row of
-//! the grid the three cells are contiguous in the sorted order, so each row is one slice. The
-//! hits are put in index order before they are visited, so sums run in the same order as
-//! all-pairs and give the same bits.
+//! Candidates of particle i are the particles in the 3×3 cells around it (a ring of empty cells
+//! around the tank gives every cell all eight neighbours). Within one row of the grid the three
+//! cells are contiguous in the sorted order, so each row is one slice. The hits are put in index
+//! order before they are visited, so sums run in the same order as all-pairs and give the same
+//! bits.
+//!
+//! A neighbour list names a hit by its position among the particle's candidates, counted row by
+//! row: one byte instead of a four-byte index (36 B of lists a particle instead of 132), turned
+//! back into the index from the particle's own cell when the list is read.
 
 use sph_strategies::{Executor, KernelPanic};
 
@@ -52,9 +57,10 @@ impl Grid {
     /// # Panics
     /// If the grid would need more than `u32::MAX` cells or particles.
     pub fn new(bounds: Bounds, h: f64, n: usize) -> Self {
-        // Positions lie in bounds; floor(width / h) is the last column.
-        let cols = (bounds.width() / h) as usize + 1;
-        let rows = (bounds.height() / h) as usize + 1;
+        // Positions lie in bounds; floor(width / h) is the last column. A ring of empty cells
+        // around them gives every cell a full 3×3 block.
+        let cols = (bounds.width() / h) as usize + 1 + 2;
+        let rows = (bounds.height() / h) as usize + 1 + 2;
         let cells = cols * rows;
         assert!(
             cells < u32::MAX as usize && n < u32::MAX as usize,
@@ -98,22 +104,22 @@ struct Shape {
     x0: f64,
     /// Lower edge of the first row.
     y0: f64,
-    /// Cells along x.
+    /// Cells along x, the empty column on either side included.
     cols: usize,
-    /// Cells along y.
+    /// Cells along y, the empty row on either side included.
     rows: usize,
 }
 
 impl Shape {
-    /// The (column, row) of a position. Positions outside the domain fall into the edge
-    /// cells, which never loses a neighbour: anything within H of an edge-cell particle is in
-    /// that cell or the one next to it.
-    #[inline]
+    /// The (column, row) of a position, inside the ring of empty cells. Positions outside
+    /// the domain fall into the edge cells, which never loses a neighbour: anything within H
+    /// of an edge-cell particle is in that cell or the one next to it.
+    #[inline(always)]
     fn coords(&self, x: f64, y: f64) -> (usize, usize) {
         // `as i64` saturates (NaN gives 0) and is one instruction on x86-64, unlike `as usize`.
-        let cx = (((x - self.x0) * self.per_cell) as i64).clamp(0, self.cols as i64 - 1);
-        let cy = (((y - self.y0) * self.per_cell) as i64).clamp(0, self.rows as i64 - 1);
-        (cx as usize, cy as usize)
+        let cx = (((x - self.x0) * self.per_cell) as i64).clamp(0, self.cols as i64 - 3);
+        let cy = (((y - self.y0) * self.per_cell) as i64).clamp(0, self.rows as i64 - 3);
+        (cx as usize + 1, cy as usize + 1)
     }
 
     /// The row-major cell number of a position.
@@ -124,8 +130,12 @@ impl Shape {
     }
 }
 
+/// A list names a neighbour by its position among the particle's candidates (the particles of
+/// its 3×3 cells, row by row): one byte, where a dam break has at most a few dozen candidates.
 impl Neighbors for Grid {
-    /// Cell numbers (per particle), the counting sort ([`CellSort`]) and the gather of sorted
+    type Key = u8;
+
+    /// Cell numbers (per particle), the counting sort (`CellSort`) and the gather of sorted
     /// positions (per slot) run on the executor.
     fn rebuild<E: Executor>(&mut self, exec: &E, pos: Positions<'_>) -> Result<(), KernelPanic> {
         let n = pos.len();
@@ -160,43 +170,42 @@ impl Neighbors for Grid {
         i: usize,
         pos: Positions<'_>,
         hsq: f64,
-        mut visit: impl FnMut(usize, f64),
+        mut visit: impl FnMut(usize, f64, u32),
     ) {
         let (xi, yi) = (pos.x[i], pos.y[i]);
-        let (cx, cy) = self.shape.coords(xi, yi);
-        let (c0, c1) = (cx.saturating_sub(1), (cx + 1).min(self.shape.cols - 1));
+        let block = self.block(xi, yi);
         // Hits are collected without branching (every candidate is written, the count only
-        // advances on a hit), then put in index order unless they already are, by a
-        // branch-free rank sort (a comparison sort past RANK_SORT_MAX hits); a row that would
-        // overflow the stack buffer goes to a vector, sorted once. The squared distance is
-        // recomputed when a hit is visited (same formula, same bits) so that only indices are
-        // moved.
+        // advances on a hit), each with its key (its position among the block's candidates),
+        // then put in index order unless they already are, by a branch-free rank sort (a
+        // comparison sort past RANK_SORT_MAX hits); a row that would overflow the stack buffer
+        // goes to a vector, sorted once. The squared distance is recomputed when a hit is
+        // visited (same formula, same bits) so that only indices are moved.
         //
         // The candidates are tested one by one, not in `lanes`: a row holds 3–12 of them, and
         // blocks of eight with a mask measured 8–15 % slower (N = 1000 and 10⁵ in motion).
-        let mut hits = [0u32; INLINE_HITS];
+        let mut hits = [0u64; INLINE_HITS];
         let mut len = 0;
-        let mut spilled: Vec<u32> = Vec::new();
-        for row in cy.saturating_sub(1)..=(cy + 1).min(self.shape.rows - 1) {
-            let lo = self.start[row * self.shape.cols + c0] as usize;
-            let hi = self.start[row * self.shape.cols + c1 + 1] as usize;
+        let mut spilled: Vec<u64> = Vec::new();
+        for (&(lo, hi), &base) in block.runs.iter().zip(&block.base) {
+            let (lo, hi) = (lo as usize, hi as usize);
             let (xs, ys, js) = (
                 &self.sorted_x[lo..hi],
                 &self.sorted_y[lo..hi],
                 &self.order[lo..hi],
             );
             if len + js.len() <= INLINE_HITS {
-                for ((&xj, &yj), &j) in xs.iter().zip(ys).zip(js) {
-                    hits[len] = j;
+                for (t, ((&xj, &yj), &j)) in xs.iter().zip(ys).zip(js).enumerate() {
+                    hits[len] = hit(j, base + t as u32);
                     len += usize::from(distance_squared(xi, yi, xj, yj) < hsq);
                 }
             } else {
-                spilled.extend(xs.iter().zip(ys).zip(js).filter_map(|((&xj, &yj), &j)| {
-                    (distance_squared(xi, yi, xj, yj) < hsq).then_some(j)
+                let found = xs.iter().zip(ys).zip(js).enumerate();
+                spilled.extend(found.filter_map(|(t, ((&xj, &yj), &j))| {
+                    (distance_squared(xi, yi, xj, yj) < hsq).then_some(hit(j, base + t as u32))
                 }));
             }
         }
-        let mut ranked = [0u32; RANK_SORT_MAX];
+        let mut ranked = [0u64; RANK_SORT_MAX];
         let hits = if spilled.is_empty() && hits[..len].is_sorted() {
             // Rows are scanned bottom to top and cells left to right: where particles are
             // still numbered in that order (a scene's start, a calm region) nothing moves.
@@ -212,19 +221,155 @@ impl Neighbors for Grid {
             spilled.sort_unstable();
             &spilled[..]
         };
-        for &j in hits {
-            let j = j as usize;
-            visit(j, distance_squared(xi, yi, pos.x[j], pos.y[j]));
+        for &h in hits {
+            let (j, key) = ((h >> 32) as usize, h as u32);
+            visit(j, distance_squared(xi, yi, pos.x[j], pos.y[j]), key);
         }
     }
+
+    /// A key is a hit's position among its block's candidates, counted along the block's rows:
+    /// it is one addition and one load away from the neighbour's index.
+    #[inline(always)]
+    fn for_each_listed(
+        &self,
+        i: usize,
+        pos: Positions<'_>,
+        list: &[u8],
+        mut visit: impl FnMut(usize),
+    ) {
+        let block = self.block(pos.x[i], pos.y[i]);
+        // Where in `order` a key of each row starts: the row's first slot minus the keys of
+        // the rows before it (wrapping: only sums with a key of that row are read).
+        let [r0, r1, r2] = block.runs.map(|(lo, _)| lo);
+        let [_, b1, b2] = block.base;
+        let (o0, o1, o2) = (r0, r1.wrapping_sub(b1), r2.wrapping_sub(b2));
+        // Branch-free: the keys of one list come from every row in turn.
+        let (step1, step2) = (o1.wrapping_sub(o0), o2.wrapping_sub(o1));
+        for &key in list {
+            let key = u32::from(key);
+            let offset = o0
+                .wrapping_add(step1.wrapping_mul(u32::from(key >= b1)))
+                .wrapping_add(step2.wrapping_mul(u32::from(key >= b2)));
+            visit(self.order[key.wrapping_add(offset) as usize] as usize);
+        }
+    }
+}
+
+/// The candidates of a particle: the particles of the 3×3 cells around its cell, as three runs
+/// of the sorted order, one per row.
+#[derive(Debug, Clone, Copy)]
+struct Block {
+    /// Each row's `order[lo..hi]`, bottom to top.
+    runs: [(u32, u32); 3],
+    /// Candidates in the rows before each row: the key of a row's first candidate.
+    base: [u32; 3],
+}
+
+impl Grid {
+    /// The block of candidates around the position (x, y).
+    #[inline(always)]
+    fn block(&self, x: f64, y: f64) -> Block {
+        let (cx, cy) = self.shape.coords(x, y);
+        let cols = self.shape.cols;
+        // Inside the ring of empty cells, so the block never leaves the grid.
+        let run = |row: usize| {
+            let first = row * cols + cx - 1;
+            (self.start[first], self.start[first + 3])
+        };
+        let runs = [run(cy - 1), run(cy), run(cy + 1)];
+        let len = |(lo, hi): (u32, u32)| hi - lo;
+        let base1 = len(runs[0]);
+        Block {
+            runs,
+            base: [0, base1, base1 + len(runs[1])],
+        }
+    }
+}
+
+/// A hit as one sortable word: its index above its key (indices are distinct, so the order is
+/// the indices' order).
+#[inline(always)]
+fn hit(j: u32, key: u32) -> u64 {
+    (u64::from(j) << 32) | u64::from(key)
 }
 
 /// Puts the distinct values of `src` in increasing order into `dst` by counting, for each, how
 /// many are smaller: quadratic but branch-free, which beats branching sorts on a few dozen.
 #[inline]
-fn rank_sort(src: &[u32], dst: &mut [u32]) {
-    for &j in src {
-        let rank: u32 = src.iter().map(|&w| u32::from(w < j)).sum();
-        dst[rank as usize] = j;
+fn rank_sort(src: &[u64], dst: &mut [u64]) {
+    for &h in src {
+        let rank: u32 = src.iter().map(|&w| u32::from(w < h)).sum();
+        dst[rank as usize] = h;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use sph_strategies::seq::SeqExecutor;
+
+    use super::*;
+    use crate::scene::splitmix::SplitMix64;
+    use crate::simd::Portable;
+
+    const H: f64 = 16.0;
+
+    fn grid_over(x: &[f64], y: &[f64]) -> Grid {
+        let bounds = Bounds {
+            min_x: 0.0,
+            min_y: 0.0,
+            max_x: 320.0,
+            max_y: 240.0,
+        };
+        let mut grid = Grid::new(bounds, H, x.len());
+        grid.rebuild(&SeqExecutor, Positions { x, y }).unwrap();
+        grid
+    }
+
+    /// Every hit of particle i as (j, key), in the order visited.
+    fn hits(grid: &Grid, i: usize, pos: Positions<'_>) -> Vec<(usize, u32)> {
+        let mut found = Vec::new();
+        grid.for_each_within(Portable, i, pos, H * H, |j, _, key| found.push((j, key)));
+        found
+    }
+
+    #[test]
+    fn every_key_names_its_neighbour_again() {
+        // Random positions, some outside the bounds (edge cells), numbered in no spatial order.
+        let mut rng = SplitMix64::new(7);
+        let n = 2000;
+        let mut coord = |extent: f64| rng.next_f64() * (extent + 40.0) - 20.0;
+        let x: Vec<f64> = (0..n).map(|_| coord(320.0)).collect();
+        let y: Vec<f64> = (0..n).map(|_| coord(240.0)).collect();
+        let pos = Positions { x: &x, y: &y };
+        let grid = grid_over(&x, &y);
+        for i in 0..n {
+            let found = hits(&grid, i, pos);
+            assert!(found.windows(2).all(|w| w[0].0 < w[1].0), "index order");
+            let keys: Vec<u8> = found
+                .iter()
+                .map(|&(_, k)| u8::try_from(k).unwrap())
+                .collect();
+            let mut named = Vec::new();
+            grid.for_each_listed(i, pos, &keys, |j| named.push(j));
+            let js: Vec<usize> = found.iter().map(|&(j, _)| j).collect();
+            assert_eq!(named, js, "particle {i}");
+        }
+    }
+
+    #[test]
+    fn a_block_of_more_candidates_than_a_key_counts_gives_keys_past_u8() {
+        // A pile of 300 in the row below particle 300's, out of its reach, comes first among
+        // its candidates, so its own neighbours' keys start at 300.
+        let (mut x, mut y): (Vec<f64>, Vec<f64>) = (0..300)
+            .map(|k| (100.0 + (k % 20) as f64 * 0.2, 81.0 + (k / 20) as f64 * 0.2))
+            .unzip();
+        x.extend([101.0, 103.0, 105.0]);
+        y.extend([105.0, 106.0, 107.0]);
+        let pos = Positions { x: &x, y: &y };
+        let grid = grid_over(&x, &y);
+        let found = hits(&grid, 300, pos);
+        let js: Vec<usize> = found.iter().map(|&(j, _)| j).collect();
+        assert_eq!(js, [300, 301, 302]);
+        assert!(found.iter().all(|&(_, key)| key >= 300), "{found:?}");
     }
 }
