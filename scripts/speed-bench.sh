@@ -382,6 +382,7 @@ done
 
 say ""
 say "Large N: grid neighbour search"
+declare -A SEQ_PER_STEP=()
 sayf '%-10s %6s %-34s %5s %10s %10s %10s %24s %6s %10s\n' N steps configuration runs \
     "min s" "median s" "max s" "Mparticle-steps/s min-max" "eff" "RSS B/part"
 for size in "${LARGE_SIZES[@]}"; do
@@ -392,7 +393,11 @@ for size in "${LARGE_SIZES[@]}"; do
             read -r strategy cores chunks <<<"$strat"
             key="large:$n:$steps:$strategy:$cores:$chunks:${simd:--}"
             read -r lo med hi <<<"$(stats "$key")"
-            if [[ "$strategy" == seq ]]; then seq_med="$med"; fi
+            if [[ "$strategy" == seq ]]; then
+                seq_med="$med"
+                SEQ_PER_STEP["$n${simd:+:$simd}"]="$(awk -v m="$med" -v n="$n" -v s="$steps" \
+                    'BEGIN { printf "%.17g", m / (n * s) }')"
+            fi
             rate="$(awk -v n="$n" -v s="$steps" -v lo="$lo" -v hi="$hi" \
                 'BEGIN { printf "%.2f-%.2f", n * s / hi / 1e6, n * s / lo / 1e6 }')"
             eff="-"
@@ -418,6 +423,17 @@ for size in "${LARGE_SIZES[@]}"; do
 done
 say "eff = seq median / (cores x median); RSS B/part = the largest peak RSS of the N = $RSS_N" \
     "runs / N"
+# How the cost of a particle-step grows with N: seq at the largest size over seq at the smallest.
+read -r first_n _ <<<"${LARGE_SIZES[0]}"
+read -r last_n _ <<<"${LARGE_SIZES[-1]}"
+for simd in "${SIMDS[@]}"; do
+    small="${SEQ_PER_STEP["$first_n${simd:+:$simd}"]:-}"
+    large="${SEQ_PER_STEP["$last_n${simd:+:$simd}"]:-}"
+    if [[ -n "$small" && -n "$large" ]]; then
+        say "seq time per particle-step, N = $last_n over N = $first_n${simd:+ (simd=$simd)}:" \
+            "$(awk -v a="$large" -v b="$small" 'BEGIN { printf "%.2fx", a / b }') (medians)"
+    fi
+done
 
 # ---- Checks -------------------------------------------------------------------------------
 say ""
