@@ -393,7 +393,7 @@ for size in "${LARGE_SIZES[@]}"; do
             read -r strategy cores chunks <<<"$strat"
             key="large:$n:$steps:$strategy:$cores:$chunks:${simd:--}"
             read -r lo med hi <<<"$(stats "$key")"
-            if [[ "$strategy" == seq ]]; then
+            if [[ "$strategy" == seq && "$med" != - ]]; then
                 seq_med="$med"
                 SEQ_PER_STEP["$n${simd:+:$simd}"]="$(awk -v m="$med" -v n="$n" -v s="$steps" \
                     'BEGIN { printf "%.17g", m / (n * s) }')"

@@ -6,7 +6,8 @@
 //! - the neighbour lists: a `u32` count and [`SLOTS`] slots per particle, a `u8` key each with
 //!   the grid (36 B), a `u32` index with all-pairs (132 B);
 //! - with `--neighbors grid`, the cell list: particle order and cell (`u32` each), sorted
-//!   positions (`f64` × 2), and one `u32` start per cell of the tank, which widens with N
+//!   positions (`f64` × 2), and one `u32` start per cell of the tank and of the empty ring
+//!   around it; the tank widens with N
 //!   (see [`crate::scene::dam_break`]).
 //!
 //! A unit test holds the estimate equal to what a [`crate::solver::Simulation`] allocates.

@@ -51,7 +51,8 @@ pub fn density_pressure<N: Neighbors>(
 /// Two particles at the same point (r = 0, j ≠ i) have no pressure direction: that term is
 /// zero there (the Haskell source divides by zero), the viscosity term is still added.
 ///
-/// `neighbors` is particle i's list from the density pass when it fit in its slots; without
+/// `neighbors` is particle i's list from the density pass when it fit in its slots and its
+/// keys fit their type; without
 /// it the search is asked again. Both give the same j in the same order.
 #[inline(always)]
 pub fn force<N: Neighbors>(

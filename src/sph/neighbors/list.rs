@@ -208,3 +208,45 @@ pub(crate) fn written_zeros<T: Copy + Default>(n: usize) -> Vec<T> {
     v.resize(n, T::default());
     v
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn written(width: usize, pushes: &[(u32, bool)]) -> (u32, Vec<u8>) {
+        let mut slots = vec![0u8; width];
+        let mut list = ListWriter::new(&mut slots);
+        for &(key, keep) in pushes {
+            list.push(key, keep);
+        }
+        (list.finish(), slots)
+    }
+
+    #[test]
+    fn a_kept_key_past_the_type_leaves_the_list_unusable() {
+        let (count, _) = written(8, &[(3, true), (256, true), (4, true)]);
+        assert_eq!(count, UNLISTED);
+    }
+
+    #[test]
+    fn a_key_past_the_type_that_is_not_kept_changes_nothing() {
+        // The particle itself (or a wall that walls do not read) is written, then written over.
+        let (count, slots) = written(8, &[(3, true), (300, false), (5, true)]);
+        assert_eq!(count, 2);
+        assert_eq!(&slots[..2], [3, 5]);
+    }
+
+    #[test]
+    fn a_list_is_read_back_up_to_one_short_of_its_slots_and_not_beyond() {
+        let mut lists = NeighborLists::<u8>::with_slots(2, 4);
+        let (count, mut slots) = lists.split_mut();
+        for (c, keys) in count.iter_mut().zip([&[1u32, 2, 3][..], &[1, 2, 3, 4]]) {
+            let mut list = slots.particle(0);
+            keys.iter().for_each(|&k| list.push(k, true));
+            *c = list.finish();
+            slots = slots.split_at(1).1;
+        }
+        assert_eq!(lists.of(0), Some(&[1u8, 2, 3][..]));
+        assert_eq!(lists.of(1), None);
+    }
+}

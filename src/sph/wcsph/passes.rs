@@ -50,7 +50,8 @@ pub fn neighbors<N: Neighbors>(
 }
 
 /// Calls `pair(b, r2)` for each of particle `i`'s neighbours ([`neighbors`]) in index order:
-/// from its list when it fit, else by asking the search again.
+/// from its list when it fit (in its slots, and its keys in their type), else by asking the
+/// search again.
 #[inline(always)]
 fn for_each_neighbor<N: Neighbors>(
     i: usize,
@@ -73,7 +74,8 @@ fn for_each_neighbor<N: Neighbors>(
         ),
         None => {
             let limit = if i < prm.fluid { usize::MAX } else { prm.fluid };
-            // A list too long for its slots is rare: the portable lanes serve (same hits).
+            // An unusable list (too long for its slots, or a grid key past 255) is rare: the
+            // portable lanes serve (same hits).
             nb.for_each_within(Portable, i, pos, prm.support_sq, |b, r2, _| {
                 if b != i && b < limit {
                     pair(b, r2);

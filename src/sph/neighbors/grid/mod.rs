@@ -9,8 +9,9 @@
 //! bits.
 //!
 //! A neighbour list names a hit by its position among the particle's candidates, counted row by
-//! row: one byte instead of a four-byte index (36 B of lists a particle instead of 132), turned
-//! back into the index from the particle's own cell when the list is read.
+//! row: one byte instead of a four-byte index (Müller's lists take 36 B a particle instead of
+//! 132, `wcsph`'s 68 instead of 260), turned back into the index from the particle's own cell
+//! when the list is read.
 
 use sph_strategies::{Executor, KernelPanic};
 
@@ -354,6 +355,29 @@ mod tests {
             let js: Vec<usize> = found.iter().map(|&(j, _)| j).collect();
             assert_eq!(named, js, "particle {i}");
         }
+    }
+
+    #[test]
+    fn keys_from_a_row_too_long_for_the_stack_buffer_name_their_neighbours_again() {
+        // 120 particles in the row below particle 120's (more than INLINE_HITS), out of its
+        // reach, plus a few in reach on both sides: the first row is collected on the heap.
+        let (mut x, mut y): (Vec<f64>, Vec<f64>) = (0..120)
+            .map(|k| (81.0 + (k % 40) as f64 * 1.1, 81.0 + (k / 40) as f64 * 0.5))
+            .unzip();
+        x.extend([101.0, 103.0, 100.0, 104.0]);
+        y.extend([105.0, 106.0, 112.0, 95.0]);
+        let pos = Positions { x: &x, y: &y };
+        let grid = grid_over(&x, &y);
+        let found = hits(&grid, 120, pos);
+        let js: Vec<usize> = found.iter().map(|&(j, _)| j).collect();
+        assert_eq!(js, [120, 121, 122, 123]);
+        let keys: Vec<u8> = found
+            .iter()
+            .map(|&(_, k)| u8::try_from(k).unwrap())
+            .collect();
+        let mut named = Vec::new();
+        grid.for_each_listed(120, pos, &keys, |j| named.push(j));
+        assert_eq!(named, js);
     }
 
     #[test]
