@@ -124,11 +124,6 @@ pub struct NeighborLists<K> {
 }
 
 impl<K: ListKey> NeighborLists<K> {
-    /// Room for `n` particles of [`SLOTS`] slots each.
-    pub fn new(n: usize) -> Self {
-        Self::with_slots(n, SLOTS)
-    }
-
     /// Room for `n` particles of `width` slots each.
     pub fn with_slots(n: usize, width: usize) -> Self {
         NeighborLists {

@@ -96,6 +96,13 @@ pub struct Searched<N: Neighbors> {
     pub lists: NeighborLists<N::Key>,
 }
 
+impl<N: Neighbors> Searched<N> {
+    /// New lists of `width` slots for as many particles.
+    fn relist(&mut self, width: usize) {
+        self.lists = NeighborLists::with_slots(self.lists.count.len(), width);
+    }
+}
+
 /// Squared distance exactly as the sources compute it: `d = x_j − x_i`, `d.x*d.x + d.y*d.y`.
 #[inline(always)]
 pub fn distance_squared(xi: f64, yi: f64, xj: f64, yj: f64) -> f64 {
@@ -173,12 +180,8 @@ impl AnyNeighbors {
     /// The same search with lists of `width` slots each (for as many particles).
     pub fn with_list_slots(&mut self, width: usize) {
         match self {
-            AnyNeighbors::AllPairs(s) => {
-                s.lists = NeighborLists::with_slots(s.lists.count.len(), width);
-            }
-            AnyNeighbors::Grid(s) => {
-                s.lists = NeighborLists::with_slots(s.lists.count.len(), width)
-            }
+            AnyNeighbors::AllPairs(s) => s.relist(width),
+            AnyNeighbors::Grid(s) => s.relist(width),
         }
     }
 
