@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Speed figures of bench-sph as ratios to the plain compiled C++ all-pairs loop (issue 15),
 # measured in the same run: benches/plain-loop/mueller.cpp (seed preset, N = 1000, 1000 steps)
-# against `bench-sph simulate` all-pairs and grid at that size, plus the grid at N = 10^4, 10^5
-# and 10^6 with every strategy of LARGE_STRATEGIES below.
+# against `bench-sph simulate` all-pairs and grid (in index and in cell order) at that size, plus
+# the grid at N = 10^4, 10^5 and 10^6 with every strategy of LARGE_STRATEGIES below.
 #
 # Usage: scripts/speed-bench.sh [--runs K] [--quick] [--simd LIST] [--out FILE [--force]]
 #   --runs K      runs of every configuration, 1..=100 (default 5; 2 with --quick), interleaved
@@ -32,6 +32,9 @@ set -euo pipefail
 # The reference run (issue 15): seed preset, N = 1000, 1000 steps.
 REF_N=1000
 REF_STEPS=1000
+# Its bench-sph rows: all-pairs, the grid, and the grid summing in cell order (`--order cell`:
+# faster, not the seed's bits, so not compared with the plain loop's state).
+REF_SEARCHES=(all-pairs grid grid-cell)
 # Large-N grid runs: "N STEPS". The same 10 steps at every size, so that the fluid is in the
 # same state (the dam at rest, just released) and the cost per particle-step compares memory
 # behaviour alone; more steps would change the physics (a collapsing dam has more neighbours).
@@ -268,7 +271,7 @@ run_one() {
     printf '  run %d/%d  %-44s %10s s\n' "$run" "$RUNS" "$key" "$wall" >&2
 }
 
-# Keys: plain | ref:NEIGHBORS:SIMD | large:N:STEPS:STRATEGY:CORES:CHUNKS:SIMD ("-" = none).
+# Keys: plain | ref:SEARCH:SIMD | large:N:STEPS:STRATEGY:CORES:CHUNKS:SIMD ("-" = none).
 simd_flag() {
     if [[ -n "$1" ]]; then printf '%s\n' --simd "$1"; fi
 }
@@ -280,8 +283,10 @@ for ((run = 1; run <= RUNS; run++)); do
     fi
     for simd in "${SIMDS[@]}"; do
         mapfile -t sflag < <(simd_flag "$simd")
-        for nb in all-pairs grid; do
-            run_one "ref:$nb:${simd:--}" "$BIN" simulate --json --strategy seq --neighbors "$nb" \
+        for nb in "${REF_SEARCHES[@]}"; do
+            search=(--neighbors "$nb")
+            if [[ "$nb" == grid-cell ]]; then search=(--neighbors grid --order cell); fi
+            run_one "ref:$nb:${simd:--}" "$BIN" simulate --json --strategy seq "${search[@]}" \
                 --n "$REF_N" --steps "$REF_STEPS" ${sflag[@]+"${sflag[@]}"}
         done
     done
@@ -365,7 +370,7 @@ if [[ -n "$PLAIN" ]]; then
         "$(fmt_s "$pmin")" "$(fmt_s "$pmed")" "$(fmt_s "$pmax")" "1"
 fi
 for simd in "${SIMDS[@]}"; do
-    for nb in all-pairs grid; do
+    for nb in "${REF_SEARCHES[@]}"; do
         key="ref:$nb:${simd:--}"
         read -r lo med hi <<<"$(stats "$key")"
         ratio="-"
@@ -374,7 +379,7 @@ for simd in "${SIMDS[@]}"; do
                 -v med="$med" -v hi="$hi" \
                 'BEGIN { printf "%.2fx (%.2f-%.2f)", pmed / med, pmin / hi, pmax / lo }')"
         fi
-        label="bench-sph seq $nb${simd:+ simd=$simd}"
+        label="bench-sph seq ${nb/grid-cell/grid --order cell}${simd:+ simd=$simd}"
         sayf '%-34s %5s %10s %10s %10s   %-26s\n' "$label" "$RUNS" "$(fmt_s "$lo")" \
             "$(fmt_s "$med")" "$(fmt_s "$hi")" "$ratio"
     done

@@ -26,11 +26,71 @@ fn json_output_carries_the_run_and_its_configuration() {
     assert_eq!(v["steps"], 5);
     assert_eq!(v["preset"], "seed");
     assert_eq!(v["neighbors"], "all-pairs");
+    assert_eq!(v["order"], "index");
     assert_eq!(v["strategy"], "seq");
     assert!(v["wall_s"].as_f64().unwrap() > 0.0);
     assert!(v["cpu_s"].as_f64().unwrap() >= 0.0);
     assert!(v["particle_steps_per_s"].as_f64().unwrap() > 0.0);
     assert_eq!(v["checksum"].as_str().unwrap().len(), 16);
+}
+
+#[test]
+fn cell_order_is_a_grid_option_with_its_own_bits_the_same_on_every_strategy() {
+    // 200 steps: the dam has collapsed, so the particles' numbers no longer follow the cells.
+    let grid = [
+        "simulate",
+        "--n",
+        "400",
+        "--steps",
+        "200",
+        "--neighbors",
+        "grid",
+    ];
+    let checksum = |extra: &[&str]| -> String {
+        let o = run(&[&grid[..], extra, &["--json"]].concat());
+        assert!(o.status.success(), "{extra:?}: {}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+        let order = if extra.contains(&"cell") {
+            "cell"
+        } else {
+            "index"
+        };
+        assert_eq!(v["order"], order, "{extra:?}");
+        v["checksum"].as_str().unwrap().to_owned()
+    };
+    let cell = checksum(&["--order", "cell"]);
+    assert_ne!(cell, checksum(&[]), "cell order sums in another order");
+    for parallel in [
+        [
+            "--strategy",
+            "rayon-chunks",
+            "--cores",
+            "2",
+            "--chunks",
+            "7",
+        ],
+        [
+            "--strategy",
+            "crossbeam-pool",
+            "--cores",
+            "3",
+            "--chunks",
+            "64",
+        ],
+        ["--strategy", "rayon-spawn", "--cores", "2", "--chunks", "1"],
+    ] {
+        assert_eq!(
+            checksum(&[&["--order", "cell"][..], &parallel].concat()),
+            cell
+        );
+    }
+    let o = run(&[&grid[..], &["--order", "cell"]].concat());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_holds_all("stdout", &stdout(&o), &["sums in cell order"]);
+    fails_with(
+        &["simulate", "--n", "40", "--steps", "2", "--order", "cell"],
+        &["Error: --order cell needs --neighbors grid"],
+    );
 }
 
 #[test]

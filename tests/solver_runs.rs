@@ -4,7 +4,7 @@
 use bench_sph::run::{RunError, run_timed};
 use bench_sph::scene::{Scene, dam_break};
 use bench_sph::solver::{Simulation, StepError};
-use bench_sph::sph::neighbors::NeighborMode;
+use bench_sph::sph::neighbors::{NeighborMode, SumOrder};
 use bench_sph::sph::params::Preset;
 use bench_sph::sph::state::{Domain, FIELD_NAMES, State};
 use sph_strategies::{Config, StrategyName};
@@ -46,13 +46,60 @@ fn grid_agrees_with_all_pairs_to_1e_9_after_10_steps_for_every_preset() {
 }
 
 #[test]
+fn cell_order_agrees_with_index_order_to_1e_9_after_10_steps_and_differs_in_bits_later() {
+    let cell_order = |preset, steps| {
+        let mut sim = Scene::dam_break(preset, 1000, 2019)
+            .unwrap()
+            .simulate(NeighborMode::Grid)
+            .with_sum_order(SumOrder::Cell)
+            .unwrap();
+        run_timed(&mut sim, StrategyName::Seq, &SEQ, steps).expect("run completes");
+        sim.state
+    };
+    for preset in Preset::ALL {
+        let (index, cell) = (
+            run(preset, 1000, 10, NeighborMode::Grid),
+            cell_order(preset, 10),
+        );
+        for (field, gap) in max_relative_gap(&cell, &index) {
+            assert!(gap <= 1e-9, "{preset} {field}: relative gap {gap:e}");
+        }
+        // Once the dam has collapsed the numbers no longer follow the cells, and the sums
+        // round differently.
+        let steps = 200;
+        assert_ne!(
+            cell_order(preset, steps),
+            run(preset, 1000, steps, NeighborMode::Grid),
+            "{preset}"
+        );
+    }
+}
+
+#[test]
+fn all_pairs_has_no_cell_order() {
+    let sim = Scene::dam_break(Preset::Seed, 10, 1)
+        .unwrap()
+        .simulate(NeighborMode::AllPairs);
+    assert!(sim.with_sum_order(SumOrder::Cell).is_err());
+}
+
+#[test]
 fn neighbour_lists_of_any_width_give_the_same_bits() {
     // Width 2 holds one neighbour: nearly every particle overflows and is searched again by
     // the passes that read the lists.
+    // In cell order the passes' own search must visit the same order as the lists do.
     for preset in Preset::ALL {
-        for mode in NeighborMode::ALL {
+        for (mode, order) in [
+            (NeighborMode::AllPairs, SumOrder::Index),
+            (NeighborMode::Grid, SumOrder::Index),
+            (NeighborMode::Grid, SumOrder::Cell),
+        ] {
             let run_with = |width: Option<usize>| {
-                let sim = Scene::dam_break(preset, 700, 2019).unwrap().simulate(mode);
+                let sim = Scene::dam_break(preset, 700, 2019)
+                    .unwrap()
+                    .simulate(mode)
+                    .with_sum_order(order)
+                    .unwrap();
                 let mut sim = match width {
                     Some(w) => sim.with_list_slots(w),
                     None => sim,
@@ -60,7 +107,7 @@ fn neighbour_lists_of_any_width_give_the_same_bits() {
                 run_timed(&mut sim, StrategyName::Seq, &SEQ, 150).expect("run completes");
                 sim.state
             };
-            assert_eq!(run_with(Some(2)), run_with(None), "{preset} {mode}");
+            assert_eq!(run_with(Some(2)), run_with(None), "{preset} {mode} {order}");
         }
     }
 }

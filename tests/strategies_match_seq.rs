@@ -1,5 +1,5 @@
-//! Every strategy gives the sequential run's bits, whatever the cores, chunks, SIMD path and
-//! thread placement (`--pin`) (the portable path's unpinned sequential run is the reference),
+//! Every strategy gives the sequential run's bits, whatever the search (the grid in index or
+//! cell order), cores, chunks, SIMD path and thread placement (`--pin`) (the portable path's unpinned sequential run is the reference),
 //! and a panic inside a kernel becomes an error of the run (never a hang) on every strategy.
 
 use std::time::Duration;
@@ -8,7 +8,7 @@ use bench_sph::run::run_timed;
 use bench_sph::scene::{Scene, dam_break};
 use bench_sph::simd::SimdPath;
 use bench_sph::solver::Simulation;
-use bench_sph::sph::neighbors::NeighborMode;
+use bench_sph::sph::neighbors::{NeighborMode, SumOrder};
 use bench_sph::sph::params::Preset;
 use bench_sph::sph::state::{FIELD_NAMES, State};
 use sph_strategies::{Config, StrategyName};
@@ -18,16 +18,30 @@ mod common;
 const N: usize = 500;
 const STEPS: usize = 25;
 
+/// A neighbour search and the order its sums run in.
+type Search = (NeighborMode, SumOrder);
+
+/// Every search, the grid in either order.
+const SEARCHES: [Search; 3] = [
+    (NeighborMode::AllPairs, SumOrder::Index),
+    (NeighborMode::Grid, SumOrder::Index),
+    (NeighborMode::Grid, SumOrder::Cell),
+];
+
+fn simulation(preset: Preset, (mode, order): Search) -> Simulation {
+    let scene = Scene::dam_break(preset, N, 7).unwrap();
+    scene.simulate(mode).with_sum_order(order).unwrap()
+}
+
 fn run(
     preset: Preset,
-    mode: NeighborMode,
+    search: Search,
     simd: SimdPath,
     strategy: StrategyName,
     cores: usize,
     chunks: usize,
 ) -> State {
-    let scene = Scene::dam_break(preset, N, 7).unwrap();
-    let mut sim = scene.simulate(mode).with_simd(simd).unwrap();
+    let mut sim = simulation(preset, search).with_simd(simd).unwrap();
     run_timed(&mut sim, strategy, &Config::new(cores, chunks), STEPS)
         .unwrap_or_else(|e| panic!("{strategy} cores={cores} chunks={chunks}: {e}"));
     sim.state
@@ -55,17 +69,18 @@ fn tested_paths() -> Vec<SimdPath> {
 #[test]
 fn every_strategy_cores_and_chunks_gives_the_bits_of_the_sequential_run() {
     for preset in Preset::ALL {
-        for mode in NeighborMode::ALL {
-            let reference = run(preset, mode, SimdPath::Portable, StrategyName::Seq, 1, 1);
+        for search in SEARCHES {
+            let reference = run(preset, search, SimdPath::Portable, StrategyName::Seq, 1, 1);
             for simd in tested_paths() {
                 for &strategy in StrategyName::ALL {
                     for cores in [1, 2, 3, 5] {
                         for chunks in [1, 7, 64, N, 2 * N] {
-                            let got = run(preset, mode, simd, strategy, cores, chunks);
+                            let got = run(preset, search, simd, strategy, cores, chunks);
                             if let Some(diff) = first_bit_difference(&got, &reference) {
+                                let (mode, order) = search;
                                 panic!(
-                                    "{preset} {mode} {simd} {strategy} cores={cores} \
-                                     chunks={chunks}: {diff}"
+                                    "{preset} {mode} order {order} {simd} {strategy} \
+                                     cores={cores} chunks={chunks}: {diff}"
                                 );
                             }
                         }
@@ -81,21 +96,22 @@ fn every_strategy_pinned_compact_or_spread_gives_the_bits_of_the_unpinned_sequen
     use bench_sph::placement::placement;
     use bench_sph::topology::Pin;
     for preset in Preset::ALL {
-        for mode in NeighborMode::ALL {
-            let reference = run(preset, mode, SimdPath::Portable, StrategyName::Seq, 1, 1);
+        for search @ (mode, order) in SEARCHES {
+            let reference = run(preset, search, SimdPath::Portable, StrategyName::Seq, 1, 1);
             for pin in [Pin::Compact, Pin::Spread] {
                 let placed = placement(pin).expect("this machine accepts its own CPUs");
                 for &strategy in StrategyName::ALL {
                     // More threads than CPUs too: worker i goes to CPU i mod the order's length.
                     for cores in [1, 2, 3] {
-                        let scene = Scene::dam_break(preset, N, 7).unwrap();
-                        let mut sim = scene.simulate(mode);
+                        let mut sim = simulation(preset, search);
                         let config = Config::new(cores, 7).placed(placed);
-                        run_timed(&mut sim, strategy, &config, STEPS).unwrap_or_else(|e| {
-                            panic!("{preset} {mode} --pin {pin} {strategy} cores={cores}: {e}")
-                        });
+                        let what = format!(
+                            "{preset} {mode} order {order} --pin {pin} {strategy} cores={cores}"
+                        );
+                        run_timed(&mut sim, strategy, &config, STEPS)
+                            .unwrap_or_else(|e| panic!("{what}: {e}"));
                         if let Some(diff) = first_bit_difference(&sim.state, &reference) {
-                            panic!("{preset} {mode} --pin {pin} {strategy} cores={cores}: {diff}");
+                            panic!("{what}: {diff}");
                         }
                     }
                 }
@@ -108,17 +124,17 @@ fn every_strategy_pinned_compact_or_spread_gives_the_bits_of_the_unpinned_sequen
 fn every_simd_path_this_machine_runs_gives_the_portable_bits() {
     eprintln!("SIMD paths available here: {:?}", SimdPath::available());
     for preset in Preset::ALL {
-        for mode in NeighborMode::ALL {
-            let reference = run(preset, mode, SimdPath::Portable, StrategyName::Seq, 1, 1);
+        for search @ (mode, order) in SEARCHES {
+            let reference = run(preset, search, SimdPath::Portable, StrategyName::Seq, 1, 1);
             for simd in SimdPath::available() {
                 for (strategy, cores, chunks) in [
                     (StrategyName::Seq, 1, 1),
                     (StrategyName::RayonChunks, 2, 7),
                     (StrategyName::CrossbeamPool, 3, 64),
                 ] {
-                    let got = run(preset, mode, simd, strategy, cores, chunks);
+                    let got = run(preset, search, simd, strategy, cores, chunks);
                     if let Some(diff) = first_bit_difference(&got, &reference) {
-                        panic!("{preset} {mode} {simd} {strategy}: {diff}");
+                        panic!("{preset} {mode} order {order} {simd} {strategy}: {diff}");
                     }
                 }
             }

@@ -15,7 +15,7 @@ use crate::run::fault::PanicAt;
 use crate::run::{RunError, Steps, run_timed_steps};
 use crate::simd::SimdPath;
 use crate::solver::{Simulation, StepError};
-use crate::sph::neighbors::NeighborMode;
+use crate::sph::neighbors::{NeighborMode, SumOrder};
 use crate::sph::params::Preset;
 use crate::topology::Pin;
 
@@ -32,6 +32,11 @@ pub struct SimulateArgs {
     /// after the first step that reaches it (wcsph's time step adapts to the flow).
     #[arg(long, value_name = "SECONDS", value_parser = super::t_end, conflicts_with = "steps")]
     pub t_end: Option<f64>,
+    /// Order of the sums over neighbours: index (the sources' order and bits) or cell (the
+    /// grid's candidate order: faster, not the sources' bits, still the same bits on every
+    /// strategy, core and chunk count; needs --neighbors grid)
+    #[arg(long, default_value = "index", value_parser = super::values::order())]
+    pub order: SumOrder,
     /// How the passes run: strategy, worker threads, chunks.
     #[command(flatten)]
     pub parallel: super::parallel::ParallelArgs,
@@ -53,6 +58,7 @@ pub struct SimulateArgs {
 struct Report {
     preset: Preset,
     neighbors: NeighborMode,
+    order: SumOrder,
     strategy: String,
     cores: usize,
     chunks: Option<usize>,
@@ -83,12 +89,15 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     // Particles that move: particle-steps count these (wcsph's walls are fixed).
     let n = scene.fluid();
     let walls = scene.state.len() - n;
+    let mut sim = scene
+        .simulate(args.scene.neighbors)
+        .with_sum_order(args.order)
+        .context("--order cell needs --neighbors grid")?;
     // Open the dump before the run, so a bad path costs nothing. It is written to a
     // temporary file and renamed over FILE at the end: a failed or interrupted run leaves
     // FILE as it was.
     let mut dump = args.dump.as_deref().map(Sink::create).transpose()?;
     let config = args.parallel.config()?;
-    let mut sim = scene.simulate(args.scene.neighbors);
     let steps = match args.t_end {
         None => Steps::timed(args.steps),
         Some(t) => Steps {
@@ -129,6 +138,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     let report = Report {
         preset: args.scene.preset,
         neighbors: args.scene.neighbors,
+        order: sim.sum_order(),
         strategy: info.name.to_owned(),
         cores: info.effective_cores(config.cores),
         chunks: info.effective_chunks(args.parallel.chunks),
@@ -187,6 +197,9 @@ fn print_report(r: &Report, json: bool) -> anyhow::Result<()> {
         "N = {} particles{walls}{resolution}, {} steps",
         r.n, r.steps
     ))?;
+    if r.order == SumOrder::Cell {
+        say("sums in cell order: not the sources' bits (same bits on every strategy)")?;
+    }
     if let Some(t) = r.simulated_s {
         say(&format!("simulated time {t:.6} s"))?;
     }

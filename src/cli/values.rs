@@ -1,7 +1,7 @@
 //! The command line's names for the domain's enums, in one place: `src/sph` and `src/render`
 //! know nothing of clap. Each CLI enum carries the help text of its values and maps onto its
-//! domain type; an option keeps the domain type, parsed by [`preset`], [`neighbors`], [`color`]
-//! or [`strategy`] (the strategies' names come from their registry).
+//! domain type; an option keeps the domain type, parsed by [`preset`], [`neighbors`], [`order`],
+//! [`color`] or [`strategy`] (the strategies' names come from their registry).
 
 use std::ffi::OsStr;
 
@@ -11,7 +11,7 @@ use sph_strategies::StrategyName;
 
 use crate::render::scale::ColorBy;
 use crate::simd::SimdPath;
-use crate::sph::neighbors::NeighborMode;
+use crate::sph::neighbors::{NeighborMode, SumOrder};
 use crate::sph::params::Preset;
 use crate::topology::Pin;
 
@@ -50,6 +50,24 @@ impl From<NeighborsArg> for NeighborMode {
         match arg {
             NeighborsArg::AllPairs => NeighborMode::AllPairs,
             NeighborsArg::Grid => NeighborMode::Grid,
+        }
+    }
+}
+
+/// `--order`'s values.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum OrderArg {
+    /// Increasing index, as the sources' loops: the seed's and the C++ program's bits.
+    Index,
+    /// The grid's cell order: faster, not the sources' bits, the same bits on every strategy.
+    Cell,
+}
+
+impl From<OrderArg> for SumOrder {
+    fn from(arg: OrderArg) -> SumOrder {
+        match arg {
+            OrderArg::Index => SumOrder::Index,
+            OrderArg::Cell => SumOrder::Cell,
         }
     }
 }
@@ -129,6 +147,11 @@ pub(super) fn simd() -> impl TypedValueParser<Value = SimdPath> {
     EnumValueParser::<SimdArg>::new().map(SimdPath::from)
 }
 
+/// Parses a [`SumOrder`] by its command-line name, listing the orders in `--help`.
+pub(super) fn order() -> impl TypedValueParser<Value = SumOrder> {
+    EnumValueParser::<OrderArg>::new().map(SumOrder::from)
+}
+
 /// Parses a [`Pin`] by its command-line name, listing the placements in `--help`.
 pub(super) fn pin() -> impl TypedValueParser<Value = Pin> {
     EnumValueParser::<PinArg>::new().map(Pin::from)
@@ -194,6 +217,7 @@ mod tests {
         let all = [
             names::<PresetArg, Preset>(),
             names::<NeighborsArg, NeighborMode>(),
+            names::<OrderArg, SumOrder>(),
             names::<ColorArg, ColorBy>(),
             names::<SimdArg, SimdPath>(),
             names::<PinArg, Pin>(),
@@ -210,6 +234,7 @@ mod tests {
             NeighborsArg::value_variants().len(),
             NeighborMode::ALL.len()
         );
+        assert_eq!(OrderArg::value_variants().len(), SumOrder::ALL.len());
         assert_eq!(ColorArg::value_variants().len(), ColorBy::ALL.len());
         assert_eq!(SimdArg::value_variants().len(), SimdPath::ALL.len());
         assert_eq!(PinArg::value_variants().len(), Pin::ALL.len());

@@ -16,7 +16,8 @@ use sph_strategies::{Executor, KernelPanic};
 
 use crate::simd::{self, AnyLanes, SimdPath};
 use crate::sph::neighbors::{
-    self, AnyNeighbors, NeighborMode, Neighbors, SLOTS, Searched, WCSPH_SLOTS,
+    self, AnyNeighbors, CellOrderNeedsGrid, NeighborMode, Neighbors, SLOTS, Searched, SumOrder,
+    WCSPH_SLOTS,
 };
 use crate::sph::physics::Physics;
 use crate::sph::state::{Domain, Positions, State};
@@ -234,6 +235,21 @@ impl Simulation {
         assert!(width >= 1, "a neighbour list needs its scratch slot");
         self.neighbors.with_list_slots(width);
         self
+    }
+
+    /// The same simulation with its sums over neighbours in `order` ([`SumOrder`]): cell order
+    /// is faster on the grid but does not give the sources' bits.
+    ///
+    /// # Errors
+    /// Cell order with all-pairs, which has no cells.
+    pub fn with_sum_order(mut self, order: SumOrder) -> Result<Self, CellOrderNeedsGrid> {
+        self.neighbors.with_sum_order(order)?;
+        Ok(self)
+    }
+
+    /// The order sums over neighbours run in.
+    pub fn sum_order(&self) -> SumOrder {
+        self.neighbors.sum_order()
     }
 
     /// The SIMD path the neighbour tests run on: the chosen one for all-pairs, `portable` for

@@ -18,6 +18,41 @@ use sph_strategies::{Executor, KernelPanic};
 use crate::simd::Lanes;
 use crate::sph::state::{Domain, Positions};
 
+/// The order a particle's neighbours are visited in, and so the order its sums run in.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SumOrder {
+    /// Increasing index, as the sources' loops: both searches give the seed's and the C++
+    /// program's bits. The default.
+    #[default]
+    Index,
+    /// The grid's candidate order: cell rows bottom to top, cells left to right, increasing
+    /// index within a cell. No sort per particle, so the grid runs faster, but the sums round
+    /// differently: not the sources' bits, though still the same bits on every strategy,
+    /// core count and chunk count (the order depends only on the positions). All-pairs
+    /// visits candidates in index order, so it has only [`SumOrder::Index`].
+    Cell,
+}
+
+impl SumOrder {
+    /// Both orders, the default first.
+    pub const ALL: [SumOrder; 2] = [SumOrder::Index, SumOrder::Cell];
+
+    /// The name used on the command line and in `--json` output.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SumOrder::Index => "index",
+            SumOrder::Cell => "cell",
+        }
+    }
+}
+
+impl std::fmt::Display for SumOrder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 /// How candidates are found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -185,6 +220,29 @@ impl AnyNeighbors {
         }
     }
 
+    /// The same search visiting neighbours in `order`.
+    ///
+    /// # Errors
+    /// All-pairs in [`SumOrder::Cell`]: it has no cells, its candidates come in index order.
+    pub fn with_sum_order(&mut self, order: SumOrder) -> Result<(), CellOrderNeedsGrid> {
+        match self {
+            AnyNeighbors::AllPairs(_) if order == SumOrder::Cell => Err(CellOrderNeedsGrid),
+            AnyNeighbors::AllPairs(_) => Ok(()),
+            AnyNeighbors::Grid(s) => {
+                s.search.set_sum_order(order);
+                Ok(())
+            }
+        }
+    }
+
+    /// The order neighbours are visited in.
+    pub fn sum_order(&self) -> SumOrder {
+        match self {
+            AnyNeighbors::AllPairs(_) => SumOrder::Index,
+            AnyNeighbors::Grid(s) => s.search.sum_order(),
+        }
+    }
+
     /// Bytes held by the search and its lists (capacity).
     pub fn heap_bytes(&self) -> usize {
         match self {
@@ -193,3 +251,8 @@ impl AnyNeighbors {
         }
     }
 }
+
+/// Cell order asked of all-pairs, which has no cells.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("all-pairs has no cells: its sums run in index order")]
+pub struct CellOrderNeedsGrid;

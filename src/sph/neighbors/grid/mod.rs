@@ -6,7 +6,8 @@
 //! around the tank gives every cell all eight neighbours). Within one row of the grid the three
 //! cells are contiguous in the sorted order, so each row is one slice. The hits are put in index
 //! order before they are visited, so sums run in the same order as all-pairs and give the same
-//! bits.
+//! bits; in [`SumOrder::Cell`] they are visited in the order found, faster but rounding
+//! differently.
 //!
 //! A neighbour list names a hit by its position among the particle's candidates, counted row by
 //! row: one byte instead of a four-byte index (Müller's lists take 36 B a particle instead of
@@ -20,7 +21,7 @@ mod sort;
 use sort::CellSort;
 
 use super::list::written_zeros;
-use super::{Bounds, Neighbors, distance_squared};
+use super::{Bounds, Neighbors, SumOrder, distance_squared};
 use crate::simd::Lanes;
 use crate::sph::state::Positions;
 
@@ -50,6 +51,8 @@ pub struct Grid {
     cell_of: Vec<u32>,
     /// The counting sort's scratch.
     sort: CellSort,
+    /// The order hits are visited in.
+    sum_order: SumOrder,
 }
 
 impl Grid {
@@ -84,7 +87,18 @@ impl Grid {
             sorted_y: written_zeros(n),
             cell_of: written_zeros(n),
             sort: CellSort::new(n, cells),
+            sum_order: SumOrder::Index,
         }
+    }
+
+    /// Visits hits in `order` from now on.
+    pub fn set_sum_order(&mut self, order: SumOrder) {
+        self.sum_order = order;
+    }
+
+    /// The order hits are visited in.
+    pub fn sum_order(&self) -> SumOrder {
+        self.sum_order
     }
 
     /// Bytes held by the grid's arrays (capacity): what `scene::memory::estimate` must
@@ -178,8 +192,8 @@ impl Neighbors for Grid {
         // Hits are collected without branching (every candidate is written, the count only
         // advances on a hit), each with its key (its position among the block's candidates),
         // then put in index order unless they already are, by a branch-free rank sort (a
-        // comparison sort past RANK_SORT_MAX hits); a row that would overflow the stack buffer
-        // goes to a vector, sorted once. The squared distance is recomputed when a hit is
+        // comparison sort past RANK_SORT_MAX hits), or left in candidate order (cell order);
+        // a row that would overflow the stack buffer goes to a vector, sorted once. The squared distance is recomputed when a hit is
         // visited (same formula, same bits) so that only indices are moved.
         //
         // The candidates are tested one by one, not in `lanes`: a row holds 3–12 of them, and
@@ -207,14 +221,22 @@ impl Neighbors for Grid {
             }
         }
         let mut ranked = [0u64; RANK_SORT_MAX];
-        // In order already? A branch-free fold: `is_sorted` is a call per particle here.
-        let sorted = hits[..len]
-            .windows(2)
-            .fold(true, |ok, w| ok & (w[0] < w[1]));
+        // In order already? A branch-free fold: `is_sorted` is a call per particle here. In
+        // cell order, the order collected is the one wanted.
+        let cell_order = self.sum_order == SumOrder::Cell;
+        let sorted = cell_order
+            || hits[..len]
+                .windows(2)
+                .fold(true, |ok, w| ok & (w[0] < w[1]));
         let hits = if spilled.is_empty() && sorted {
             // Rows are scanned bottom to top and cells left to right: where particles are
             // still numbered in that order (a scene's start, a calm region) nothing moves.
             &hits[..len]
+        } else if cell_order {
+            // Rows went to the stack or to the heap: back in candidate order, by key.
+            spilled.extend_from_slice(&hits[..len]);
+            spilled.sort_unstable_by_key(|&h| h as u32);
+            &spilled[..]
         } else if spilled.is_empty() && len <= RANK_SORT_MAX {
             rank_sort(&hits[..len], &mut ranked[..len]);
             &ranked[..len]
@@ -337,14 +359,19 @@ mod tests {
         found
     }
 
-    #[test]
-    fn every_key_names_its_neighbour_again() {
-        // Random positions, some outside the bounds (edge cells), numbered in no spatial order.
+    /// Random positions, some outside the bounds (edge cells), numbered in no spatial order.
+    fn scattered(n: usize) -> (Vec<f64>, Vec<f64>) {
         let mut rng = SplitMix64::new(7);
-        let n = 2000;
         let mut coord = |extent: f64| rng.next_f64() * (extent + 40.0) - 20.0;
         let x: Vec<f64> = (0..n).map(|_| coord(320.0)).collect();
         let y: Vec<f64> = (0..n).map(|_| coord(240.0)).collect();
+        (x, y)
+    }
+
+    #[test]
+    fn every_key_names_its_neighbour_again() {
+        let n = 2000;
+        let (x, y) = scattered(n);
         let pos = Positions { x: &x, y: &y };
         let grid = grid_over(&x, &y);
         for i in 0..n {
@@ -359,6 +386,45 @@ mod tests {
             let js: Vec<usize> = found.iter().map(|&(j, _)| j).collect();
             assert_eq!(named, js, "particle {i}");
         }
+    }
+
+    #[test]
+    fn cell_order_visits_the_hits_of_index_order_in_candidate_order_spilled_rows_too() {
+        let (mut x, mut y) = scattered(2000);
+        // And a pile of 120 in one cell row (more than INLINE_HITS, so the row spills to the
+        // heap) with particles just above it that reach into it.
+        for k in 0..120 {
+            x.push(81.0 + (k % 40) as f64 * 1.1);
+            y.push(81.0 + (k / 40) as f64 * 0.5);
+        }
+        x.extend([100.0, 103.0, 98.0, 95.0]);
+        y.extend([96.5, 99.0, 104.0, 97.0]);
+        let pos = Positions { x: &x, y: &y };
+        let by_index = grid_over(&x, &y);
+        let mut by_cell = grid_over(&x, &y);
+        by_cell.set_sum_order(SumOrder::Cell);
+        let mut spilled_hits = 0;
+        for i in 0..x.len() {
+            let found = hits(&by_cell, i, pos);
+            assert!(found.windows(2).all(|w| w[0].1 < w[1].1), "particle {i}");
+            let mut js: Vec<usize> = found.iter().map(|&(j, _)| j).collect();
+            let keys: Vec<u8> = found.iter().map(|&(_, k)| k as u8).collect();
+            let mut named = Vec::new();
+            by_cell.for_each_listed(i, pos, &keys, |j| named.push(j));
+            assert_eq!(
+                named, js,
+                "particle {i}: keys name the hits in the order visited"
+            );
+            js.sort_unstable();
+            let in_index_order: Vec<usize> = hits(&by_index, i, pos).iter().map(|h| h.0).collect();
+            assert_eq!(js, in_index_order, "particle {i}");
+            spilled_hits +=
+                usize::from(i >= 2120 && found.iter().any(|&(j, _)| (2000..2120).contains(&j)));
+        }
+        assert!(
+            spilled_hits >= 2,
+            "the pile's row is reached from the row above"
+        );
     }
 
     #[test]
