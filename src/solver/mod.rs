@@ -155,6 +155,10 @@ macro_rules! with_search {
                 search: $nb,
                 lists: $lists,
             }) => $body,
+            AnyNeighbors::GridInCellOrder(Searched {
+                search: $nb,
+                lists: $lists,
+            }) => $body,
         }
     };
 }
@@ -170,6 +174,13 @@ macro_rules! with_search_lanes {
                 lists: $lists,
             }) => with_lanes!($lanes, $l => $body),
             AnyNeighbors::Grid(Searched {
+                search: $nb,
+                lists: $lists,
+            }) => {
+                let $l = simd::Portable;
+                $body
+            }
+            AnyNeighbors::GridInCellOrder(Searched {
                 search: $nb,
                 lists: $lists,
             }) => {
@@ -243,7 +254,7 @@ impl Simulation {
     /// # Errors
     /// Cell order with all-pairs, which has no cells.
     pub fn with_sum_order(mut self, order: SumOrder) -> Result<Self, CellOrderNeedsGrid> {
-        self.neighbors.with_sum_order(order)?;
+        self.neighbors = self.neighbors.with_sum_order(order)?;
         Ok(self)
     }
 
@@ -258,7 +269,7 @@ impl Simulation {
     pub fn simd(&self) -> SimdPath {
         match self.neighbors {
             AnyNeighbors::AllPairs(_) => self.lanes.path(),
-            AnyNeighbors::Grid(_) => SimdPath::Portable,
+            AnyNeighbors::Grid(_) | AnyNeighbors::GridInCellOrder(_) => SimdPath::Portable,
         }
     }
 

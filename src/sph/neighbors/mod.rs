@@ -9,7 +9,7 @@ mod grid;
 pub mod list;
 
 pub use all_pairs::AllPairs;
-pub use grid::Grid;
+pub use grid::{Grid, InCellOrder, InIndexOrder, VisitOrder};
 pub use list::{ListKey, ListWriter, NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS};
 
 use serde::Serialize;
@@ -207,8 +207,10 @@ pub fn build(
 pub enum AnyNeighbors {
     /// See [`AllPairs`].
     AllPairs(Searched<AllPairs>),
-    /// See [`Grid`].
+    /// See [`Grid`], visiting hits in index order.
     Grid(Searched<Grid>),
+    /// See [`Grid`], visiting hits in cell order.
+    GridInCellOrder(Searched<Grid<InCellOrder>>),
 }
 
 impl AnyNeighbors {
@@ -217,6 +219,7 @@ impl AnyNeighbors {
         match self {
             AnyNeighbors::AllPairs(s) => s.relist(width),
             AnyNeighbors::Grid(s) => s.relist(width),
+            AnyNeighbors::GridInCellOrder(s) => s.relist(width),
         }
     }
 
@@ -224,22 +227,26 @@ impl AnyNeighbors {
     ///
     /// # Errors
     /// All-pairs in [`SumOrder::Cell`]: it has no cells, its candidates come in index order.
-    pub fn with_sum_order(&mut self, order: SumOrder) -> Result<(), CellOrderNeedsGrid> {
-        match self {
-            AnyNeighbors::AllPairs(_) if order == SumOrder::Cell => Err(CellOrderNeedsGrid),
-            AnyNeighbors::AllPairs(_) => Ok(()),
-            AnyNeighbors::Grid(s) => {
-                s.search.set_sum_order(order);
-                Ok(())
-            }
-        }
+    pub fn with_sum_order(self, order: SumOrder) -> Result<AnyNeighbors, CellOrderNeedsGrid> {
+        Ok(match (self, order) {
+            (AnyNeighbors::AllPairs(_), SumOrder::Cell) => return Err(CellOrderNeedsGrid),
+            (AnyNeighbors::Grid(s), SumOrder::Cell) => AnyNeighbors::GridInCellOrder(Searched {
+                search: s.search.reordered(),
+                lists: s.lists,
+            }),
+            (AnyNeighbors::GridInCellOrder(s), SumOrder::Index) => AnyNeighbors::Grid(Searched {
+                search: s.search.reordered(),
+                lists: s.lists,
+            }),
+            (same, _) => same,
+        })
     }
 
     /// The order neighbours are visited in.
     pub fn sum_order(&self) -> SumOrder {
         match self {
-            AnyNeighbors::AllPairs(_) => SumOrder::Index,
-            AnyNeighbors::Grid(s) => s.search.sum_order(),
+            AnyNeighbors::AllPairs(_) | AnyNeighbors::Grid(_) => SumOrder::Index,
+            AnyNeighbors::GridInCellOrder(_) => SumOrder::Cell,
         }
     }
 
@@ -248,6 +255,7 @@ impl AnyNeighbors {
         match self {
             AnyNeighbors::AllPairs(s) => s.lists.heap_bytes(),
             AnyNeighbors::Grid(s) => s.search.heap_bytes() + s.lists.heap_bytes(),
+            AnyNeighbors::GridInCellOrder(s) => s.search.heap_bytes() + s.lists.heap_bytes(),
         }
     }
 }

@@ -14,6 +14,8 @@
 //! 132, `wcsph`'s 68 instead of 260), turned back into the index from the particle's own cell
 //! when the list is read.
 
+use std::marker::PhantomData;
+
 use sph_strategies::{Executor, KernelPanic};
 
 mod sort;
@@ -34,9 +36,32 @@ const INLINE_HITS: usize = 96;
 /// increasing order of distinct indices.
 const RANK_SORT_MAX: usize = 24;
 
-/// A cell list over a fixed domain.
+/// The order a grid visits each particle's hits in, as a type: a run's order is fixed, so each
+/// order's passes are compiled without the other's branches.
+pub trait VisitOrder: Send + Sync + 'static {
+    /// Which order.
+    const ORDER: SumOrder;
+}
+
+/// Increasing index: the sources' order and bits ([`SumOrder::Index`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct InIndexOrder;
+
+/// The order the candidates are found in ([`SumOrder::Cell`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct InCellOrder;
+
+impl VisitOrder for InIndexOrder {
+    const ORDER: SumOrder = SumOrder::Index;
+}
+
+impl VisitOrder for InCellOrder {
+    const ORDER: SumOrder = SumOrder::Cell;
+}
+
+/// A cell list over a fixed domain, visiting hits in the order `O`.
 #[derive(Debug, Clone)]
-pub struct Grid {
+pub struct Grid<O = InIndexOrder> {
     /// Cell size and counts.
     shape: Shape,
     /// Particles of cell c are `order[start[c]..start[c + 1]]`, in increasing index.
@@ -52,10 +77,10 @@ pub struct Grid {
     /// The counting sort's scratch.
     sort: CellSort,
     /// The order hits are visited in.
-    sum_order: SumOrder,
+    visit: PhantomData<O>,
 }
 
-impl Grid {
+impl<O> Grid<O> {
     /// An empty grid covering `bounds` with cells of edge `h`, with room for `n` particles.
     ///
     /// # Panics
@@ -87,18 +112,22 @@ impl Grid {
             sorted_y: written_zeros(n),
             cell_of: written_zeros(n),
             sort: CellSort::new(n, cells),
-            sum_order: SumOrder::Index,
+            visit: PhantomData,
         }
     }
 
-    /// Visits hits in `order` from now on.
-    pub fn set_sum_order(&mut self, order: SumOrder) {
-        self.sum_order = order;
-    }
-
-    /// The order hits are visited in.
-    pub fn sum_order(&self) -> SumOrder {
-        self.sum_order
+    /// The same grid, visiting hits in the order `O2`.
+    pub fn reordered<O2>(self) -> Grid<O2> {
+        Grid {
+            shape: self.shape,
+            start: self.start,
+            order: self.order,
+            sorted_x: self.sorted_x,
+            sorted_y: self.sorted_y,
+            cell_of: self.cell_of,
+            sort: self.sort,
+            visit: PhantomData,
+        }
     }
 
     /// Bytes held by the grid's arrays (capacity): what `scene::memory::estimate` must
@@ -147,7 +176,7 @@ impl Shape {
 
 /// A list names a neighbour by its position among the particle's candidates (the particles of
 /// its 3×3 cells, row by row): one byte, where a dam break has at most a few dozen candidates.
-impl Neighbors for Grid {
+impl<O: VisitOrder> Neighbors for Grid<O> {
     type Key = u8;
 
     /// Cell numbers (per particle), the counting sort (`CellSort`) and the gather of sorted
@@ -223,7 +252,7 @@ impl Neighbors for Grid {
         let mut ranked = [0u64; RANK_SORT_MAX];
         // In order already? A branch-free fold: `is_sorted` is a call per particle here. In
         // cell order, the order collected is the one wanted.
-        let cell_order = self.sum_order == SumOrder::Cell;
+        let cell_order = matches!(O::ORDER, SumOrder::Cell);
         let sorted = cell_order
             || hits[..len]
                 .windows(2)
@@ -292,7 +321,7 @@ struct Block {
     base: [u32; 3],
 }
 
-impl Grid {
+impl<O> Grid<O> {
     /// The block of candidates around the position (x, y).
     #[inline(always)]
     fn block(&self, x: f64, y: f64) -> Block {
@@ -340,20 +369,20 @@ mod tests {
 
     const H: f64 = 16.0;
 
-    fn grid_over(x: &[f64], y: &[f64]) -> Grid {
+    fn grid_over<O: VisitOrder>(x: &[f64], y: &[f64]) -> Grid<O> {
         let bounds = Bounds {
             min_x: 0.0,
             min_y: 0.0,
             max_x: 320.0,
             max_y: 240.0,
         };
-        let mut grid = Grid::new(bounds, H, x.len());
+        let mut grid = Grid::<O>::new(bounds, H, x.len());
         grid.rebuild(&SeqExecutor, Positions { x, y }).unwrap();
         grid
     }
 
     /// Every hit of particle i as (j, key), in the order visited.
-    fn hits(grid: &Grid, i: usize, pos: Positions<'_>) -> Vec<(usize, u32)> {
+    fn hits<O: VisitOrder>(grid: &Grid<O>, i: usize, pos: Positions<'_>) -> Vec<(usize, u32)> {
         let mut found = Vec::new();
         grid.for_each_within(Portable, i, pos, H * H, |j, _, key| found.push((j, key)));
         found
@@ -373,7 +402,7 @@ mod tests {
         let n = 2000;
         let (x, y) = scattered(n);
         let pos = Positions { x: &x, y: &y };
-        let grid = grid_over(&x, &y);
+        let grid = grid_over::<InIndexOrder>(&x, &y);
         for i in 0..n {
             let found = hits(&grid, i, pos);
             assert!(found.windows(2).all(|w| w[0].0 < w[1].0), "index order");
@@ -400,9 +429,8 @@ mod tests {
         x.extend([100.0, 103.0, 98.0, 95.0]);
         y.extend([96.5, 99.0, 104.0, 97.0]);
         let pos = Positions { x: &x, y: &y };
-        let by_index = grid_over(&x, &y);
-        let mut by_cell = grid_over(&x, &y);
-        by_cell.set_sum_order(SumOrder::Cell);
+        let by_index = grid_over::<InIndexOrder>(&x, &y);
+        let by_cell = grid_over::<InCellOrder>(&x, &y);
         let mut spilled_hits = 0;
         for i in 0..x.len() {
             let found = hits(&by_cell, i, pos);
@@ -437,7 +465,7 @@ mod tests {
         x.extend([101.0, 103.0, 100.0, 104.0]);
         y.extend([105.0, 106.0, 112.0, 95.0]);
         let pos = Positions { x: &x, y: &y };
-        let grid = grid_over(&x, &y);
+        let grid = grid_over::<InIndexOrder>(&x, &y);
         let found = hits(&grid, 120, pos);
         let js: Vec<usize> = found.iter().map(|&(j, _)| j).collect();
         assert_eq!(js, [120, 121, 122, 123]);
@@ -460,7 +488,7 @@ mod tests {
         x.extend([101.0, 103.0, 105.0]);
         y.extend([105.0, 106.0, 107.0]);
         let pos = Positions { x: &x, y: &y };
-        let grid = grid_over(&x, &y);
+        let grid = grid_over::<InIndexOrder>(&x, &y);
         let found = hits(&grid, 300, pos);
         let js: Vec<usize> = found.iter().map(|&(j, _)| j).collect();
         assert_eq!(js, [300, 301, 302]);
