@@ -4,7 +4,7 @@
 use bench_sph::run::{RunError, run_timed};
 use bench_sph::scene::{Scene, dam_break};
 use bench_sph::solver::{Simulation, StepError};
-use bench_sph::sph::neighbors::{NeighborMode, SumOrder};
+use bench_sph::sph::neighbors::{GridKeys, NeighborMode, SumOrder};
 use bench_sph::sph::params::Preset;
 use bench_sph::sph::state::{Domain, FIELD_NAMES, State};
 use sph_strategies::{Config, StrategyName};
@@ -89,15 +89,18 @@ fn neighbour_lists_of_any_width_give_the_same_bits() {
     // the passes that read the lists.
     // In cell order the passes' own search must visit the same order as the lists do.
     for preset in Preset::ALL {
-        for (mode, order) in [
-            (NeighborMode::AllPairs, SumOrder::Index),
-            (NeighborMode::Grid, SumOrder::Index),
-            (NeighborMode::Grid, SumOrder::Cell),
+        for (mode, keys, order) in [
+            (NeighborMode::AllPairs, GridKeys::Index, SumOrder::Index),
+            (NeighborMode::Grid, GridKeys::Index, SumOrder::Index),
+            (NeighborMode::Grid, GridKeys::Position, SumOrder::Index),
+            (NeighborMode::Grid, GridKeys::Index, SumOrder::Cell),
+            (NeighborMode::Grid, GridKeys::Position, SumOrder::Cell),
         ] {
             let run_with = |width: Option<usize>| {
                 let sim = Scene::dam_break(preset, 700, 2019)
                     .unwrap()
                     .simulate(mode)
+                    .with_grid_keys(keys)
                     .with_sum_order(order)
                     .unwrap();
                 let mut sim = match width {
@@ -107,7 +110,8 @@ fn neighbour_lists_of_any_width_give_the_same_bits() {
                 run_timed(&mut sim, StrategyName::Seq, &SEQ, 150).expect("run completes");
                 sim.state
             };
-            assert_eq!(run_with(Some(2)), run_with(None), "{preset} {mode} {order}");
+            let what = format!("{preset} {mode} {keys:?} keys, order {order}");
+            assert_eq!(run_with(Some(2)), run_with(None), "{what}");
         }
     }
 }
@@ -115,20 +119,38 @@ fn neighbour_lists_of_any_width_give_the_same_bits() {
 #[test]
 fn grid_visits_neighbours_in_index_order_so_it_gives_the_same_bits_as_all_pairs() {
     for preset in Preset::ALL {
-        assert_eq!(
-            run(preset, 700, 200, NeighborMode::Grid),
-            run(preset, 700, 200, NeighborMode::AllPairs)
-        );
+        let all_pairs = run(preset, 700, 200, NeighborMode::AllPairs);
+        for keys in [GridKeys::Index, GridKeys::Position] {
+            let mut sim = Scene::dam_break(preset, 700, 2019)
+                .unwrap()
+                .simulate(NeighborMode::Grid)
+                .with_grid_keys(keys);
+            run_timed(&mut sim, StrategyName::Seq, &SEQ, 200).expect("run completes");
+            assert_eq!(sim.state, all_pairs, "{preset} {keys:?}");
+        }
     }
 }
 
-/// One step of `state` in a 1200 × 900 tank with the seed constants.
-fn one_step(state: State, mode: NeighborMode) -> State {
+#[test]
+fn small_runs_list_grid_neighbours_by_index_and_large_ones_by_position() {
+    let keys = |n| {
+        Scene::dam_break(Preset::Seed, n, 1)
+            .unwrap()
+            .simulate(NeighborMode::Grid)
+            .grid_keys()
+    };
+    assert_eq!(keys(1000), Some(GridKeys::Index));
+    assert_eq!(keys(10_000), Some(GridKeys::Position));
+}
+
+/// One step of `state` in a 1200 × 900 tank with the seed constants; the grid's lists in
+/// `keys`.
+fn one_step(state: State, mode: NeighborMode, keys: GridKeys) -> State {
     let domain = Domain {
         width: 1200.0,
         height: 900.0,
     };
-    let mut sim = Simulation::new(Preset::Seed.params(), domain, state, mode);
+    let mut sim = Simulation::new(Preset::Seed.params(), domain, state, mode).with_grid_keys(keys);
     run_timed(&mut sim, StrategyName::Seq, &SEQ, 1).expect("step completes");
     sim.state
 }
@@ -156,16 +178,20 @@ fn a_crowd_beyond_the_grids_buffers_gives_the_same_bits_as_all_pairs() {
     }
     let n = x.len();
     let state = State::from_kinematics(x, y, vec![0.0; n], vec![0.0; n]);
-    let grid = one_step(state.clone(), NeighborMode::Grid);
-    assert_eq!(grid, one_step(state, NeighborMode::AllPairs));
-    assert!(grid.first_non_finite().is_none());
+    let all_pairs = one_step(state.clone(), NeighborMode::AllPairs, GridKeys::Index);
+    assert!(all_pairs.first_non_finite().is_none());
+    for keys in [GridKeys::Index, GridKeys::Position] {
+        let grid = one_step(state.clone(), NeighborMode::Grid, keys);
+        assert_eq!(grid, all_pairs, "{keys:?}");
+    }
 }
 
 #[test]
 fn neighbours_behind_a_pile_of_more_candidates_than_a_grid_key_counts_give_all_pairs_bits() {
     // 300 particles piled in one cell row, and a few in the row above, out of the pile's
-    // reach: their lists would fit, but the grid names their neighbours by keys past 255
-    // (the pile comes first among their candidates), so the force pass searches again.
+    // reach: their lists would fit, but a grid with position keys names their neighbours by
+    // keys past 255 (the pile comes first among their candidates), so the force pass searches
+    // again.
     let (mut x, mut y): (Vec<f64>, Vec<f64>) = (0..300)
         .map(|k| (600.0 + (k % 20) as f64 * 0.2, 401.0 + (k / 20) as f64 * 0.2))
         .unzip();
@@ -173,8 +199,9 @@ fn neighbours_behind_a_pile_of_more_candidates_than_a_grid_key_counts_give_all_p
     y.extend([425.0, 426.0, 427.0, 425.5]);
     let n = x.len();
     let state = State::from_kinematics(x, y, vec![0.0; n], vec![0.0; n]);
-    let grid = one_step(state.clone(), NeighborMode::Grid);
-    assert_eq!(grid, one_step(state, NeighborMode::AllPairs));
+    let grid = one_step(state.clone(), NeighborMode::Grid, GridKeys::Position);
+    let all_pairs = one_step(state, NeighborMode::AllPairs, GridKeys::Position);
+    assert_eq!(grid, all_pairs);
     assert!(grid.first_non_finite().is_none());
 }
 

@@ -1,5 +1,5 @@
-//! Every strategy gives the sequential run's bits, whatever the search (the grid in index or
-//! cell order), cores, chunks, SIMD path and thread placement (`--pin`) (the portable path's unpinned sequential run is the reference),
+//! Every strategy gives the sequential run's bits, whatever the search (the grid with either
+//! list key, in index or cell order), cores, chunks, SIMD path and thread placement (`--pin`) (the portable path's unpinned sequential run is the reference),
 //! and a panic inside a kernel becomes an error of the run (never a hang) on every strategy.
 
 use std::time::Duration;
@@ -8,7 +8,7 @@ use bench_sph::run::run_timed;
 use bench_sph::scene::{Scene, dam_break};
 use bench_sph::simd::SimdPath;
 use bench_sph::solver::Simulation;
-use bench_sph::sph::neighbors::{NeighborMode, SumOrder};
+use bench_sph::sph::neighbors::{GridKeys, NeighborMode, SumOrder};
 use bench_sph::sph::params::Preset;
 use bench_sph::sph::state::{FIELD_NAMES, State};
 use sph_strategies::{Config, StrategyName};
@@ -18,19 +18,24 @@ mod common;
 const N: usize = 500;
 const STEPS: usize = 25;
 
-/// A neighbour search and the order its sums run in.
-type Search = (NeighborMode, SumOrder);
+/// A neighbour search, the keys of the grid's lists (all-pairs lists indices whatever this
+/// says) and the order its sums run in.
+type Search = (NeighborMode, GridKeys, SumOrder);
 
-/// Every search, the grid in either order.
-const SEARCHES: [Search; 3] = [
-    (NeighborMode::AllPairs, SumOrder::Index),
-    (NeighborMode::Grid, SumOrder::Index),
-    (NeighborMode::Grid, SumOrder::Cell),
+/// Every search, the grid with either key (N particles get index keys by size; position keys,
+/// what large runs get, are forced) in either order.
+const SEARCHES: [Search; 5] = [
+    (NeighborMode::AllPairs, GridKeys::Index, SumOrder::Index),
+    (NeighborMode::Grid, GridKeys::Index, SumOrder::Index),
+    (NeighborMode::Grid, GridKeys::Position, SumOrder::Index),
+    (NeighborMode::Grid, GridKeys::Index, SumOrder::Cell),
+    (NeighborMode::Grid, GridKeys::Position, SumOrder::Cell),
 ];
 
-fn simulation(preset: Preset, (mode, order): Search) -> Simulation {
+fn simulation(preset: Preset, (mode, keys, order): Search) -> Simulation {
     let scene = Scene::dam_break(preset, N, 7).unwrap();
-    scene.simulate(mode).with_sum_order(order).unwrap()
+    let sim = scene.simulate(mode).with_grid_keys(keys);
+    sim.with_sum_order(order).unwrap()
 }
 
 fn run(
@@ -77,10 +82,10 @@ fn every_strategy_cores_and_chunks_gives_the_bits_of_the_sequential_run() {
                         for chunks in [1, 7, 64, N, 2 * N] {
                             let got = run(preset, search, simd, strategy, cores, chunks);
                             if let Some(diff) = first_bit_difference(&got, &reference) {
-                                let (mode, order) = search;
+                                let (mode, keys, order) = search;
                                 panic!(
-                                    "{preset} {mode} order {order} {simd} {strategy} \
-                                     cores={cores} chunks={chunks}: {diff}"
+                                    "{preset} {mode} {keys:?} keys, order {order} {simd} \
+                                     {strategy} cores={cores} chunks={chunks}: {diff}"
                                 );
                             }
                         }
@@ -96,7 +101,7 @@ fn every_strategy_pinned_compact_or_spread_gives_the_bits_of_the_unpinned_sequen
     use bench_sph::placement::placement;
     use bench_sph::topology::Pin;
     for preset in Preset::ALL {
-        for search @ (mode, order) in SEARCHES {
+        for search @ (mode, keys, order) in SEARCHES {
             let reference = run(preset, search, SimdPath::Portable, StrategyName::Seq, 1, 1);
             for pin in [Pin::Compact, Pin::Spread] {
                 let placed = placement(pin).expect("this machine accepts its own CPUs");
@@ -106,7 +111,7 @@ fn every_strategy_pinned_compact_or_spread_gives_the_bits_of_the_unpinned_sequen
                         let mut sim = simulation(preset, search);
                         let config = Config::new(cores, 7).placed(placed);
                         let what = format!(
-                            "{preset} {mode} order {order} --pin {pin} {strategy} cores={cores}"
+                            "{preset} {mode} {keys:?} keys, order {order} --pin {pin} {strategy} cores={cores}"
                         );
                         run_timed(&mut sim, strategy, &config, STEPS)
                             .unwrap_or_else(|e| panic!("{what}: {e}"));
@@ -124,7 +129,7 @@ fn every_strategy_pinned_compact_or_spread_gives_the_bits_of_the_unpinned_sequen
 fn every_simd_path_this_machine_runs_gives_the_portable_bits() {
     eprintln!("SIMD paths available here: {:?}", SimdPath::available());
     for preset in Preset::ALL {
-        for search @ (mode, order) in SEARCHES {
+        for search @ (mode, keys, order) in SEARCHES {
             let reference = run(preset, search, SimdPath::Portable, StrategyName::Seq, 1, 1);
             for simd in SimdPath::available() {
                 for (strategy, cores, chunks) in [
@@ -134,7 +139,9 @@ fn every_simd_path_this_machine_runs_gives_the_portable_bits() {
                 ] {
                     let got = run(preset, search, simd, strategy, cores, chunks);
                     if let Some(diff) = first_bit_difference(&got, &reference) {
-                        panic!("{preset} {mode} order {order} {simd} {strategy}: {diff}");
+                        panic!(
+                            "{preset} {mode} {keys:?} keys, order {order} {simd} {strategy}: {diff}"
+                        );
                     }
                 }
             }

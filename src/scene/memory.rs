@@ -3,8 +3,9 @@
 //!
 //! The estimate counts the arrays that grow with N, from the sizes of their element types:
 //! - the particle state: [`FIELD_NAMES`]`.len()` arrays of `f64` (64 B per particle);
-//! - the neighbour lists: a `u32` count and [`SLOTS`] slots per particle, a `u8` key each with
-//!   the grid (36 B), a `u32` index with all-pairs (132 B);
+//! - the neighbour lists: a `u32` count and [`SLOTS`] slots per particle, a `u32` index each
+//!   with all-pairs (132 B), and with the grid a `u8` key (36 B) or, while the lists fit in
+//!   [`GridKeys`]' cache budget, a `u32` index;
 //! - with `--neighbors grid`, the cell list: particle order and cell (`u32` each), sorted
 //!   positions (`f64` × 2), and one `u32` start per cell of the tank and of the empty ring
 //!   around it; the tank widens with N
@@ -19,7 +20,7 @@ use std::mem::size_of;
 use crate::limits::MAX_PARTICLES;
 use crate::scene::{dam_break, tank};
 use crate::solver::SPEED_BLOCK;
-use crate::sph::neighbors::{NeighborMode, SLOTS, WCSPH_SLOTS};
+use crate::sph::neighbors::{GridKeys, NeighborMode, SLOTS, WCSPH_SLOTS};
 use crate::sph::params::Preset;
 use crate::sph::physics::Physics;
 use crate::sph::state::FIELD_NAMES;
@@ -73,10 +74,10 @@ pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
         }
     };
     let n64 = n as u64;
-    // A list's count, and its slots in the search's keys: `u8` for the grid, `u32` for
-    // all-pairs.
+    // A list's count, and its slots in the search's keys: `u32` for all-pairs, and for the
+    // grid those its size gets (`u32` while they fit in a cache budget, `u8` past it).
     let key_bytes = match neighbors {
-        NeighborMode::Grid => size_of::<u8>(),
+        NeighborMode::Grid => GridKeys::for_lists(n, lists_of).slot_bytes(),
         NeighborMode::AllPairs => size_of::<u32>(),
     };
     let per_particle =

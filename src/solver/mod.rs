@@ -16,8 +16,8 @@ use sph_strategies::{Executor, KernelPanic};
 
 use crate::simd::{self, AnyLanes, SimdPath};
 use crate::sph::neighbors::{
-    self, AnyNeighbors, CellOrderNeedsGrid, NeighborMode, Neighbors, SLOTS, Searched, SumOrder,
-    WCSPH_SLOTS,
+    self, AnyNeighbors, CellOrderNeedsGrid, GridKeys, NeighborMode, Neighbors, SLOTS, Searched,
+    SumOrder, WCSPH_SLOTS,
 };
 use crate::sph::physics::Physics;
 use crate::sph::state::{Domain, Positions, State};
@@ -155,7 +155,15 @@ macro_rules! with_search {
                 search: $nb,
                 lists: $lists,
             }) => $body,
+            AnyNeighbors::GridByIndex(Searched {
+                search: $nb,
+                lists: $lists,
+            }) => $body,
             AnyNeighbors::GridInCellOrder(Searched {
+                search: $nb,
+                lists: $lists,
+            }) => $body,
+            AnyNeighbors::GridByIndexInCellOrder(Searched {
                 search: $nb,
                 lists: $lists,
             }) => $body,
@@ -169,21 +177,22 @@ macro_rules! with_search {
 macro_rules! with_search_lanes {
     ($any:expr, $lanes:expr, ($nb:ident, $lists:ident, $l:ident) => $body:expr) => {
         match $any {
-            AnyNeighbors::AllPairs(Searched {
-                search: $nb,
-                lists: $lists,
-            }) => with_lanes!($lanes, $l => $body),
-            AnyNeighbors::Grid(Searched {
-                search: $nb,
-                lists: $lists,
-            }) => {
+            AnyNeighbors::AllPairs(Searched { search: $nb, lists: $lists }) => {
+                with_lanes!($lanes, $l => $body)
+            }
+            AnyNeighbors::Grid(Searched { search: $nb, lists: $lists }) => {
                 let $l = simd::Portable;
                 $body
             }
-            AnyNeighbors::GridInCellOrder(Searched {
-                search: $nb,
-                lists: $lists,
-            }) => {
+            AnyNeighbors::GridByIndex(Searched { search: $nb, lists: $lists }) => {
+                let $l = simd::Portable;
+                $body
+            }
+            AnyNeighbors::GridInCellOrder(Searched { search: $nb, lists: $lists }) => {
+                let $l = simd::Portable;
+                $body
+            }
+            AnyNeighbors::GridByIndexInCellOrder(Searched { search: $nb, lists: $lists }) => {
                 let $l = simd::Portable;
                 $body
             }
@@ -263,13 +272,26 @@ impl Simulation {
         self.neighbors.sum_order()
     }
 
+    /// The same simulation with the grid's neighbour lists in `keys` instead of the ones its
+    /// size gets ([`GridKeys::for_lists`]); all-pairs is left as it is. The results are the
+    /// same bits, only speed and memory differ (tests use it to run both keys at any size).
+    pub fn with_grid_keys(mut self, keys: GridKeys) -> Self {
+        self.neighbors = self.neighbors.with_grid_keys(keys);
+        self
+    }
+
+    /// How the grid's neighbour lists name neighbours; `None` for all-pairs.
+    pub fn grid_keys(&self) -> Option<GridKeys> {
+        self.neighbors.grid_keys()
+    }
+
     /// The SIMD path the neighbour tests run on: the chosen one for all-pairs, `portable` for
     /// the grid (which tests its few candidates per row one by one), so that `--json` and
     /// `meta.json` name what ran.
     pub fn simd(&self) -> SimdPath {
         match self.neighbors {
             AnyNeighbors::AllPairs(_) => self.lanes.path(),
-            AnyNeighbors::Grid(_) | AnyNeighbors::GridInCellOrder(_) => SimdPath::Portable,
+            _ => SimdPath::Portable,
         }
     }
 

@@ -2,8 +2,9 @@
 //! pass, so a step scans for candidates once instead of twice.
 //!
 //! A list names its neighbours by the search's keys ([`ListKey`]): all-pairs by index (`u32`),
-//! the grid by position among the particle's candidates (`u8`, a quarter of the memory, see
-//! [`crate::sph::neighbors::Neighbors::for_each_listed`]).
+//! the grid by index in a small run and by position among the particle's candidates in a
+//! large one (`u8`, a quarter of the memory; see
+//! [`GridKeys`](crate::sph::neighbors::GridKeys)).
 //!
 //! A particle has a fixed number of slots ([`SLOTS`] for Müller's presets,
 //! [`WCSPH_SLOTS`] for `wcsph`, whose kernel reaches about 21 fluid neighbours and as many
@@ -131,6 +132,21 @@ impl<K: ListKey> NeighborLists<K> {
             slots: written_zeros(n * width),
             width,
         }
+    }
+
+    /// Particles with a list.
+    pub fn len(&self) -> usize {
+        self.count.len()
+    }
+
+    /// Whether no particle has a list.
+    pub fn is_empty(&self) -> bool {
+        self.count.is_empty()
+    }
+
+    /// Slots per particle.
+    pub fn width(&self) -> usize {
+        self.width
     }
 
     /// The counts and the slots, to be cut per particle in lockstep with other per-particle

@@ -9,6 +9,7 @@ mod grid;
 pub mod list;
 
 pub use all_pairs::AllPairs;
+pub use grid::keys::GridKeys;
 pub use grid::{Grid, InCellOrder, InIndexOrder, VisitOrder};
 pub use list::{ListKey, ListWriter, NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS};
 
@@ -134,7 +135,7 @@ pub struct Searched<N: Neighbors> {
 impl<N: Neighbors> Searched<N> {
     /// New lists of `width` slots for as many particles.
     fn relist(&mut self, width: usize) {
-        self.lists = NeighborLists::with_slots(self.lists.count.len(), width);
+        self.lists = NeighborLists::with_slots(self.lists.len(), width);
     }
 }
 
@@ -182,7 +183,8 @@ impl Bounds {
 }
 
 /// Builds the search for `mode` over `bounds` with search radius `radius` (the cell edge) for
-/// `n` particles, with lists of `width` slots for the first `listed` of them.
+/// `n` particles, with lists of `width` slots for the first `listed` of them: the grid's in the
+/// keys [`GridKeys::for_lists`] picks for that size, visiting hits in index order.
 pub fn build(
     mode: NeighborMode,
     bounds: Bounds,
@@ -195,32 +197,111 @@ pub fn build(
             search: AllPairs,
             lists: NeighborLists::with_slots(listed, width),
         }),
-        NeighborMode::Grid => AnyNeighbors::Grid(Searched {
-            search: Grid::new(bounds, radius, n),
-            lists: NeighborLists::with_slots(listed, width),
-        }),
+        NeighborMode::Grid => AnyNeighbors::of_grid(
+            Grid::new(bounds, radius, n),
+            (listed, width),
+            GridKeys::for_lists(listed, width),
+            SumOrder::Index,
+        ),
     }
 }
 
-/// One of the searches, with its lists, chosen once per run.
+/// One of the searches, with its lists, chosen once per run; the grid in each of its list keys
+/// and visit orders, so that each combination's passes are compiled on their own.
 #[derive(Debug, Clone)]
 pub enum AnyNeighbors {
     /// See [`AllPairs`].
     AllPairs(Searched<AllPairs>),
-    /// See [`Grid`], visiting hits in index order.
+    /// See [`Grid`]: position keys, index order.
     Grid(Searched<Grid>),
-    /// See [`Grid`], visiting hits in cell order.
-    GridInCellOrder(Searched<Grid<InCellOrder>>),
+    /// See [`Grid`]: index keys, index order.
+    GridByIndex(Searched<Grid<u32>>),
+    /// See [`Grid`]: position keys, cell order.
+    GridInCellOrder(Searched<Grid<u8, InCellOrder>>),
+    /// See [`Grid`]: index keys, cell order.
+    GridByIndexInCellOrder(Searched<Grid<u32, InCellOrder>>),
 }
 
+/// A grid taken apart from its lists: the grid, the lists' particles and slots, their keys and
+/// the visit order.
+type GridParts = (Grid, (usize, usize), GridKeys, SumOrder);
+
 impl AnyNeighbors {
+    /// `grid` with new lists for `listed` particles of `width` slots in `keys`, visiting hits
+    /// in `order`.
+    fn of_grid(
+        grid: Grid,
+        (listed, width): (usize, usize),
+        keys: GridKeys,
+        order: SumOrder,
+    ) -> AnyNeighbors {
+        match (keys, order) {
+            (GridKeys::Position, SumOrder::Index) => AnyNeighbors::Grid(Searched {
+                search: grid,
+                lists: NeighborLists::with_slots(listed, width),
+            }),
+            (GridKeys::Index, SumOrder::Index) => AnyNeighbors::GridByIndex(Searched {
+                search: grid.recast(),
+                lists: NeighborLists::with_slots(listed, width),
+            }),
+            (GridKeys::Position, SumOrder::Cell) => AnyNeighbors::GridInCellOrder(Searched {
+                search: grid.recast(),
+                lists: NeighborLists::with_slots(listed, width),
+            }),
+            (GridKeys::Index, SumOrder::Cell) => AnyNeighbors::GridByIndexInCellOrder(Searched {
+                search: grid.recast(),
+                lists: NeighborLists::with_slots(listed, width),
+            }),
+        }
+    }
+
+    /// The same search, the grid rebuilt by `f` from its parts; all-pairs as it is.
+    fn map_grid(self, f: impl FnOnce(GridParts) -> AnyNeighbors) -> AnyNeighbors {
+        match self {
+            AnyNeighbors::AllPairs(_) => self,
+            AnyNeighbors::Grid(s) => f((
+                s.search,
+                (s.lists.len(), s.lists.width()),
+                GridKeys::Position,
+                SumOrder::Index,
+            )),
+            AnyNeighbors::GridByIndex(s) => f((
+                s.search.recast(),
+                (s.lists.len(), s.lists.width()),
+                GridKeys::Index,
+                SumOrder::Index,
+            )),
+            AnyNeighbors::GridInCellOrder(s) => f((
+                s.search.recast(),
+                (s.lists.len(), s.lists.width()),
+                GridKeys::Position,
+                SumOrder::Cell,
+            )),
+            AnyNeighbors::GridByIndexInCellOrder(s) => f((
+                s.search.recast(),
+                (s.lists.len(), s.lists.width()),
+                GridKeys::Index,
+                SumOrder::Cell,
+            )),
+        }
+    }
+
     /// The same search with lists of `width` slots each (for as many particles).
     pub fn with_list_slots(&mut self, width: usize) {
         match self {
             AnyNeighbors::AllPairs(s) => s.relist(width),
             AnyNeighbors::Grid(s) => s.relist(width),
+            AnyNeighbors::GridByIndex(s) => s.relist(width),
             AnyNeighbors::GridInCellOrder(s) => s.relist(width),
+            AnyNeighbors::GridByIndexInCellOrder(s) => s.relist(width),
         }
+    }
+
+    /// For the grid, the same grid with lists in `keys` (for as many particles, as wide);
+    /// all-pairs, which lists indices, as it is. Both keys give the same bits: tests use this
+    /// to run either at any size.
+    pub fn with_grid_keys(self, keys: GridKeys) -> AnyNeighbors {
+        self.map_grid(|(grid, dims, _, order)| AnyNeighbors::of_grid(grid, dims, keys, order))
     }
 
     /// The same search visiting neighbours in `order`.
@@ -228,25 +309,32 @@ impl AnyNeighbors {
     /// # Errors
     /// All-pairs in [`SumOrder::Cell`]: it has no cells, its candidates come in index order.
     pub fn with_sum_order(self, order: SumOrder) -> Result<AnyNeighbors, CellOrderNeedsGrid> {
-        Ok(match (self, order) {
-            (AnyNeighbors::AllPairs(_), SumOrder::Cell) => return Err(CellOrderNeedsGrid),
-            (AnyNeighbors::Grid(s), SumOrder::Cell) => AnyNeighbors::GridInCellOrder(Searched {
-                search: s.search.reordered(),
-                lists: s.lists,
-            }),
-            (AnyNeighbors::GridInCellOrder(s), SumOrder::Index) => AnyNeighbors::Grid(Searched {
-                search: s.search.reordered(),
-                lists: s.lists,
-            }),
-            (same, _) => same,
-        })
+        if order == SumOrder::Cell && matches!(self, AnyNeighbors::AllPairs(_)) {
+            return Err(CellOrderNeedsGrid);
+        }
+        Ok(self.map_grid(|(grid, dims, keys, _)| AnyNeighbors::of_grid(grid, dims, keys, order)))
+    }
+
+    /// How the grid's lists name neighbours; `None` for all-pairs.
+    pub fn grid_keys(&self) -> Option<GridKeys> {
+        match self {
+            AnyNeighbors::AllPairs(_) => None,
+            AnyNeighbors::Grid(_) | AnyNeighbors::GridInCellOrder(_) => Some(GridKeys::Position),
+            AnyNeighbors::GridByIndex(_) | AnyNeighbors::GridByIndexInCellOrder(_) => {
+                Some(GridKeys::Index)
+            }
+        }
     }
 
     /// The order neighbours are visited in.
     pub fn sum_order(&self) -> SumOrder {
         match self {
-            AnyNeighbors::AllPairs(_) | AnyNeighbors::Grid(_) => SumOrder::Index,
-            AnyNeighbors::GridInCellOrder(_) => SumOrder::Cell,
+            AnyNeighbors::AllPairs(_) | AnyNeighbors::Grid(_) | AnyNeighbors::GridByIndex(_) => {
+                SumOrder::Index
+            }
+            AnyNeighbors::GridInCellOrder(_) | AnyNeighbors::GridByIndexInCellOrder(_) => {
+                SumOrder::Cell
+            }
         }
     }
 
@@ -255,7 +343,9 @@ impl AnyNeighbors {
         match self {
             AnyNeighbors::AllPairs(s) => s.lists.heap_bytes(),
             AnyNeighbors::Grid(s) => s.search.heap_bytes() + s.lists.heap_bytes(),
+            AnyNeighbors::GridByIndex(s) => s.search.heap_bytes() + s.lists.heap_bytes(),
             AnyNeighbors::GridInCellOrder(s) => s.search.heap_bytes() + s.lists.heap_bytes(),
+            AnyNeighbors::GridByIndexInCellOrder(s) => s.search.heap_bytes() + s.lists.heap_bytes(),
         }
     }
 }

@@ -9,17 +9,19 @@
 //! bits; in [`SumOrder::Cell`] they are visited in the order found, faster but rounding
 //! differently.
 //!
-//! A neighbour list names a hit by its position among the particle's candidates, counted row by
-//! row: one byte instead of a four-byte index (Müller's lists take 36 B a particle instead of
-//! 132, `wcsph`'s 68 instead of 260), turned back into the index from the particle's own cell
-//! when the list is read.
+//! A neighbour list names a hit by its index or, in a large run, by its position among the
+//! particle's candidates, counted row by row: one byte instead of a four-byte index (Müller's
+//! lists take 36 B a particle instead of 132, `wcsph`'s 68 instead of 260), turned back into
+//! the index from the particle's own cell when the list is read ([`keys`]).
 
 use std::marker::PhantomData;
 
 use sph_strategies::{Executor, KernelPanic};
 
+pub mod keys;
 mod sort;
 
+use keys::GridKey;
 use sort::CellSort;
 
 use super::list::written_zeros;
@@ -59,9 +61,10 @@ impl VisitOrder for InCellOrder {
     const ORDER: SumOrder = SumOrder::Cell;
 }
 
-/// A cell list over a fixed domain, visiting hits in the order `O`.
+/// A cell list over a fixed domain, listing neighbours in keys of type `K` ([`keys`]) and
+/// visiting hits in the order `O`.
 #[derive(Debug, Clone)]
-pub struct Grid<O = InIndexOrder> {
+pub struct Grid<K = u8, O = InIndexOrder> {
     /// Cell size and counts.
     shape: Shape,
     /// Particles of cell c are `order[start[c]..start[c + 1]]`, in increasing index.
@@ -76,11 +79,11 @@ pub struct Grid<O = InIndexOrder> {
     cell_of: Vec<u32>,
     /// The counting sort's scratch.
     sort: CellSort,
-    /// The order hits are visited in.
-    visit: PhantomData<O>,
+    /// The key type of the lists ([`keys`]) and the order hits are visited in.
+    marker: PhantomData<(K, O)>,
 }
 
-impl<O> Grid<O> {
+impl<K, O> Grid<K, O> {
     /// An empty grid covering `bounds` with cells of edge `h`, with room for `n` particles.
     ///
     /// # Panics
@@ -112,12 +115,12 @@ impl<O> Grid<O> {
             sorted_y: written_zeros(n),
             cell_of: written_zeros(n),
             sort: CellSort::new(n, cells),
-            visit: PhantomData,
+            marker: PhantomData,
         }
     }
 
-    /// The same grid, visiting hits in the order `O2`.
-    pub fn reordered<O2>(self) -> Grid<O2> {
+    /// The same grid, for lists in keys of type `K2` and visiting hits in the order `O2`.
+    pub fn recast<K2, O2>(self) -> Grid<K2, O2> {
         Grid {
             shape: self.shape,
             start: self.start,
@@ -126,7 +129,7 @@ impl<O> Grid<O> {
             sorted_y: self.sorted_y,
             cell_of: self.cell_of,
             sort: self.sort,
-            visit: PhantomData,
+            marker: PhantomData,
         }
     }
 
@@ -174,10 +177,11 @@ impl Shape {
     }
 }
 
-/// A list names a neighbour by its position among the particle's candidates (the particles of
-/// its 3×3 cells, row by row): one byte, where a dam break has at most a few dozen candidates.
-impl<O: VisitOrder> Neighbors for Grid<O> {
-    type Key = u8;
+/// A list names a neighbour by its index (`u32` keys) or by its position among the particle's
+/// candidates (the particles of its 3×3 cells, row by row; `u8` keys: one byte, where a dam
+/// break has at most a few dozen candidates).
+impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
+    type Key = K;
 
     /// Cell numbers (per particle), the counting sort (`CellSort`) and the gather of sorted
     /// positions (per slot) run on the executor.
@@ -219,11 +223,12 @@ impl<O: VisitOrder> Neighbors for Grid<O> {
         let (xi, yi) = (pos.x[i], pos.y[i]);
         let block = self.block(xi, yi);
         // Hits are collected without branching (every candidate is written, the count only
-        // advances on a hit), each with its key (its position among the block's candidates),
-        // then put in index order unless they already are, by a branch-free rank sort (a
-        // comparison sort past RANK_SORT_MAX hits), or left in candidate order (cell order);
-        // a row that would overflow the stack buffer goes to a vector, sorted once. The squared distance is recomputed when a hit is
-        // visited (same formula, same bits) so that only indices are moved.
+        // advances on a hit), each with its key (its index, or its position among the block's
+        // candidates), then put in index order unless they already are, by a branch-free rank
+        // sort (a comparison sort past RANK_SORT_MAX hits), or left in candidate order (cell
+        // order); a row that would overflow the stack buffer goes to a vector, sorted once.
+        // The squared distance is recomputed when a hit is visited (same formula, same bits)
+        // so that only indices are moved.
         //
         // The candidates are tested one by one, not in `lanes`: a row holds 3–12 of them, and
         // blocks of eight with a mask measured 8–15 % slower (N = 1000 and 10⁵ in motion).
@@ -239,13 +244,14 @@ impl<O: VisitOrder> Neighbors for Grid<O> {
             );
             if len + js.len() <= INLINE_HITS {
                 for (t, ((&xj, &yj), &j)) in xs.iter().zip(ys).zip(js).enumerate() {
-                    hits[len] = hit(j, base + t as u32);
+                    hits[len] = hit(j, key::<K>(j, base + t as u32));
                     len += usize::from(distance_squared(xi, yi, xj, yj) < hsq);
                 }
             } else {
                 let found = xs.iter().zip(ys).zip(js).enumerate();
                 spilled.extend(found.filter_map(|(t, ((&xj, &yj), &j))| {
-                    (distance_squared(xi, yi, xj, yj) < hsq).then_some(hit(j, base + t as u32))
+                    (distance_squared(xi, yi, xj, yj) < hsq)
+                        .then_some(hit(j, key::<K>(j, base + t as u32)))
                 }));
             }
         }
@@ -283,16 +289,23 @@ impl<O: VisitOrder> Neighbors for Grid<O> {
         }
     }
 
-    /// A key is a hit's position among its block's candidates, counted along the block's rows:
-    /// it is one addition and one load away from the neighbour's index.
+    /// An index key is the neighbour. A position key is a hit's position among its block's
+    /// candidates, counted along the block's rows: it is one addition and one load away from
+    /// the neighbour's index.
     #[inline(always)]
     fn for_each_listed(
         &self,
         i: usize,
         pos: Positions<'_>,
-        list: &[u8],
+        list: &[K],
         mut visit: impl FnMut(usize),
     ) {
+        if K::BY_INDEX {
+            for &key in list {
+                visit(key.get() as usize);
+            }
+            return;
+        }
         let block = self.block(pos.x[i], pos.y[i]);
         // Where in `order` a key of each row starts: the row's first slot minus the keys of
         // the rows before it (wrapping: only sums with a key of that row are read).
@@ -302,13 +315,19 @@ impl<O: VisitOrder> Neighbors for Grid<O> {
         // Branch-free: the keys of one list come from every row in turn.
         let (step1, step2) = (o1.wrapping_sub(o0), o2.wrapping_sub(o1));
         for &key in list {
-            let key = u32::from(key);
+            let key = key.get();
             let offset = o0
                 .wrapping_add(step1.wrapping_mul(u32::from(key >= b1)))
                 .wrapping_add(step2.wrapping_mul(u32::from(key >= b2)));
             visit(self.order[key.wrapping_add(offset) as usize] as usize);
         }
     }
+}
+
+/// The key of neighbour `j`, the candidate at `position` in its block, in keys of type `K`.
+#[inline(always)]
+fn key<K: GridKey>(j: u32, position: u32) -> u32 {
+    if K::BY_INDEX { j } else { position }
 }
 
 /// The candidates of a particle: the particles of the 3×3 cells around its cell, as three runs
@@ -321,7 +340,7 @@ struct Block {
     base: [u32; 3],
 }
 
-impl<O> Grid<O> {
+impl<K, O> Grid<K, O> {
     /// The block of candidates around the position (x, y).
     #[inline(always)]
     fn block(&self, x: f64, y: f64) -> Block {
@@ -369,20 +388,24 @@ mod tests {
 
     const H: f64 = 16.0;
 
-    fn grid_over<O: VisitOrder>(x: &[f64], y: &[f64]) -> Grid<O> {
+    fn grid_over<K: GridKey, O: VisitOrder>(x: &[f64], y: &[f64]) -> Grid<K, O> {
         let bounds = Bounds {
             min_x: 0.0,
             min_y: 0.0,
             max_x: 320.0,
             max_y: 240.0,
         };
-        let mut grid = Grid::<O>::new(bounds, H, x.len());
+        let mut grid = Grid::<K, O>::new(bounds, H, x.len());
         grid.rebuild(&SeqExecutor, Positions { x, y }).unwrap();
         grid
     }
 
     /// Every hit of particle i as (j, key), in the order visited.
-    fn hits<O: VisitOrder>(grid: &Grid<O>, i: usize, pos: Positions<'_>) -> Vec<(usize, u32)> {
+    fn hits<K: GridKey, O: VisitOrder>(
+        grid: &Grid<K, O>,
+        i: usize,
+        pos: Positions<'_>,
+    ) -> Vec<(usize, u32)> {
         let mut found = Vec::new();
         grid.for_each_within(Portable, i, pos, H * H, |j, _, key| found.push((j, key)));
         found
@@ -397,23 +420,49 @@ mod tests {
         (x, y)
     }
 
-    #[test]
-    fn every_key_names_its_neighbour_again() {
-        let n = 2000;
-        let (x, y) = scattered(n);
-        let pos = Positions { x: &x, y: &y };
-        let grid = grid_over::<InIndexOrder>(&x, &y);
-        for i in 0..n {
+    /// Checks that every particle's hits come in index order and that their keys, listed in
+    /// type `K`, name the same neighbours again.
+    fn keys_name_their_neighbours_again<K: GridKey>(x: &[f64], y: &[f64]) {
+        let pos = Positions { x, y };
+        let grid = grid_over::<K, InIndexOrder>(x, y);
+        for i in 0..x.len() {
             let found = hits(&grid, i, pos);
             assert!(found.windows(2).all(|w| w[0].0 < w[1].0), "index order");
-            let keys: Vec<u8> = found
+            let keys: Vec<K> = found
                 .iter()
-                .map(|&(_, k)| u8::try_from(k).unwrap())
+                .map(|&(_, k)| {
+                    assert!(k <= K::MAX, "particle {i}: key {k}");
+                    K::truncate(k)
+                })
                 .collect();
             let mut named = Vec::new();
             grid.for_each_listed(i, pos, &keys, |j| named.push(j));
             let js: Vec<usize> = found.iter().map(|&(j, _)| j).collect();
             assert_eq!(named, js, "particle {i}");
+        }
+    }
+
+    #[test]
+    fn every_position_key_names_its_neighbour_again() {
+        let (x, y) = scattered(2000);
+        keys_name_their_neighbours_again::<u8>(&x, &y);
+    }
+
+    #[test]
+    fn index_keys_are_the_neighbours_and_find_what_position_keys_find() {
+        let (x, y) = scattered(2000);
+        keys_name_their_neighbours_again::<u32>(&x, &y);
+        let pos = Positions { x: &x, y: &y };
+        let by_index = grid_over::<u32, InIndexOrder>(&x, &y);
+        let by_position = grid_over::<u8, InIndexOrder>(&x, &y);
+        let js = |found: Vec<(usize, u32)>| found.into_iter().map(|(j, _)| j).collect::<Vec<_>>();
+        for i in 0..x.len() {
+            let found = hits(&by_index, i, pos);
+            assert!(
+                found.iter().all(|&(j, key)| key as usize == j),
+                "particle {i}"
+            );
+            assert_eq!(js(found), js(hits(&by_position, i, pos)), "particle {i}");
         }
     }
 
@@ -429,8 +478,8 @@ mod tests {
         x.extend([100.0, 103.0, 98.0, 95.0]);
         y.extend([96.5, 99.0, 104.0, 97.0]);
         let pos = Positions { x: &x, y: &y };
-        let by_index = grid_over::<InIndexOrder>(&x, &y);
-        let by_cell = grid_over::<InCellOrder>(&x, &y);
+        let by_index = grid_over::<u8, InIndexOrder>(&x, &y);
+        let by_cell = grid_over::<u8, InCellOrder>(&x, &y);
         let mut spilled_hits = 0;
         for i in 0..x.len() {
             let found = hits(&by_cell, i, pos);
@@ -465,7 +514,7 @@ mod tests {
         x.extend([101.0, 103.0, 100.0, 104.0]);
         y.extend([105.0, 106.0, 112.0, 95.0]);
         let pos = Positions { x: &x, y: &y };
-        let grid = grid_over::<InIndexOrder>(&x, &y);
+        let grid = grid_over::<u8, InIndexOrder>(&x, &y);
         let found = hits(&grid, 120, pos);
         let js: Vec<usize> = found.iter().map(|&(j, _)| j).collect();
         assert_eq!(js, [120, 121, 122, 123]);
@@ -488,7 +537,7 @@ mod tests {
         x.extend([101.0, 103.0, 105.0]);
         y.extend([105.0, 106.0, 107.0]);
         let pos = Positions { x: &x, y: &y };
-        let grid = grid_over::<InIndexOrder>(&x, &y);
+        let grid = grid_over::<u8, InIndexOrder>(&x, &y);
         let found = hits(&grid, 300, pos);
         let js: Vec<usize> = found.iter().map(|&(j, _)| j).collect();
         assert_eq!(js, [300, 301, 302]);
