@@ -9,7 +9,7 @@ mod grid;
 pub mod list;
 
 pub use all_pairs::AllPairs;
-pub use grid::keys::GridKeys;
+pub use grid::keys::{GridKeys, INDEX_KEYS_MAX_BYTES};
 pub use grid::{Grid, InCellOrder, InIndexOrder, VisitOrder};
 pub use list::{ListKey, ListWriter, NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS};
 

@@ -12,7 +12,8 @@
 //! A neighbour list names a hit by its index or, in a large run, by its position among the
 //! particle's candidates, counted row by row: one byte instead of a four-byte index (Müller's
 //! lists take 36 B a particle instead of 132, `wcsph`'s 68 instead of 260), turned back into
-//! the index from the particle's own cell when the list is read ([`keys`]).
+//! the index from the particle's own cell when the list is read
+//! ([`GridKeys`](keys::GridKeys)).
 
 use std::marker::PhantomData;
 
@@ -61,8 +62,8 @@ impl VisitOrder for InCellOrder {
     const ORDER: SumOrder = SumOrder::Cell;
 }
 
-/// A cell list over a fixed domain, listing neighbours in keys of type `K` ([`keys`]) and
-/// visiting hits in the order `O`.
+/// A cell list over a fixed domain, listing neighbours in keys of type `K`
+/// ([`GridKeys`](keys::GridKeys)) and visiting hits in the order `O`.
 #[derive(Debug, Clone)]
 pub struct Grid<K = u8, O = InIndexOrder> {
     /// Cell size and counts.
@@ -79,7 +80,7 @@ pub struct Grid<K = u8, O = InIndexOrder> {
     cell_of: Vec<u32>,
     /// The counting sort's scratch.
     sort: CellSort,
-    /// The key type of the lists ([`keys`]) and the order hits are visited in.
+    /// The key type of the lists and the order hits are visited in.
     marker: PhantomData<(K, O)>,
 }
 
