@@ -255,34 +255,31 @@ impl AnyNeighbors {
         }
     }
 
-    /// The same search, the grid rebuilt by `f` from its parts; all-pairs as it is.
+    /// The same search, the grid rebuilt by `f` from its parts; all-pairs as it is. The old
+    /// lists are freed before `f` allocates new ones, so the two never add up in the peak
+    /// memory of a large run.
     fn map_grid(self, f: impl FnOnce(GridParts) -> AnyNeighbors) -> AnyNeighbors {
+        fn dims<K: ListKey>(lists: NeighborLists<K>) -> (usize, usize) {
+            (lists.len(), lists.width())
+        }
         match self {
             AnyNeighbors::AllPairs(_) => self,
-            AnyNeighbors::Grid(s) => f((
-                s.search,
-                (s.lists.len(), s.lists.width()),
-                GridKeys::Position,
-                SumOrder::Index,
-            )),
-            AnyNeighbors::GridByIndex(s) => f((
-                s.search.recast(),
-                (s.lists.len(), s.lists.width()),
-                GridKeys::Index,
-                SumOrder::Index,
-            )),
-            AnyNeighbors::GridInCellOrder(s) => f((
-                s.search.recast(),
-                (s.lists.len(), s.lists.width()),
-                GridKeys::Position,
-                SumOrder::Cell,
-            )),
-            AnyNeighbors::GridByIndexInCellOrder(s) => f((
-                s.search.recast(),
-                (s.lists.len(), s.lists.width()),
-                GridKeys::Index,
-                SumOrder::Cell,
-            )),
+            AnyNeighbors::Grid(s) => {
+                let dims = dims(s.lists);
+                f((s.search, dims, GridKeys::Position, SumOrder::Index))
+            }
+            AnyNeighbors::GridByIndex(s) => {
+                let dims = dims(s.lists);
+                f((s.search.recast(), dims, GridKeys::Index, SumOrder::Index))
+            }
+            AnyNeighbors::GridInCellOrder(s) => {
+                let dims = dims(s.lists);
+                f((s.search.recast(), dims, GridKeys::Position, SumOrder::Cell))
+            }
+            AnyNeighbors::GridByIndexInCellOrder(s) => {
+                let dims = dims(s.lists);
+                f((s.search.recast(), dims, GridKeys::Index, SumOrder::Cell))
+            }
         }
     }
 
@@ -301,6 +298,9 @@ impl AnyNeighbors {
     /// all-pairs, which lists indices, as it is. Both keys give the same bits: tests use this
     /// to run either at any size.
     pub fn with_grid_keys(self, keys: GridKeys) -> AnyNeighbors {
+        if self.grid_keys() == Some(keys) {
+            return self;
+        }
         self.map_grid(|(grid, dims, _, order)| AnyNeighbors::of_grid(grid, dims, keys, order))
     }
 
@@ -311,6 +311,9 @@ impl AnyNeighbors {
     pub fn with_sum_order(self, order: SumOrder) -> Result<AnyNeighbors, CellOrderNeedsGrid> {
         if order == SumOrder::Cell && matches!(self, AnyNeighbors::AllPairs(_)) {
             return Err(CellOrderNeedsGrid);
+        }
+        if self.sum_order() == order {
+            return Ok(self);
         }
         Ok(self.map_grid(|(grid, dims, keys, _)| AnyNeighbors::of_grid(grid, dims, keys, order)))
     }
