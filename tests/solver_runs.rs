@@ -143,14 +143,20 @@ fn small_runs_list_grid_neighbours_by_index_and_large_ones_by_position() {
     assert_eq!(keys(10_000), Some(GridKeys::Position));
 }
 
-/// One step of `state` in a 1200 × 900 tank with the seed constants; the grid's lists in
-/// `keys`.
-fn one_step(state: State, mode: NeighborMode, keys: GridKeys) -> State {
+/// One step of `state` in a 1200 × 900 tank with the seed constants: with the grid and its
+/// lists in `keys`, or with all-pairs (`None`).
+fn one_step(state: State, grid_keys: Option<GridKeys>) -> State {
     let domain = Domain {
         width: 1200.0,
         height: 900.0,
     };
-    let mut sim = Simulation::new(Preset::Seed.params(), domain, state, mode).with_grid_keys(keys);
+    let params = Preset::Seed.params();
+    let mut sim = match grid_keys {
+        Some(keys) => {
+            Simulation::new(params, domain, state, NeighborMode::Grid).with_grid_keys(keys)
+        }
+        None => Simulation::new(params, domain, state, NeighborMode::AllPairs),
+    };
     run_timed(&mut sim, StrategyName::Seq, &SEQ, 1).expect("step completes");
     sim.state
 }
@@ -178,12 +184,52 @@ fn a_crowd_beyond_the_grids_buffers_gives_the_same_bits_as_all_pairs() {
     }
     let n = x.len();
     let state = State::from_kinematics(x, y, vec![0.0; n], vec![0.0; n]);
-    let all_pairs = one_step(state.clone(), NeighborMode::AllPairs, GridKeys::Index);
+    let all_pairs = one_step(state.clone(), None);
     assert!(all_pairs.first_non_finite().is_none());
     for keys in [GridKeys::Index, GridKeys::Position] {
-        let grid = one_step(state.clone(), NeighborMode::Grid, keys);
+        let grid = one_step(state.clone(), Some(keys));
         assert_eq!(grid, all_pairs, "{keys:?}");
     }
+}
+
+#[test]
+fn cell_order_gives_the_same_bits_with_either_key_when_a_row_spills() {
+    // 200 particles across a cell boundary, numbered in scrambled order: their row holds more
+    // candidates than the grid's stack buffer, and each particle's hits come from two cells,
+    // whose candidate order is not their index order.
+    let (x, y): (Vec<f64>, Vec<f64>) = (0..200u64)
+        .map(|k| {
+            let s = (k * 7919) % 200;
+            (600.0 + (s % 20) as f64 * 0.8, 400.0 + (s / 20) as f64 * 0.9)
+        })
+        .unzip();
+    let n = x.len();
+    let state = State::from_kinematics(x, y, vec![0.0; n], vec![0.0; n]);
+    let domain = Domain {
+        width: 1200.0,
+        height: 900.0,
+    };
+    let cell_order = |keys| {
+        let sim = Simulation::new(
+            Preset::Seed.params(),
+            domain,
+            state.clone(),
+            NeighborMode::Grid,
+        );
+        let mut sim = sim
+            .with_grid_keys(keys)
+            .with_sum_order(SumOrder::Cell)
+            .unwrap();
+        run_timed(&mut sim, StrategyName::Seq, &SEQ, 1).expect("step completes");
+        sim.state
+    };
+    let by_position = cell_order(GridKeys::Position);
+    assert_eq!(cell_order(GridKeys::Index), by_position);
+    assert_ne!(
+        by_position,
+        one_step(state, None),
+        "cell order sums in another order"
+    );
 }
 
 #[test]
@@ -199,8 +245,8 @@ fn neighbours_behind_a_pile_of_more_candidates_than_a_grid_key_counts_give_all_p
     y.extend([425.0, 426.0, 427.0, 425.5]);
     let n = x.len();
     let state = State::from_kinematics(x, y, vec![0.0; n], vec![0.0; n]);
-    let grid = one_step(state.clone(), NeighborMode::Grid, GridKeys::Position);
-    let all_pairs = one_step(state, NeighborMode::AllPairs, GridKeys::Position);
+    let grid = one_step(state.clone(), Some(GridKeys::Position));
+    let all_pairs = one_step(state, None);
     assert_eq!(grid, all_pairs);
     assert!(grid.first_non_finite().is_none());
 }

@@ -151,7 +151,7 @@ macro_rules! with_search {
                 search: $nb,
                 lists: $lists,
             }) => $body,
-            AnyNeighbors::Grid(Searched {
+            AnyNeighbors::GridByPosition(Searched {
                 search: $nb,
                 lists: $lists,
             }) => $body,
@@ -180,7 +180,7 @@ macro_rules! with_search_lanes {
             AnyNeighbors::AllPairs(Searched { search: $nb, lists: $lists }) => {
                 with_lanes!($lanes, $l => $body)
             }
-            AnyNeighbors::Grid(Searched { search: $nb, lists: $lists }) => {
+            AnyNeighbors::GridByPosition(Searched { search: $nb, lists: $lists }) => {
                 let $l = simd::Portable;
                 $body
             }

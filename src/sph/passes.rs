@@ -15,8 +15,9 @@ use crate::simd::Lanes;
 /// pressure `GAS_CONST · (rho − REST_DENS)` (eq. 12) of particle `i`, plus the number of its
 /// neighbours j ≠ i. Candidates are tested in `lanes` (every path finds the same).
 ///
-/// Contributions `(MASS·POLY6) · ((u·u)·u)`, `u = HSQ − r2`, are summed in index order from 0.
-/// The neighbours j ≠ i are written to `list` in index order; the returned count is its
+/// Contributions `(MASS·POLY6) · ((u·u)·u)`, `u = HSQ − r2`, are summed in the search's visit
+/// order (index order unless a grid in cell order) from 0. The neighbours j ≠ i are written to
+/// `list` in that order; the returned count is its
 /// [`ListWriter::finish`].
 #[inline(always)]
 pub fn density_pressure<N: Neighbors>(
@@ -44,9 +45,10 @@ pub fn density_pressure<N: Neighbors>(
     (rho, prm.gas_const * (rho - prm.rest_density), count)
 }
 
-/// Force on particle `i` from this step's densities and pressures in `input`: pressure (Müller 2003 eq. 10 with the spiky gradient, eq. 21) plus
-/// viscosity (eq. 14 with the viscosity Laplacian, eq. 22) over j ≠ i with `r < H`, in index
-/// order, plus `G · rho_i`.
+/// Force on particle `i` from this step's densities and pressures in `input`: pressure (Müller
+/// 2003 eq. 10 with the spiky gradient, eq. 21) plus viscosity (eq. 14 with the viscosity
+/// Laplacian, eq. 22) over j ≠ i with `r < H`, in the search's visit order (index order unless
+/// a grid in cell order), plus `G · rho_i`.
 ///
 /// Two particles at the same point (r = 0, j ≠ i) have no pressure direction: that term is
 /// zero there (the Haskell source divides by zero), the viscosity term is still added.

@@ -16,8 +16,8 @@
 
 use sph_strategies::Split;
 
-/// Neighbour slots per particle of Müller's presets (32 bytes with the grid's keys, 128 with
-/// all-pairs'). Dam-break particles have about 5–15 neighbours; piles in the corners can have
+/// Neighbour slots per particle of Müller's presets (32 bytes with the grid's one-byte keys,
+/// 128 with `u32` indices: all-pairs', and the grid's in small runs). Dam-break particles have about 5–15 neighbours; piles in the corners can have
 /// more, and take the slower path.
 ///
 /// Narrower lists of `u32` indices were measured (8 and 16 slots from 10⁵ particles on, 36 or
@@ -117,7 +117,7 @@ pub struct NeighborLists<K> {
     /// Neighbours of particle i (excluding i) listed, possibly more than the slots hold, or
     /// more than any list holds when the list is not usable.
     pub count: Vec<u32>,
-    /// Particle i's neighbours are `slots[i * width..][..count[i]]`, in increasing index,
+    /// Particle i's neighbours are `slots[i * width..][..count[i]]`, in the search's visit order,
     /// when `count[i] < width`.
     pub slots: Vec<K>,
     /// Slots per particle.
@@ -159,7 +159,7 @@ impl<K: ListKey> NeighborLists<K> {
         (&mut self.count, slots)
     }
 
-    /// Particle i's neighbours (their keys) in increasing index, or `None` when they did
+    /// Particle i's neighbours (their keys) in the search's visit order, or `None` when they did
     /// not fit.
     #[inline]
     pub fn of(&self, i: usize) -> Option<&[K]> {

@@ -2,7 +2,8 @@
 //!
 //! Both searches visit exactly the particles with `r2 = dx*dx + dy*dy < HSQ` (self included),
 //! in increasing index order, so a pass sums their contributions in the same order as the
-//! sources' loops: the grid gives the same bits as all-pairs.
+//! sources' loops: the grid gives the same bits as all-pairs. The one exception is the grid in
+//! [`SumOrder::Cell`], asked for explicitly, which visits them in the order it finds them.
 
 mod all_pairs;
 mod grid;
@@ -95,7 +96,8 @@ pub trait Neighbors: Sync {
     fn rebuild<E: Executor>(&mut self, exec: &E, pos: Positions<'_>) -> Result<(), KernelPanic>;
 
     /// Calls `visit(j, r2, key)` for every particle j (including `i` itself) whose squared
-    /// distance `r2 = dx*dx + dy*dy` (with `d = x_j − x_i`) is below `hsq`, in increasing j,
+    /// distance `r2 = dx*dx + dy*dy` (with `d = x_j − x_i`) is below `hsq`, in the search's
+    /// visit order (increasing j, unless a grid in [`SumOrder::Cell`]),
     /// testing candidates in `lanes` where the search uses them (all-pairs does, the grid does
     /// not); every path finds the same j with the same r2.
     ///
@@ -213,7 +215,7 @@ pub enum AnyNeighbors {
     /// See [`AllPairs`].
     AllPairs(Searched<AllPairs>),
     /// See [`Grid`]: position keys, index order.
-    Grid(Searched<Grid>),
+    GridByPosition(Searched<Grid>),
     /// See [`Grid`]: index keys, index order.
     GridByIndex(Searched<Grid<u32>>),
     /// See [`Grid`]: position keys, cell order.
@@ -236,7 +238,7 @@ impl AnyNeighbors {
         order: SumOrder,
     ) -> AnyNeighbors {
         match (keys, order) {
-            (GridKeys::Position, SumOrder::Index) => AnyNeighbors::Grid(Searched {
+            (GridKeys::Position, SumOrder::Index) => AnyNeighbors::GridByPosition(Searched {
                 search: grid,
                 lists: NeighborLists::with_slots(listed, width),
             }),
@@ -264,7 +266,7 @@ impl AnyNeighbors {
         }
         match self {
             AnyNeighbors::AllPairs(_) => self,
-            AnyNeighbors::Grid(s) => {
+            AnyNeighbors::GridByPosition(s) => {
                 let dims = dims(s.lists);
                 f((s.search, dims, GridKeys::Position, SumOrder::Index))
             }
@@ -287,7 +289,7 @@ impl AnyNeighbors {
     pub fn with_list_slots(&mut self, width: usize) {
         match self {
             AnyNeighbors::AllPairs(s) => s.relist(width),
-            AnyNeighbors::Grid(s) => s.relist(width),
+            AnyNeighbors::GridByPosition(s) => s.relist(width),
             AnyNeighbors::GridByIndex(s) => s.relist(width),
             AnyNeighbors::GridInCellOrder(s) => s.relist(width),
             AnyNeighbors::GridByIndexInCellOrder(s) => s.relist(width),
@@ -322,7 +324,9 @@ impl AnyNeighbors {
     pub fn grid_keys(&self) -> Option<GridKeys> {
         match self {
             AnyNeighbors::AllPairs(_) => None,
-            AnyNeighbors::Grid(_) | AnyNeighbors::GridInCellOrder(_) => Some(GridKeys::Position),
+            AnyNeighbors::GridByPosition(_) | AnyNeighbors::GridInCellOrder(_) => {
+                Some(GridKeys::Position)
+            }
             AnyNeighbors::GridByIndex(_) | AnyNeighbors::GridByIndexInCellOrder(_) => {
                 Some(GridKeys::Index)
             }
@@ -332,9 +336,9 @@ impl AnyNeighbors {
     /// The order neighbours are visited in.
     pub fn sum_order(&self) -> SumOrder {
         match self {
-            AnyNeighbors::AllPairs(_) | AnyNeighbors::Grid(_) | AnyNeighbors::GridByIndex(_) => {
-                SumOrder::Index
-            }
+            AnyNeighbors::AllPairs(_)
+            | AnyNeighbors::GridByPosition(_)
+            | AnyNeighbors::GridByIndex(_) => SumOrder::Index,
             AnyNeighbors::GridInCellOrder(_) | AnyNeighbors::GridByIndexInCellOrder(_) => {
                 SumOrder::Cell
             }
@@ -345,7 +349,7 @@ impl AnyNeighbors {
     pub fn heap_bytes(&self) -> usize {
         match self {
             AnyNeighbors::AllPairs(s) => s.lists.heap_bytes(),
-            AnyNeighbors::Grid(s) => s.search.heap_bytes() + s.lists.heap_bytes(),
+            AnyNeighbors::GridByPosition(s) => s.search.heap_bytes() + s.lists.heap_bytes(),
             AnyNeighbors::GridByIndex(s) => s.search.heap_bytes() + s.lists.heap_bytes(),
             AnyNeighbors::GridInCellOrder(s) => s.search.heap_bytes() + s.lists.heap_bytes(),
             AnyNeighbors::GridByIndexInCellOrder(s) => s.search.heap_bytes() + s.lists.heap_bytes(),

@@ -1,6 +1,8 @@
 //! The passes of one weakly compressible step, each a pure function of one particle and
 //! read-only state. Sums run over the neighbours in increasing index order (fluid first, then
-//! walls, as the state stores them), so every strategy and both searches give the same bits.
+//! walls, as the state stores them), so every strategy and both searches give the same bits
+//! (the grid in `--order cell` visits them in the order it finds them instead: its own bits,
+//! the same on every strategy).
 //!
 //! Notation: r_ab = x_a − x_b, v_ab = v_a − v_b, ∇_a W_ab = g(r) r_ab with
 //! g = [`WcParams::gradient_factor`].
@@ -21,7 +23,7 @@ pub fn max_speed_squared(vx: &[f64], vy: &[f64]) -> f64 {
         .fold(0.0, |m: f64, (&x, &y)| m.max(x * x + y * y))
 }
 
-/// Particle `i`'s neighbours within the kernel support, in index order: for a fluid particle
+/// Particle `i`'s neighbours within the kernel support, in the search's visit order: for a fluid particle
 /// every other particle, for a wall particle the fluid ones only (walls never read walls).
 ///
 /// They are written to `list`; the returned count is its [`ListWriter::finish`] (see
@@ -49,7 +51,7 @@ pub fn neighbors<N: Neighbors>(
     list.finish()
 }
 
-/// Calls `pair(b, r2)` for each of particle `i`'s neighbours ([`neighbors`]) in index order:
+/// Calls `pair(b, r2)` for each of particle `i`'s neighbours ([`neighbors`]) in visit order:
 /// from its list when it fit (in its slots, and its keys in their type), else by asking the
 /// search again.
 #[inline(always)]

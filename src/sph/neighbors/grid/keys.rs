@@ -15,8 +15,8 @@
 
 use crate::sph::neighbors::ListKey;
 
-/// The most bytes a run's lists may take in index keys (512 KiB: under half the L2 cache of a
-/// current x86-64 core). Müller's 32 slots get index keys up to 4096 particles, `wcsph`'s 64
+/// The most bytes a run's lists may take in index keys (512 KiB: at most half of a 1 MiB L2
+/// cache, and a quarter of this VM's 2 MiB). Müller's 32 slots get index keys up to 4096 particles, `wcsph`'s 64
 /// slots up to 2048 particles, walls included.
 pub const INDEX_KEYS_MAX_BYTES: usize = 512 << 10;
 

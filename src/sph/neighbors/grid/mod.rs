@@ -224,10 +224,11 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         let (xi, yi) = (pos.x[i], pos.y[i]);
         let block = self.block(xi, yi);
         // Hits are collected without branching (every candidate is written, the count only
-        // advances on a hit), each with its key (its index, or its position among the block's
-        // candidates), then put in index order unless they already are, by a branch-free rank
-        // sort (a comparison sort past RANK_SORT_MAX hits), or left in candidate order (cell
-        // order); a row that would overflow the stack buffer goes to a vector, sorted once.
+        // advances on a hit), each with its position among the block's candidates (its key is
+        // made when it is visited), then put in index order unless they already are, by a
+        // branch-free rank sort (a comparison sort past RANK_SORT_MAX hits), or left in
+        // candidate order (cell order); a row that would overflow the stack buffer goes to a
+        // vector, sorted once.
         // The squared distance is recomputed when a hit is visited (same formula, same bits)
         // so that only indices are moved.
         //
@@ -245,14 +246,13 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
             );
             if len + js.len() <= INLINE_HITS {
                 for (t, ((&xj, &yj), &j)) in xs.iter().zip(ys).zip(js).enumerate() {
-                    hits[len] = hit(j, key::<K>(j, base + t as u32));
+                    hits[len] = hit(j, base + t as u32);
                     len += usize::from(distance_squared(xi, yi, xj, yj) < hsq);
                 }
             } else {
                 let found = xs.iter().zip(ys).zip(js).enumerate();
                 spilled.extend(found.filter_map(|(t, ((&xj, &yj), &j))| {
-                    (distance_squared(xi, yi, xj, yj) < hsq)
-                        .then_some(hit(j, key::<K>(j, base + t as u32)))
+                    (distance_squared(xi, yi, xj, yj) < hsq).then_some(hit(j, base + t as u32))
                 }));
             }
         }
@@ -269,7 +269,7 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
             // still numbered in that order (a scene's start, a calm region) nothing moves.
             &hits[..len]
         } else if cell_order {
-            // Rows went to the stack or to the heap: back in candidate order, by key.
+            // Rows went to the stack or to the heap: back in candidate order, by position.
             spilled.extend_from_slice(&hits[..len]);
             spilled.sort_unstable_by_key(|&h| h as u32);
             &spilled[..]
@@ -285,8 +285,9 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
             &spilled[..]
         };
         for &h in hits {
-            let (j, key) = ((h >> 32) as usize, h as u32);
-            visit(j, distance_squared(xi, yi, pos.x[j], pos.y[j]), key);
+            let (j, position) = ((h >> 32) as u32, h as u32);
+            let r2 = distance_squared(xi, yi, pos.x[j as usize], pos.y[j as usize]);
+            visit(j as usize, r2, key::<K>(j, position));
         }
     }
 
@@ -362,11 +363,11 @@ impl<K, O> Grid<K, O> {
     }
 }
 
-/// A hit as one sortable word: its index above its key (indices are distinct, so the order is
-/// the indices' order).
+/// A hit as one sortable word: its index above its position among the candidates (indices are
+/// distinct, so the order is the indices' order; the low word alone gives the candidates').
 #[inline(always)]
-fn hit(j: u32, key: u32) -> u64 {
-    (u64::from(j) << 32) | u64::from(key)
+fn hit(j: u32, position: u32) -> u64 {
+    (u64::from(j) << 32) | u64::from(position)
 }
 
 /// Puts the distinct values of `src` in increasing order into `dst` by counting, for each, how
@@ -468,7 +469,7 @@ mod tests {
     }
 
     #[test]
-    fn cell_order_visits_the_hits_of_index_order_in_candidate_order_spilled_rows_too() {
+    fn cell_order_visits_hits_in_candidate_order_with_either_key_spilled_rows_too() {
         let (mut x, mut y) = scattered(2000);
         // And a pile of 120 in one cell row (more than INLINE_HITS, so the row spills to the
         // heap) with particles just above it that reach into it.
@@ -481,6 +482,7 @@ mod tests {
         let pos = Positions { x: &x, y: &y };
         let by_index = grid_over::<u8, InIndexOrder>(&x, &y);
         let by_cell = grid_over::<u8, InCellOrder>(&x, &y);
+        let by_cell_with_index_keys = grid_over::<u32, InCellOrder>(&x, &y);
         let mut spilled_hits = 0;
         for i in 0..x.len() {
             let found = hits(&by_cell, i, pos);
@@ -492,6 +494,13 @@ mod tests {
             assert_eq!(
                 named, js,
                 "particle {i}: keys name the hits in the order visited"
+            );
+            let with_index_keys = hits(&by_cell_with_index_keys, i, pos);
+            assert!(with_index_keys.iter().all(|&(j, key)| key as usize == j));
+            let js_with_index_keys: Vec<usize> = with_index_keys.iter().map(|h| h.0).collect();
+            assert_eq!(
+                js_with_index_keys, js,
+                "particle {i}: either key, one order"
             );
             js.sort_unstable();
             let in_index_order: Vec<usize> = hits(&by_index, i, pos).iter().map(|h| h.0).collect();
