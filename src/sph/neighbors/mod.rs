@@ -135,6 +135,14 @@ pub struct Searched<N: Neighbors> {
 }
 
 impl<N: Neighbors> Searched<N> {
+    /// `search` with lists for `listed` particles of `width` slots each.
+    fn new(search: N, (listed, width): (usize, usize)) -> Self {
+        Searched {
+            search,
+            lists: NeighborLists::with_slots(listed, width),
+        }
+    }
+
     /// New lists of `width` slots for as many particles.
     fn relist(&mut self, width: usize) {
         self.lists = NeighborLists::with_slots(self.lists.len(), width);
@@ -195,10 +203,7 @@ pub fn build(
     (listed, width): (usize, usize),
 ) -> AnyNeighbors {
     match mode {
-        NeighborMode::AllPairs => AnyNeighbors::AllPairs(Searched {
-            search: AllPairs,
-            lists: NeighborLists::with_slots(listed, width),
-        }),
+        NeighborMode::AllPairs => AnyNeighbors::AllPairs(Searched::new(AllPairs, (listed, width))),
         NeighborMode::Grid => AnyNeighbors::of_grid(
             Grid::new(bounds, radius, n),
             (listed, width),
@@ -229,31 +234,22 @@ pub enum AnyNeighbors {
 type GridParts = (Grid, (usize, usize), GridKeys, SumOrder);
 
 impl AnyNeighbors {
-    /// `grid` with new lists for `listed` particles of `width` slots in `keys`, visiting hits
-    /// in `order`.
-    fn of_grid(
-        grid: Grid,
-        (listed, width): (usize, usize),
-        keys: GridKeys,
-        order: SumOrder,
-    ) -> AnyNeighbors {
+    /// `grid` with new lists of `dims` (particles, slots each) in `keys`, visiting hits in
+    /// `order`.
+    fn of_grid(grid: Grid, dims: (usize, usize), keys: GridKeys, order: SumOrder) -> AnyNeighbors {
         match (keys, order) {
-            (GridKeys::Position, SumOrder::Index) => AnyNeighbors::GridByPosition(Searched {
-                search: grid,
-                lists: NeighborLists::with_slots(listed, width),
-            }),
-            (GridKeys::Index, SumOrder::Index) => AnyNeighbors::GridByIndex(Searched {
-                search: grid.recast(),
-                lists: NeighborLists::with_slots(listed, width),
-            }),
-            (GridKeys::Position, SumOrder::Cell) => AnyNeighbors::GridInCellOrder(Searched {
-                search: grid.recast(),
-                lists: NeighborLists::with_slots(listed, width),
-            }),
-            (GridKeys::Index, SumOrder::Cell) => AnyNeighbors::GridByIndexInCellOrder(Searched {
-                search: grid.recast(),
-                lists: NeighborLists::with_slots(listed, width),
-            }),
+            (GridKeys::Position, SumOrder::Index) => {
+                AnyNeighbors::GridByPosition(Searched::new(grid, dims))
+            }
+            (GridKeys::Index, SumOrder::Index) => {
+                AnyNeighbors::GridByIndex(Searched::new(grid.recast(), dims))
+            }
+            (GridKeys::Position, SumOrder::Cell) => {
+                AnyNeighbors::GridInCellOrder(Searched::new(grid.recast(), dims))
+            }
+            (GridKeys::Index, SumOrder::Cell) => {
+                AnyNeighbors::GridByIndexInCellOrder(Searched::new(grid.recast(), dims))
+            }
         }
     }
 
