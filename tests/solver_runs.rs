@@ -163,10 +163,10 @@ fn one_step(state: State, grid_keys: Option<GridKeys>) -> State {
 
 #[test]
 fn a_crowd_beyond_the_grids_buffers_gives_the_same_bits_as_all_pairs() {
-    // 150 particles within a few px, numbered in scrambled order: more hits per particle
-    // than the grid's stack buffer and the neighbour-list slots hold, so the spill and
-    // fallback paths run; plus a sparse line of particles (and some outside the tank) whose
-    // rows have few candidates.
+    // 150 particles within a few px, numbered in scrambled order: more candidates than the
+    // grid's scratch holds (128) and more hits than the neighbour-list slots hold, so the
+    // crowded-block and fallback paths run; plus a sparse line of particles (and some outside
+    // the tank) whose rows have few candidates.
     let mut x = Vec::new();
     let mut y = Vec::new();
     for k in 0..150u64 {
@@ -193,10 +193,10 @@ fn a_crowd_beyond_the_grids_buffers_gives_the_same_bits_as_all_pairs() {
 }
 
 #[test]
-fn cell_order_gives_the_same_bits_with_either_key_when_a_row_spills() {
+fn cell_order_gives_the_same_bits_with_either_key_in_a_crowded_block() {
     // 200 particles across a cell boundary, numbered in scrambled order: their row holds more
-    // candidates than the grid's stack buffer, and each particle's hits come from two cells,
-    // whose candidate order is not their index order.
+    // candidates than the grid's scratch holds (128), and each particle's hits come from two
+    // cells, whose candidate order is not their index order.
     let (x, y): (Vec<f64>, Vec<f64>) = (0..200u64)
         .map(|k| {
             let s = (k * 7919) % 200;

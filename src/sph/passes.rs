@@ -18,10 +18,12 @@ use crate::simd::Lanes;
 /// Contributions `(MASS·POLY6) · ((u·u)·u)`, `u = HSQ − r2`, are summed in the search's visit
 /// order (index order unless a grid in cell order) from 0. The neighbours j ≠ i are written to
 /// `list` in that order; the returned count is its
-/// [`ListWriter::finish`].
+/// [`ListWriter::finish`]. `scratch` is the search's working memory (see
+/// [`Neighbors::Scratch`]).
 #[inline(always)]
 pub fn density_pressure<N: Neighbors>(
     i: usize,
+    scratch: &mut N::Scratch,
     lanes: impl Lanes,
     pos: Positions<'_>,
     nb: &N,
@@ -30,6 +32,7 @@ pub fn density_pressure<N: Neighbors>(
 ) -> (f64, f64, u32) {
     let mut rho = 0.0;
     nb.for_each_within(
+        scratch,
         lanes,
         i,
         pos,
@@ -82,11 +85,15 @@ pub fn force<N: Neighbors>(
                 add_pair_force(&mut acc, &me, j, r2, input, prm);
             },
         ),
-        None => nb.for_each_within(lanes, i, input.pos, prm.hsq, |j, r2, _| {
-            if j != i {
-                add_pair_force(&mut acc, &me, j, r2, input, prm);
-            }
-        }),
+        None => {
+            // Rare (a pile), so its working memory is made here.
+            let scratch = &mut N::Scratch::default();
+            nb.for_each_within(scratch, lanes, i, input.pos, prm.hsq, |j, r2, _| {
+                if j != i {
+                    add_pair_force(&mut acc, &me, j, r2, input, prm);
+                }
+            });
+        }
     }
     let (fpress, fvisc) = acc;
     (fpress + fvisc) + prm.gravity * input.rho[i]

@@ -25,9 +25,11 @@ pub fn density<E: Executor, N: Neighbors, L: Lanes>(
         lanes.vectorize(
             #[inline(always)]
             || {
+                let scratch = &mut N::Scratch::default();
                 for (k, ((rho, p), count)) in rho.iter_mut().zip(p).zip(count).enumerate() {
+                    let list = slots.particle(k);
                     (*rho, *p, *count) =
-                        passes::density_pressure(first + k, lanes, pos, nb, prm, slots.particle(k));
+                        passes::density_pressure(first + k, scratch, lanes, pos, nb, prm, list);
                 }
             },
         )

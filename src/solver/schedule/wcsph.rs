@@ -79,8 +79,10 @@ pub fn neighbors<E: Executor, N: Neighbors, L: Lanes>(
         lanes.vectorize(
             #[inline(always)]
             || {
+                let scratch = &mut N::Scratch::default();
                 for (k, c) in count.iter_mut().enumerate() {
-                    *c = passes::neighbors(first + k, lanes, pos, nb, prm, slots.particle(k));
+                    let list = slots.particle(k);
+                    *c = passes::neighbors(first + k, scratch, lanes, pos, nb, prm, list);
                 }
             },
         )

@@ -13,6 +13,7 @@ pub struct AllPairs;
 /// A list names a neighbour by its index.
 impl Neighbors for AllPairs {
     type Key = u32;
+    type Scratch = ();
     fn rebuild<E: Executor>(&mut self, _exec: &E, _pos: Positions<'_>) -> Result<(), KernelPanic> {
         Ok(())
     }
@@ -20,6 +21,7 @@ impl Neighbors for AllPairs {
     #[inline(always)]
     fn for_each_within<L: Lanes>(
         &self,
+        _scratch: &mut (),
         lanes: L,
         i: usize,
         pos: Positions<'_>,

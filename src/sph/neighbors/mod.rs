@@ -11,7 +11,7 @@ pub mod list;
 
 pub use all_pairs::AllPairs;
 pub use grid::keys::{GridKeys, INDEX_KEYS_MAX_BYTES};
-pub use grid::{Grid, InCellOrder, InIndexOrder, VisitOrder};
+pub use grid::{Grid, GridScratch, InCellOrder, InIndexOrder, VisitOrder};
 pub use list::{ListKey, ListWriter, NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS};
 
 use serde::Serialize;
@@ -91,6 +91,10 @@ pub trait Neighbors: Sync {
     /// [`Neighbors::for_each_listed`].
     type Key: ListKey;
 
+    /// Working memory of one [`Neighbors::for_each_within`] call, made once for a run of
+    /// particles and handed to each call in turn (its contents between calls mean nothing).
+    type Scratch: Default;
+
     /// Brings the search up to date with `pos` (called once per step, before the passes);
     /// per-particle parts of the work run on `exec`.
     fn rebuild<E: Executor>(&mut self, exec: &E, pos: Positions<'_>) -> Result<(), KernelPanic>;
@@ -106,6 +110,7 @@ pub trait Neighbors: Sync {
     /// a list is not used.
     fn for_each_within<L: Lanes>(
         &self,
+        scratch: &mut Self::Scratch,
         lanes: L,
         i: usize,
         pos: Positions<'_>,

@@ -31,6 +31,7 @@ pub fn max_speed_squared(vx: &[f64], vy: &[f64]) -> f64 {
 #[inline(always)]
 pub fn neighbors<N: Neighbors>(
     i: usize,
+    scratch: &mut N::Scratch,
     lanes: impl Lanes,
     pos: Positions<'_>,
     nb: &N,
@@ -39,6 +40,7 @@ pub fn neighbors<N: Neighbors>(
 ) -> u32 {
     let limit = if i < prm.fluid { usize::MAX } else { prm.fluid };
     nb.for_each_within(
+        scratch,
         lanes,
         i,
         pos,
@@ -78,7 +80,8 @@ fn for_each_neighbor<N: Neighbors>(
             let limit = if i < prm.fluid { usize::MAX } else { prm.fluid };
             // An unusable list (too long for its slots, or a grid key past 255) is rare: the
             // portable lanes serve (same hits).
-            nb.for_each_within(Portable, i, pos, prm.support_sq, |b, r2, _| {
+            let scratch = &mut N::Scratch::default();
+            nb.for_each_within(scratch, Portable, i, pos, prm.support_sq, |b, r2, _| {
                 if b != i && b < limit {
                     pair(b, r2);
                 }

@@ -7,7 +7,8 @@
 //! cells are contiguous in the sorted order, so each row is one slice. The hits are put in index
 //! order before they are visited, so sums run in the same order as all-pairs and give the same
 //! bits; in [`SumOrder::Cell`] they are visited in the order found, faster but rounding
-//! differently.
+//! differently. Collecting and sorting them works in a [`GridScratch`] the caller makes once
+//! per run of particles (`hits.rs`).
 //!
 //! A neighbour list names a hit by its index or, in a large run, by its position among the
 //! particle's candidates, counted row by row: one byte instead of a four-byte index (Müller's
@@ -19,9 +20,15 @@ use std::marker::PhantomData;
 
 use sph_strategies::{Executor, KernelPanic};
 
+mod hits;
 pub mod keys;
 mod sort;
 
+pub use hits::GridScratch;
+use hits::{
+    INLINE_HITS, ONE_LOOP_MAX, RANK_SORT_MAX, SMALL, hit, index_of, position_of, rank_sort,
+    sort_small,
+};
 use keys::GridKey;
 use sort::CellSort;
 
@@ -29,15 +36,6 @@ use super::list::written_zeros;
 use super::{Bounds, Neighbors, SumOrder, distance_squared};
 use crate::simd::Lanes;
 use crate::sph::state::Positions;
-
-/// Hits of one particle kept on the stack before spilling to the heap (Müller's presets
-/// have about 10, `wcsph` up to about 45 next to a wall).
-const INLINE_HITS: usize = 96;
-
-/// The most hits put in order by [`rank_sort`]: its cost grows with the square of the hits,
-/// so more (`wcsph` has about 20–45) are sorted by comparison instead. Either gives the one
-/// increasing order of distinct indices.
-const RANK_SORT_MAX: usize = 24;
 
 /// The order a grid visits each particle's hits in, as a type: a run's order is fixed, so each
 /// order's passes are compiled without the other's branches.
@@ -183,6 +181,7 @@ impl Shape {
 /// break has at most a few dozen candidates).
 impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
     type Key = K;
+    type Scratch = GridScratch;
 
     /// Cell numbers (per particle), the counting sort (`CellSort`) and the gather of sorted
     /// positions (per slot) run on the executor.
@@ -215,6 +214,7 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
     #[inline(always)]
     fn for_each_within<L: Lanes>(
         &self,
+        scratch: &mut GridScratch,
         _lanes: L,
         i: usize,
         pos: Positions<'_>,
@@ -223,71 +223,65 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
     ) {
         let (xi, yi) = (pos.x[i], pos.y[i]);
         let block = self.block(xi, yi);
-        // Hits are collected without branching (every candidate is written, the count only
-        // advances on a hit), each with its position among the block's candidates (its key is
-        // made when it is visited), then put in index order unless they already are, by a
-        // branch-free rank sort (a comparison sort past RANK_SORT_MAX hits), or left in
-        // candidate order (cell order); a row that would overflow the stack buffer goes to a
-        // vector, sorted once.
-        // The squared distance is recomputed when a hit is visited (same formula, same bits)
-        // so that only indices are moved.
+        let candidates = block.candidates();
+        if candidates as usize > INLINE_HITS {
+            return self.visit_crowded(&block, (xi, yi), pos, hsq, visit);
+        }
+        // Hits are collected without branching: every candidate written at the next free
+        // place, which only a hit keeps, and its squared distance at its position, where its
+        // hit finds it again (no position loads when visited). A small block's candidates
+        // are scanned in one loop over its three rows (each candidate's place in the sorted
+        // order found without a branch), so that the rows' lengths, a few candidates each,
+        // are not loop ends to mispredict; a larger block's row by row.
         //
         // The candidates are tested one by one, not in `lanes`: a row holds 3–12 of them, and
         // blocks of eight with a mask measured 8–15 % slower (N = 1000 and 10⁵ in motion).
-        let mut hits = [0u64; INLINE_HITS];
+        let GridScratch {
+            hits,
+            r2: dists,
+            ranked,
+        } = scratch;
         let mut len = 0;
-        let mut spilled: Vec<u64> = Vec::new();
-        for (&(lo, hi), &base) in block.runs.iter().zip(&block.base) {
-            let (lo, hi) = (lo as usize, hi as usize);
-            let (xs, ys, js) = (
-                &self.sorted_x[lo..hi],
-                &self.sorted_y[lo..hi],
-                &self.order[lo..hi],
-            );
-            if len + js.len() <= INLINE_HITS {
-                for (t, ((&xj, &yj), &j)) in xs.iter().zip(ys).zip(js).enumerate() {
-                    hits[len] = hit(j, base + t as u32);
-                    len += usize::from(distance_squared(xi, yi, xj, yj) < hsq);
-                }
-            } else {
-                let found = xs.iter().zip(ys).zip(js).enumerate();
-                spilled.extend(found.filter_map(|(t, ((&xj, &yj), &j))| {
-                    (distance_squared(xi, yi, xj, yj) < hsq).then_some(hit(j, base + t as u32))
-                }));
+        let mut collect = |t: u32, (xj, yj, j): (f64, f64, u32)| {
+            let r2 = distance_squared(xi, yi, xj, yj);
+            hits[len] = hit(j, t);
+            dists[t as usize] = r2;
+            len += usize::from(r2 < hsq);
+        };
+        if candidates <= ONE_LOOP_MAX {
+            let slots = block.slots();
+            for t in 0..candidates {
+                let s = slots.of(t);
+                collect(t, (self.sorted_x[s], self.sorted_y[s], self.order[s]));
             }
+        } else {
+            self.for_each_by_row(&block, collect);
         }
-        let mut ranked = [0u64; RANK_SORT_MAX];
-        // In order already? A branch-free fold: `is_sorted` is a call per particle here. In
-        // cell order, the order collected is the one wanted.
-        let cell_order = matches!(O::ORDER, SumOrder::Cell);
-        let sorted = cell_order
+        // In order already? Rows are scanned bottom to top and cells left to right: where
+        // particles are still numbered that way (a scene at rest, a calm region) nothing
+        // moves. A branch-free fold: `is_sorted` is a call per particle here.
+        let sorted = matches!(O::ORDER, SumOrder::Cell)
             || hits[..len]
                 .windows(2)
                 .fold(true, |ok, w| ok & (w[0] < w[1]));
-        let hits = if spilled.is_empty() && sorted {
-            // Rows are scanned bottom to top and cells left to right: where particles are
-            // still numbered in that order (a scene's start, a calm region) nothing moves.
+        let hits = if sorted {
             &hits[..len]
-        } else if cell_order {
-            // Rows went to the stack or to the heap: back in candidate order, by position.
-            spilled.extend_from_slice(&hits[..len]);
-            spilled.sort_unstable_by_key(|&h| h as u32);
-            &spilled[..]
-        } else if spilled.is_empty() && len <= RANK_SORT_MAX {
+        } else if len <= SMALL {
+            // The usual case in motion: a fixed, branch-free sort of SMALL places, the rest
+            // padding.
+            hits[len..len + SMALL].fill(u64::MAX);
+            sort_small((&mut hits[..SMALL]).try_into().expect("SMALL places"));
+            &hits[..len]
+        } else if len <= RANK_SORT_MAX {
             rank_sort(&hits[..len], &mut ranked[..len]);
             &ranked[..len]
-        } else if spilled.is_empty() {
+        } else {
             hits[..len].sort_unstable();
             &hits[..len]
-        } else {
-            spilled.extend_from_slice(&hits[..len]);
-            spilled.sort_unstable();
-            &spilled[..]
         };
         for &h in hits {
-            let (j, position) = ((h >> 32) as u32, h as u32);
-            let r2 = distance_squared(xi, yi, pos.x[j as usize], pos.y[j as usize]);
-            visit(j as usize, r2, key::<K>(j, position));
+            let (j, position) = (index_of(h), position_of(h));
+            visit(j as usize, dists[position as usize], key::<K>(j, position));
         }
     }
 
@@ -308,20 +302,9 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
             }
             return;
         }
-        let block = self.block(pos.x[i], pos.y[i]);
-        // Where in `order` a key of each row starts: the row's first slot minus the keys of
-        // the rows before it (wrapping: only sums with a key of that row are read).
-        let [r0, r1, r2] = block.runs.map(|(lo, _)| lo);
-        let [_, b1, b2] = block.base;
-        let (o0, o1, o2) = (r0, r1.wrapping_sub(b1), r2.wrapping_sub(b2));
-        // Branch-free: the keys of one list come from every row in turn.
-        let (step1, step2) = (o1.wrapping_sub(o0), o2.wrapping_sub(o1));
+        let slots = self.block(pos.x[i], pos.y[i]).slots();
         for &key in list {
-            let key = key.get();
-            let offset = o0
-                .wrapping_add(step1.wrapping_mul(u32::from(key >= b1)))
-                .wrapping_add(step2.wrapping_mul(u32::from(key >= b2)));
-            visit(self.order[key.wrapping_add(offset) as usize] as usize);
+            visit(self.order[slots.of(key.get())] as usize);
         }
     }
 }
@@ -361,22 +344,102 @@ impl<K, O> Grid<K, O> {
             base: [0, base1, base1 + len(runs[1])],
         }
     }
+
+    /// Calls `f(position, (x, y, index))` for each of the block's candidates, row by row.
+    #[inline(always)]
+    fn for_each_by_row(&self, block: &Block, mut f: impl FnMut(u32, (f64, f64, u32))) {
+        for (&(lo, hi), &base) in block.runs.iter().zip(&block.base) {
+            let (lo, hi) = (lo as usize, hi as usize);
+            let row = self.sorted_x[lo..hi]
+                .iter()
+                .zip(&self.sorted_y[lo..hi])
+                .zip(&self.order[lo..hi]);
+            for (t, ((&xj, &yj), &j)) in (base..).zip(row) {
+                f(t, (xj, yj, j));
+            }
+        }
+    }
+
+    /// Calls `visit` for the hits of a block of more candidates than [`GridScratch`] holds (a
+    /// pile): collected row by row in a vector, in candidate order, then sorted by index
+    /// unless the grid visits in cell order. The distances are computed again when visited
+    /// (same formula, same bits).
+    #[cold]
+    fn visit_crowded(
+        &self,
+        block: &Block,
+        (xi, yi): (f64, f64),
+        pos: Positions<'_>,
+        hsq: f64,
+        mut visit: impl FnMut(usize, f64, u32),
+    ) where
+        K: GridKey,
+        O: VisitOrder,
+    {
+        let mut found = Vec::new();
+        self.for_each_by_row(block, |t, (xj, yj, j)| {
+            if distance_squared(xi, yi, xj, yj) < hsq {
+                found.push(hit(j, t));
+            }
+        });
+        if matches!(O::ORDER, SumOrder::Index) {
+            found.sort_unstable();
+        }
+        for h in found {
+            let j = index_of(h);
+            let r2 = distance_squared(xi, yi, pos.x[j as usize], pos.y[j as usize]);
+            visit(j as usize, r2, key::<K>(j, position_of(h)));
+        }
+    }
 }
 
-/// A hit as one sortable word: its index above its position among the candidates (indices are
-/// distinct, so the order is the indices' order; the low word alone gives the candidates').
-#[inline(always)]
-fn hit(j: u32, position: u32) -> u64 {
-    (u64::from(j) << 32) | u64::from(position)
+impl Block {
+    /// The block's candidates.
+    #[inline(always)]
+    fn candidates(&self) -> u32 {
+        let (lo, hi) = self.runs[2];
+        self.base[2] + (hi - lo)
+    }
+
+    /// Where each of the block's candidates lies in the sorted order.
+    #[inline(always)]
+    fn slots(&self) -> Slots {
+        // Where in `order` a position of each row starts: the row's first slot minus the
+        // candidates of the rows before it (wrapping: only sums with a position in that row
+        // are read).
+        let [r0, r1, r2] = self.runs.map(|(lo, _)| lo);
+        let [_, b1, b2] = self.base;
+        let (o0, o1, o2) = (r0, r1.wrapping_sub(b1), r2.wrapping_sub(b2));
+        Slots {
+            first: o0,
+            step: [o1.wrapping_sub(o0), o2.wrapping_sub(o1)],
+            rows: [b1, b2],
+        }
+    }
 }
 
-/// Puts the distinct values of `src` in increasing order into `dst` by counting, for each, how
-/// many are smaller: quadratic but branch-free, which beats branching sorts on a few dozen.
-#[inline]
-fn rank_sort(src: &[u64], dst: &mut [u64]) {
-    for &h in src {
-        let rank: u32 = src.iter().map(|&w| u32::from(w < h)).sum();
-        dst[rank as usize] = h;
+/// Turns a candidate's position in its block (counted row by row) into its slot in the
+/// grid's sorted order without a branch, whichever row it is in: the positions of one loop or
+/// list come from every row in turn.
+#[derive(Debug, Clone, Copy)]
+struct Slots {
+    /// The offset of the first row's positions.
+    first: u32,
+    /// What the offset gains at the second row and at the third.
+    step: [u32; 2],
+    /// The first position of the second row and of the third.
+    rows: [u32; 2],
+}
+
+impl Slots {
+    /// The slot of the candidate at `position`.
+    #[inline(always)]
+    fn of(&self, position: u32) -> usize {
+        let offset = self
+            .first
+            .wrapping_add(self.step[0].wrapping_mul(u32::from(position >= self.rows[0])))
+            .wrapping_add(self.step[1].wrapping_mul(u32::from(position >= self.rows[1])));
+        position.wrapping_add(offset) as usize
     }
 }
 
@@ -389,6 +452,9 @@ mod tests {
     use crate::simd::Portable;
 
     const H: f64 = 16.0;
+
+    /// Particles in a pile that fills a block past the scratch's places.
+    const PILE: usize = INLINE_HITS + 22;
 
     fn grid_over<K: GridKey, O: VisitOrder>(x: &[f64], y: &[f64]) -> Grid<K, O> {
         let bounds = Bounds {
@@ -409,7 +475,10 @@ mod tests {
         pos: Positions<'_>,
     ) -> Vec<(usize, u32)> {
         let mut found = Vec::new();
-        grid.for_each_within(Portable, i, pos, H * H, |j, _, key| found.push((j, key)));
+        let scratch = &mut GridScratch::default();
+        grid.for_each_within(scratch, Portable, i, pos, H * H, |j, _, key| {
+            found.push((j, key))
+        });
         found
     }
 
@@ -445,6 +514,36 @@ mod tests {
     }
 
     #[test]
+    fn every_scan_and_sort_finds_all_pairs_hits_in_index_order_with_their_distances() {
+        // From sparse to crowded: blocks scanned in one loop and row by row, hits put in
+        // order by the network, the rank sort and the comparison sort, blocks on the heap.
+        let mut paths = (0, 0, 0);
+        for n in [150, 600, 1500, 4000] {
+            let (x, y) = scattered(n);
+            let pos = Positions { x: &x, y: &y };
+            let grid = grid_over::<u32, InIndexOrder>(&x, &y);
+            let scratch = &mut GridScratch::default();
+            for i in 0..n {
+                let mut found = Vec::new();
+                grid.for_each_within(scratch, Portable, i, pos, H * H, |j, r2, _| {
+                    found.push((j, r2.to_bits()))
+                });
+                let expected: Vec<(usize, u64)> = (0..n)
+                    .map(|j| (j, distance_squared(x[i], y[i], x[j], y[j])))
+                    .filter(|&(_, r2)| r2 < H * H)
+                    .map(|(j, r2)| (j, r2.to_bits()))
+                    .collect();
+                assert_eq!(found, expected, "n {n}, particle {i}");
+                let candidates = grid.block(x[i], y[i]).candidates();
+                paths.0 += usize::from(candidates <= ONE_LOOP_MAX && found.len() <= SMALL);
+                paths.1 += usize::from(candidates > ONE_LOOP_MAX);
+                paths.2 += usize::from(found.len() > RANK_SORT_MAX);
+            }
+        }
+        assert!(paths.0 > 100 && paths.1 > 100 && paths.2 > 10, "{paths:?}");
+    }
+
+    #[test]
     fn every_position_key_names_its_neighbour_again() {
         let (x, y) = scattered(2000);
         keys_name_their_neighbours_again::<u8>(&x, &y);
@@ -469,11 +568,11 @@ mod tests {
     }
 
     #[test]
-    fn cell_order_visits_hits_in_candidate_order_with_either_key_spilled_rows_too() {
+    fn cell_order_visits_hits_in_candidate_order_with_either_key_crowded_blocks_too() {
         let (mut x, mut y) = scattered(2000);
-        // And a pile of 120 in one cell row (more than INLINE_HITS, so the row spills to the
-        // heap) with particles just above it that reach into it.
-        for k in 0..120 {
+        // And a pile in one cell row (more than INLINE_HITS, so a block holding it is collected
+        // on the heap) with particles just above it that reach into it.
+        for k in 0..PILE {
             x.push(81.0 + (k % 40) as f64 * 1.1);
             y.push(81.0 + (k / 40) as f64 * 0.5);
         }
@@ -483,7 +582,7 @@ mod tests {
         let by_index = grid_over::<u8, InIndexOrder>(&x, &y);
         let by_cell = grid_over::<u8, InCellOrder>(&x, &y);
         let by_cell_with_index_keys = grid_over::<u32, InCellOrder>(&x, &y);
-        let mut spilled_hits = 0;
+        let mut crowded_hits = 0;
         for i in 0..x.len() {
             let found = hits(&by_cell, i, pos);
             assert!(found.windows(2).all(|w| w[0].1 < w[1].1), "particle {i}");
@@ -505,35 +604,36 @@ mod tests {
             js.sort_unstable();
             let in_index_order: Vec<usize> = hits(&by_index, i, pos).iter().map(|h| h.0).collect();
             assert_eq!(js, in_index_order, "particle {i}");
-            spilled_hits +=
-                usize::from(i >= 2120 && found.iter().any(|&(j, _)| (2000..2120).contains(&j)));
+            let pile = 2000..2000 + PILE;
+            crowded_hits +=
+                usize::from(i >= pile.end && found.iter().any(|&(j, _)| pile.contains(&j)));
         }
         assert!(
-            spilled_hits >= 2,
+            crowded_hits >= 2,
             "the pile's row is reached from the row above"
         );
     }
 
     #[test]
-    fn keys_from_a_row_too_long_for_the_stack_buffer_name_their_neighbours_again() {
-        // 120 particles in the row below particle 120's (more than INLINE_HITS), out of its
-        // reach, plus a few in reach on both sides: the first row is collected on the heap.
-        let (mut x, mut y): (Vec<f64>, Vec<f64>) = (0..120)
+    fn keys_from_a_block_too_large_for_the_scratch_name_their_neighbours_again() {
+        // A pile in the row below particle PILE's (more than INLINE_HITS), out of its reach,
+        // plus a few in reach on both sides: the block is collected on the heap.
+        let (mut x, mut y): (Vec<f64>, Vec<f64>) = (0..PILE)
             .map(|k| (81.0 + (k % 40) as f64 * 1.1, 81.0 + (k / 40) as f64 * 0.5))
             .unzip();
         x.extend([101.0, 103.0, 100.0, 104.0]);
         y.extend([105.0, 106.0, 112.0, 95.0]);
         let pos = Positions { x: &x, y: &y };
         let grid = grid_over::<u8, InIndexOrder>(&x, &y);
-        let found = hits(&grid, 120, pos);
+        let found = hits(&grid, PILE, pos);
         let js: Vec<usize> = found.iter().map(|&(j, _)| j).collect();
-        assert_eq!(js, [120, 121, 122, 123]);
+        assert_eq!(js, [PILE, PILE + 1, PILE + 2, PILE + 3]);
         let keys: Vec<u8> = found
             .iter()
             .map(|&(_, k)| u8::try_from(k).unwrap())
             .collect();
         let mut named = Vec::new();
-        grid.for_each_listed(120, pos, &keys, |j| named.push(j));
+        grid.for_each_listed(PILE, pos, &keys, |j| named.push(j));
         assert_eq!(named, js);
     }
 

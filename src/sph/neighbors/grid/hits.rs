@@ -1,0 +1,140 @@
+//! A particle's hits while the grid collects them and puts them in order: the working memory
+//! a search call reuses ([`GridScratch`]) and the sorts.
+//!
+//! A hit is one word, the neighbour's index above its position among the particle's
+//! candidates ([`hit`]): indices are distinct, so sorting the words sorts by index, and the low
+//! word alone gives the candidates' order.
+
+/// Candidates of one particle collected in [`GridScratch`]; a particle with more (a pile in a
+/// corner) collects its hits in a vector. Müller's presets have about 12–30 candidates, `wcsph`
+/// up to about 100 next to a wall.
+pub(super) const INLINE_HITS: usize = 128;
+
+/// Blocks of up to this many candidates are scanned in one loop rather than row by row: see
+/// the grid's `for_each_within`.
+pub(super) const ONE_LOOP_MAX: u32 = 32;
+
+/// The most hits put in order by [`rank_sort`]: its cost grows with the square of the hits,
+/// so more (`wcsph` has about 20–45) are sorted by comparison instead. Either gives the one
+/// increasing order of distinct indices.
+pub(super) const RANK_SORT_MAX: usize = 24;
+
+/// The most hits put in order by [`sort_small`], whose work is fixed: no branch depends on the
+/// number of hits. Müller's particles have about 6 hits (self included) once the dam has
+/// fallen, 13 while it falls.
+pub(super) const SMALL: usize = 8;
+
+/// Working memory of the grid's search for one particle, made once per run of particles (a
+/// chunk) and reused: made per particle, its 2 KiB were zeroed per particle, a tenth of the
+/// reference run's instructions.
+#[derive(Debug, Clone)]
+pub struct GridScratch {
+    /// The hits collected: every candidate is written at the next free place, which only a hit
+    /// takes. [`SMALL`] more places hold the padding of [`sort_small`].
+    pub(super) hits: [u64; INLINE_HITS + SMALL],
+    /// Each candidate's squared distance, by its position in the block.
+    pub(super) r2: [f64; INLINE_HITS],
+    /// The hits put in order by [`rank_sort`].
+    pub(super) ranked: [u64; RANK_SORT_MAX],
+}
+
+impl Default for GridScratch {
+    fn default() -> Self {
+        GridScratch {
+            hits: [0; INLINE_HITS + SMALL],
+            r2: [0.0; INLINE_HITS],
+            ranked: [0; RANK_SORT_MAX],
+        }
+    }
+}
+
+/// Neighbour `j`, the candidate at `position` in its block, as one sortable word.
+#[inline(always)]
+pub(super) fn hit(j: u32, position: u32) -> u64 {
+    (u64::from(j) << 32) | u64::from(position)
+}
+
+/// The index of the neighbour a hit names.
+#[inline(always)]
+pub(super) fn index_of(hit: u64) -> u32 {
+    (hit >> 32) as u32
+}
+
+/// The position among its block's candidates of the neighbour a hit names.
+#[inline(always)]
+pub(super) fn position_of(hit: u64) -> u32 {
+    hit as u32
+}
+
+/// Puts the distinct values of `src` in increasing order into `dst` by counting, for each, how
+/// many are smaller: quadratic but branch-free, which beats branching sorts on a few dozen.
+#[inline]
+pub(super) fn rank_sort(src: &[u64], dst: &mut [u64]) {
+    for &h in src {
+        let rank: u32 = src.iter().map(|&w| u32::from(w < h)).sum();
+        dst[rank as usize] = h;
+    }
+}
+
+/// Puts the first [`SMALL`] hits in increasing order: the hits and, from some place on, padding
+/// of `u64::MAX` (which stays last). A sorting network: a fixed sequence of compare-exchanges
+/// with no branch (a sort whose work varies with the number of hits mispredicts its loops'
+/// ends; these hits number about 6).
+#[inline(always)]
+pub(super) fn sort_small(hits: &mut [u64; SMALL]) {
+    // Batcher's odd-even merge sort of 8: 19 compare-exchanges, the fewest for 8. Written out
+    // (a loop over pairs kept them in memory, each load bounds-checked), on a copy the
+    // compiler keeps in registers.
+    macro_rules! exchange {
+        ($v:ident: $(($a:literal, $b:literal)),*) => {$(
+            let (x, y) = ($v[$a], $v[$b]);
+            $v[$a] = x.min(y);
+            $v[$b] = x.max(y);
+        )*};
+    }
+    let mut v = *hits;
+    exchange!(v: (0, 2), (1, 3), (4, 6), (5, 7));
+    exchange!(v: (0, 4), (1, 5), (2, 6), (3, 7));
+    exchange!(v: (0, 1), (2, 3), (4, 5), (6, 7));
+    exchange!(v: (2, 4), (3, 5));
+    exchange!(v: (1, 4), (3, 6));
+    exchange!(v: (1, 2), (3, 4), (5, 6));
+    *hits = v;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_small_network_sorts_every_input() {
+        // A network that sorts every sequence of 0s and 1s sorts every sequence (Knuth's
+        // 0-1 principle): all 256 of them.
+        for bits in 0u32..1 << SMALL {
+            let mut v: [u64; SMALL] = std::array::from_fn(|k| u64::from((bits >> k) & 1));
+            sort_small(&mut v);
+            assert!(v.is_sorted(), "{bits:08b}: {v:?}");
+        }
+        // And hits with padding, at every length.
+        let indices = [41u32, 7, 300, 2, 99, 0, 1000, 8];
+        for len in 0..=SMALL {
+            let mut v = [u64::MAX; SMALL];
+            for (k, &j) in indices[..len].iter().enumerate() {
+                v[k] = hit(j, 50 - k as u32);
+            }
+            let mut expected = v;
+            expected.sort_unstable();
+            sort_small(&mut v);
+            assert_eq!(v, expected, "len {len}");
+        }
+    }
+
+    #[test]
+    fn a_rank_sort_orders_distinct_hits_by_index() {
+        let src = [hit(9, 0), hit(3, 1), hit(12, 2), hit(4, 3)];
+        let mut dst = [0u64; 4];
+        rank_sort(&src, &mut dst);
+        assert_eq!(dst.map(index_of), [3, 4, 9, 12]);
+        assert_eq!(dst.map(position_of), [1, 3, 0, 2]);
+    }
+}
