@@ -103,7 +103,8 @@ pub trait Neighbors: Sync {
     /// distance `r2 = dx*dx + dy*dy` (with `d = x_j − x_i`) is below `hsq`, in the search's
     /// visit order (increasing j, unless a grid in [`SumOrder::Cell`]),
     /// testing candidates in `lanes` where the search uses them (all-pairs does, the grid does
-    /// not); every path finds the same j with the same r2.
+    /// not); every path finds the same j with the same r2. `pos` must be the positions of the
+    /// last [`Neighbors::rebuild`] (the grid tests copies of them).
     ///
     /// `key` names j in a list of i's neighbours ([`Neighbors::for_each_listed`]); it may
     /// exceed [`ListKey::MAX`] (the grid's, among more candidates than a key counts), and such

@@ -30,8 +30,9 @@ pub(super) const SMALL: usize = 8;
 #[derive(Debug, Clone)]
 pub struct GridScratch {
     /// The hits collected: every candidate is written at the next free place, which only a hit
-    /// takes. [`SMALL`] more places hold the padding of [`sort_small`].
-    pub(super) hits: [u64; INLINE_HITS + SMALL],
+    /// takes. Up to [`SMALL`] hits are followed by [`SMALL`] places of padding for
+    /// [`sort_small`] (within the first `2 × SMALL`).
+    pub(super) hits: [u64; INLINE_HITS],
     /// Each candidate's squared distance, by its position in the block.
     pub(super) r2: [f64; INLINE_HITS],
     /// The hits put in order by [`rank_sort`].
@@ -41,7 +42,7 @@ pub struct GridScratch {
 impl Default for GridScratch {
     fn default() -> Self {
         GridScratch {
-            hits: [0; INLINE_HITS + SMALL],
+            hits: [0; INLINE_HITS],
             r2: [0.0; INLINE_HITS],
             ranked: [0; RANK_SORT_MAX],
         }
@@ -82,7 +83,7 @@ pub(super) fn rank_sort(src: &[u64], dst: &mut [u64]) {
 /// ends; these hits number about 6).
 #[inline(always)]
 pub(super) fn sort_small(hits: &mut [u64; SMALL]) {
-    // Batcher's odd-even merge sort of 8: 19 compare-exchanges, the fewest for 8. Written out
+    // A network of 19 compare-exchanges in 6 layers, the fewest for 8 inputs. Written out
     // (a loop over pairs kept them in memory, each load bounds-checked), on a copy the
     // compiler keeps in registers.
     macro_rules! exchange {
