@@ -180,21 +180,10 @@ macro_rules! with_search_lanes {
             AnyNeighbors::AllPairs(Searched { search: $nb, lists: $lists }) => {
                 with_lanes!($lanes, $l => $body)
             }
-            AnyNeighbors::GridByPosition(Searched { search: $nb, lists: $lists }) => {
+            // Every grid (`with_search!`'s all-pairs arm is never taken here).
+            grid => {
                 let $l = simd::Portable;
-                $body
-            }
-            AnyNeighbors::GridByIndex(Searched { search: $nb, lists: $lists }) => {
-                let $l = simd::Portable;
-                $body
-            }
-            AnyNeighbors::GridInCellOrder(Searched { search: $nb, lists: $lists }) => {
-                let $l = simd::Portable;
-                $body
-            }
-            AnyNeighbors::GridByIndexInCellOrder(Searched { search: $nb, lists: $lists }) => {
-                let $l = simd::Portable;
-                $body
+                with_search!(grid, ($nb, $lists) => $body)
             }
         }
     };
