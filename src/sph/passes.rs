@@ -68,6 +68,7 @@ pub fn force<N: Neighbors>(
     nb: &N,
     prm: &Params,
 ) -> DVec2 {
+    let input = &input.to_common_length();
     let me = Particle {
         x: input.pos.at(i),
         v: DVec2::new(input.vx[i], input.vy[i]),

@@ -78,16 +78,24 @@ impl ListKey for u32 {
 #[derive(Debug)]
 pub struct ListWriter<'a, K> {
     slots: &'a mut [K],
+    /// The scratch slot: `slots.len() - 1`.
+    scratch: usize,
     len: usize,
     fits: bool,
 }
 
 impl<'a, K: ListKey> ListWriter<'a, K> {
     /// Writes into `slots` (at least one: the scratch slot).
+    ///
+    /// # Panics
+    /// If `slots` is empty.
     #[inline(always)]
     pub fn new(slots: &'a mut [K]) -> Self {
+        // Found here once, so that each push's slot is known to lie in `slots`.
+        let scratch = slots.len().checked_sub(1).expect("a scratch slot");
         ListWriter {
             slots,
+            scratch,
             len: 0,
             fits: true,
         }
@@ -97,8 +105,7 @@ impl<'a, K: ListKey> ListWriter<'a, K> {
     /// otherwise).
     #[inline(always)]
     pub fn push(&mut self, key: u32, keep: bool) {
-        let scratch = self.slots.len() - 1;
-        self.slots[self.len.min(scratch)] = K::truncate(key);
+        self.slots[self.len.min(self.scratch)] = K::truncate(key);
         self.fits &= !keep | (key <= K::MAX);
         self.len += usize::from(keep);
     }

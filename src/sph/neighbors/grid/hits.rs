@@ -10,6 +10,9 @@
 /// up to about 100 next to a wall.
 pub(super) const INLINE_HITS: usize = 128;
 
+// The search indexes its hits modulo INLINE_HITS: a mask, not a division.
+const _: () = assert!(INLINE_HITS.is_power_of_two());
+
 /// Blocks of up to this many candidates are scanned in one loop rather than row by row: see
 /// the grid's `for_each_within`.
 pub(super) const ONE_LOOP_MAX: u32 = 32;
@@ -75,6 +78,14 @@ pub(super) fn rank_sort(src: &[u64], dst: &mut [u64]) {
         let rank: u32 = src.iter().map(|&w| u32::from(w < h)).sum();
         dst[rank as usize] = h;
     }
+}
+
+/// Whether `hits` are in increasing order, found without a branch: a fold, not `is_sorted`,
+/// which is a call per particle here. Padding (`u64::MAX`, equal to each other) counts as in
+/// order after the hits; the hits themselves are distinct.
+#[inline(always)]
+pub(super) fn in_order(hits: &[u64]) -> bool {
+    hits.windows(2).fold(true, |ok, w| ok & (w[0] <= w[1]))
 }
 
 /// Puts the first [`SMALL`] hits in increasing order: the hits and, from some place on, padding

@@ -16,6 +16,7 @@
 //! the index from the particle's own cell when the list is read
 //! ([`GridKeys`](keys::GridKeys)).
 
+use std::hint::select_unpredictable;
 use std::marker::PhantomData;
 
 use sph_strategies::{Executor, KernelPanic};
@@ -26,8 +27,8 @@ mod sort;
 
 pub use hits::GridScratch;
 use hits::{
-    INLINE_HITS, ONE_LOOP_MAX, RANK_SORT_MAX, SMALL, hit, index_of, position_of, rank_sort,
-    sort_small,
+    INLINE_HITS, ONE_LOOP_MAX, RANK_SORT_MAX, SMALL, hit, in_order, index_of, position_of,
+    rank_sort, sort_small,
 };
 use keys::GridKey;
 use sort::CellSort;
@@ -190,8 +191,12 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         let shape = self.shape;
         self.cell_of.resize(n, 0);
         exec.for_each_chunk(&mut self.cell_of[..], |first, cells| {
-            for (k, c) in cells.iter_mut().enumerate() {
-                *c = shape.cell_of(pos.x[first + k], pos.y[first + k]);
+            let (xs, ys) = (
+                &pos.x[first..][..cells.len()],
+                &pos.y[first..][..cells.len()],
+            );
+            for ((c, &x), &y) in cells.iter_mut().zip(xs).zip(ys) {
+                *c = shape.cell_of(x, y);
             }
         })?;
         self.order.resize(n, 0);
@@ -200,12 +205,14 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         self.sorted_x.resize(n, 0.0);
         self.sorted_y.resize(n, 0.0);
         let order = &self.order;
+        // One length for both, so that one bounds check covers both reads.
+        let (px, py) = (&pos.x[..n], &pos.y[..n]);
         exec.for_each_chunk(
             (&mut self.sorted_x[..], &mut self.sorted_y[..]),
             |first, (xs, ys)| {
-                for (k, (sx, sy)) in xs.iter_mut().zip(ys).enumerate() {
-                    let j = order[first + k] as usize;
-                    (*sx, *sy) = (pos.x[j], pos.y[j]);
+                let order = &order[first..][..xs.len()];
+                for ((sx, sy), &j) in xs.iter_mut().zip(ys).zip(order) {
+                    (*sx, *sy) = (px[j as usize], py[j as usize]);
                 }
             },
         )
@@ -225,7 +232,13 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         let block = self.block(xi, yi);
         let candidates = block.candidates();
         if candidates as usize > INLINE_HITS {
-            return self.visit_crowded(&block, (xi, yi), pos, hsq, visit);
+            for h in self.crowded_hits(&block, (xi, yi), hsq) {
+                let j = index_of(h);
+                // Computed again: the same formula, the same bits.
+                let r2 = distance_squared(xi, yi, pos.x[j as usize], pos.y[j as usize]);
+                visit(j as usize, r2, key::<K>(j, position_of(h)));
+            }
+            return;
         }
         // Hits are collected without branching: every candidate written at the next free
         // place, which only a hit keeps, and its squared distance at its position, where its
@@ -244,33 +257,39 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         let mut len = 0;
         let mut collect = |t: u32, (xj, yj, j): (f64, f64, u32)| {
             let r2 = distance_squared(xi, yi, xj, yj);
-            hits[len] = hit(j, t);
+            // len ≤ t < candidates ≤ INLINE_HITS: the wrap never happens, and spares the
+            // loop a bounds check.
+            hits[len % INLINE_HITS] = hit(j, t);
             dists[t as usize] = r2;
             len += usize::from(r2 < hsq);
         };
         if candidates <= ONE_LOOP_MAX {
             let slots = block.slots();
+            // Cut to one length, so that one bounds check covers all three reads.
+            let n = self.order.len();
+            let (xs, ys, order) = (&self.sorted_x[..n], &self.sorted_y[..n], &self.order[..n]);
             for t in 0..candidates {
                 let s = slots.of(t);
-                collect(t, (self.sorted_x[s], self.sorted_y[s], self.order[s]));
+                collect(t, (xs[s], ys[s], order[s]));
             }
         } else {
             self.for_each_by_row(&block, collect);
         }
         // In order already? Rows are scanned bottom to top and cells left to right: where
         // particles are still numbered that way (a scene at rest, a calm region) nothing
-        // moves. A branch-free fold: `is_sorted` is a call per particle here.
-        let sorted = matches!(O::ORDER, SumOrder::Cell)
-            || hits[..len]
-                .windows(2)
-                .fold(true, |ok, w| ok & (w[0] < w[1]));
-        let hits = if sorted {
+        // moves.
+        let hits = if matches!(O::ORDER, SumOrder::Cell) {
             &hits[..len]
         } else if len <= SMALL {
-            // The usual case in motion: a fixed, branch-free sort of SMALL places, the rest
-            // padding.
+            // The usual case in motion: SMALL places, the rest padding, checked and sorted in
+            // a fixed number of steps, so that no loop's end depends on the number of hits.
             hits[len..len + SMALL].fill(u64::MAX);
-            sort_small((&mut hits[..SMALL]).try_into().expect("SMALL places"));
+            let small: &mut [u64; SMALL] = (&mut hits[..SMALL]).try_into().expect("SMALL places");
+            if !in_order(small) {
+                sort_small(small);
+            }
+            &hits[..len]
+        } else if in_order(&hits[..len]) {
             &hits[..len]
         } else if len <= RANK_SORT_MAX {
             rank_sort(&hits[..len], &mut ranked[..len]);
@@ -281,7 +300,9 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         };
         for &h in hits {
             let (j, position) = (index_of(h), position_of(h));
-            visit(j as usize, dists[position as usize], key::<K>(j, position));
+            // position < candidates ≤ INLINE_HITS: the wrap spares a bounds check.
+            let r2 = dists[position as usize % INLINE_HITS];
+            visit(j as usize, r2, key::<K>(j, position));
         }
     }
 
@@ -360,20 +381,15 @@ impl<K, O> Grid<K, O> {
         }
     }
 
-    /// Calls `visit` for the hits of a block of more candidates than [`GridScratch`] holds (a
-    /// pile): collected row by row in a vector, in candidate order, then sorted by index
-    /// unless the grid visits in cell order. The distances are computed again when visited
-    /// (same formula, same bits).
+    /// The hits of a block of more candidates than [`GridScratch`] holds (a pile): collected
+    /// row by row in a vector, in candidate order, then sorted by index unless the grid visits
+    /// in cell order.
+    ///
+    /// It returns them rather than visiting them: a visit closure handed to a call that is not
+    /// inlined would make the pass keep its sums in memory, hot loop included.
     #[cold]
-    fn visit_crowded(
-        &self,
-        block: &Block,
-        (xi, yi): (f64, f64),
-        pos: Positions<'_>,
-        hsq: f64,
-        mut visit: impl FnMut(usize, f64, u32),
-    ) where
-        K: GridKey,
+    fn crowded_hits(&self, block: &Block, (xi, yi): (f64, f64), hsq: f64) -> Vec<u64>
+    where
         O: VisitOrder,
     {
         let mut found = Vec::new();
@@ -385,11 +401,7 @@ impl<K, O> Grid<K, O> {
         if matches!(O::ORDER, SumOrder::Index) {
             found.sort_unstable();
         }
-        for h in found {
-            let j = index_of(h);
-            let r2 = distance_squared(xi, yi, pos.x[j as usize], pos.y[j as usize]);
-            visit(j as usize, r2, key::<K>(j, position_of(h)));
-        }
+        found
     }
 }
 
@@ -409,10 +421,8 @@ impl Block {
         // are read).
         let [r0, r1, r2] = self.runs.map(|(lo, _)| lo);
         let [_, b1, b2] = self.base;
-        let (o0, o1, o2) = (r0, r1.wrapping_sub(b1), r2.wrapping_sub(b2));
         Slots {
-            first: o0,
-            step: [o1.wrapping_sub(o0), o2.wrapping_sub(o1)],
+            offset: [r0, r1.wrapping_sub(b1), r2.wrapping_sub(b2)],
             rows: [b1, b2],
         }
     }
@@ -423,10 +433,8 @@ impl Block {
 /// list come from every row in turn.
 #[derive(Debug, Clone, Copy)]
 struct Slots {
-    /// The offset of the first row's positions.
-    first: u32,
-    /// What the offset gains at the second row and at the third.
-    step: [u32; 2],
+    /// What each row's positions are offset by.
+    offset: [u32; 3],
     /// The first position of the second row and of the third.
     rows: [u32; 2],
 }
@@ -435,10 +443,10 @@ impl Slots {
     /// The slot of the candidate at `position`.
     #[inline(always)]
     fn of(&self, position: u32) -> usize {
-        let offset = self
-            .first
-            .wrapping_add(self.step[0].wrapping_mul(u32::from(position >= self.rows[0])))
-            .wrapping_add(self.step[1].wrapping_mul(u32::from(position >= self.rows[1])));
+        // Two conditional moves: which row varies from one candidate to the next.
+        let [o0, o1, o2] = self.offset;
+        let offset = select_unpredictable(position >= self.rows[0], o1, o0);
+        let offset = select_unpredictable(position >= self.rows[1], o2, offset);
         position.wrapping_add(offset) as usize
     }
 }
