@@ -184,13 +184,15 @@ impl<'a> Fields<'a> {
         }
     }
 
-    /// The same fields, each cut to the shortest one's length: in a loop that reads all six
-    /// at one index, a single bounds check then covers them.
+    /// The same fields, each cut to the number of particles (the positions' length): in a
+    /// loop that reads all six at one index, a single bounds check then covers them.
+    ///
+    /// # Panics
+    /// If an array is shorter than the positions (fields of fluid particles only, as
+    /// `wcsph`'s, are not for this).
     #[inline(always)]
     pub fn to_common_length(&self) -> Fields<'a> {
-        let n = [self.pos.y, self.vx, self.vy, self.rho, self.p]
-            .iter()
-            .fold(self.pos.x.len(), |n, a| n.min(a.len()));
+        let n = self.pos.x.len();
         Fields::new(
             (&self.pos.x[..n], &self.pos.y[..n]),
             (&self.vx[..n], &self.vy[..n]),

@@ -34,7 +34,7 @@ pub(super) const SMALL: usize = 8;
 pub struct GridScratch {
     /// The hits collected: every candidate is written at the next free place, which only a hit
     /// takes. Up to [`SMALL`] hits are followed by [`SMALL`] places of padding for
-    /// [`sort_small`] (within the first `2 × SMALL`).
+    /// [`in_order`] and [`sort_small`] (within the first `2 × SMALL`).
     pub(super) hits: [u64; INLINE_HITS],
     /// Each candidate's squared distance, by its position in the block.
     pub(super) r2: [f64; INLINE_HITS],
@@ -139,6 +139,16 @@ mod tests {
             sort_small(&mut v);
             assert_eq!(v, expected, "len {len}");
         }
+    }
+
+    #[test]
+    fn hits_are_in_order_when_each_is_below_the_next_padding_included() {
+        let padding = [u64::MAX; 3];
+        let with_padding = |hits: &[u64]| [hits, &padding].concat();
+        assert!(in_order(&with_padding(&[hit(1, 5), hit(4, 0), hit(9, 2)])));
+        assert!(!in_order(&with_padding(&[hit(4, 0), hit(1, 5), hit(9, 2)])));
+        assert!(!in_order(&[u64::MAX, hit(1, 0)]));
+        assert!(in_order(&[]) && in_order(&padding));
     }
 
     #[test]

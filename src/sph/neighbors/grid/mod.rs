@@ -275,9 +275,9 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         } else {
             self.for_each_by_row(&block, collect);
         }
-        // In order already? Rows are scanned bottom to top and cells left to right: where
-        // particles are still numbered that way (a scene at rest, a calm region) nothing
-        // moves.
+        // Put in index order unless already so. Rows are scanned bottom to top and cells left
+        // to right: where particles are still numbered that way (a scene at rest, a calm
+        // region) the hits come in order and nothing moves.
         let hits = if matches!(O::ORDER, SumOrder::Cell) {
             &hits[..len]
         } else if len <= SMALL {
@@ -521,6 +521,42 @@ mod tests {
         }
     }
 
+    /// Checks every particle's hits (index, r2 bits, order) against a brute-force search, and
+    /// counts which scan and sort each took: one loop with the network, row by row, rank sort,
+    /// comparison sort, crowded. Returns the counts and how many particles had more than one
+    /// hit found already in index order (their positions in the block increase with the index).
+    fn check_against_all_pairs(x: &[f64], y: &[f64], paths: &mut [usize; 5]) -> usize {
+        let (n, pos) = (x.len(), Positions { x, y });
+        let grid = grid_over::<u8, InIndexOrder>(x, y);
+        let scratch = &mut GridScratch::default();
+        let mut found_in_order = 0;
+        for i in 0..n {
+            let mut found = Vec::new();
+            grid.for_each_within(scratch, Portable, i, pos, H * H, |j, r2, key| {
+                found.push((j, r2.to_bits(), key))
+            });
+            let expected: Vec<(usize, u64)> = (0..n)
+                .map(|j| (j, distance_squared(x[i], y[i], x[j], y[j])))
+                .filter(|&(_, r2)| r2 < H * H)
+                .map(|(j, r2)| (j, r2.to_bits()))
+                .collect();
+            let got: Vec<(usize, u64)> = found.iter().map(|&(j, r2, _)| (j, r2)).collect();
+            assert_eq!(got, expected, "n {n}, particle {i}");
+            found_in_order +=
+                usize::from(found.len() > 1 && found.windows(2).all(|w| w[0].2 < w[1].2));
+            let candidates = grid.block(x[i], y[i]).candidates() as usize;
+            let path = match (candidates, found.len()) {
+                (c, _) if c > INLINE_HITS => 4,
+                (_, hits) if hits > RANK_SORT_MAX => 3,
+                (_, hits) if hits > SMALL => 2,
+                (c, _) if c > ONE_LOOP_MAX as usize => 1,
+                _ => 0,
+            };
+            paths[path] += 1;
+        }
+        found_in_order
+    }
+
     #[test]
     fn every_scan_and_sort_finds_all_pairs_hits_in_index_order_with_their_distances() {
         // From sparse to crowded: blocks scanned in one loop and row by row, hits put in
@@ -528,32 +564,31 @@ mod tests {
         let mut paths = [0; 5];
         for n in [150, 600, 1500, 4000, 9000] {
             let (x, y) = scattered(n);
-            let pos = Positions { x: &x, y: &y };
-            let grid = grid_over::<u32, InIndexOrder>(&x, &y);
-            let scratch = &mut GridScratch::default();
-            for i in 0..n {
-                let mut found = Vec::new();
-                grid.for_each_within(scratch, Portable, i, pos, H * H, |j, r2, _| {
-                    found.push((j, r2.to_bits()))
-                });
-                let expected: Vec<(usize, u64)> = (0..n)
-                    .map(|j| (j, distance_squared(x[i], y[i], x[j], y[j])))
-                    .filter(|&(_, r2)| r2 < H * H)
-                    .map(|(j, r2)| (j, r2.to_bits()))
-                    .collect();
-                assert_eq!(found, expected, "n {n}, particle {i}");
-                let candidates = grid.block(x[i], y[i]).candidates() as usize;
-                let path = match (candidates, found.len()) {
-                    (c, _) if c > INLINE_HITS => 4,
-                    (_, hits) if hits > RANK_SORT_MAX => 3,
-                    (_, hits) if hits > SMALL => 2,
-                    (c, _) if c > ONE_LOOP_MAX as usize => 1,
-                    _ => 0,
-                };
-                paths[path] += 1;
-            }
+            check_against_all_pairs(&x, &y, &mut paths);
         }
         assert!(paths.iter().all(|&p| p > 10), "{paths:?}");
+    }
+
+    #[test]
+    fn hits_found_in_index_order_are_visited_as_found_on_every_path() {
+        // Particles numbered in the grid's own order (row by row, cell by cell): every block's
+        // hits are found in index order, so each path's check finds them in order and no
+        // sort runs.
+        let mut paths = [0; 5];
+        let mut in_order = 0;
+        for n in [150, 600, 1500, 4000, 9000] {
+            let (x, y) = scattered(n);
+            let grid = grid_over::<u32, InIndexOrder>(&x, &y);
+            let (x, y): (Vec<f64>, Vec<f64>) = grid
+                .order
+                .iter()
+                .map(|&j| (x[j as usize], y[j as usize]))
+                .unzip();
+            in_order += check_against_all_pairs(&x, &y, &mut paths);
+        }
+        assert!(paths.iter().all(|&p| p > 10), "{paths:?}");
+        let particles = paths.iter().sum::<usize>();
+        assert!(in_order * 10 > particles * 9, "{in_order} of {particles}");
     }
 
     #[test]
