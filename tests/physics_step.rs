@@ -213,3 +213,32 @@ fn a_pair_at_exactly_the_kernel_radius_does_not_interact() {
     assert_eq!(got.fx, vec![0.0, 0.0]);
     assert_eq!(got.rho[0], got.rho[1]);
 }
+
+#[test]
+fn neighbours_taken_two_at_a_time_give_the_hand_computed_step_on_every_simd_path() {
+    use bench_sph::simd::SimdPath;
+    // Particle 0 has four neighbours, one of them at its own point (r = 0: the pair in the
+    // same four lanes as another is left to the one-at-a-time code), and the others an odd or
+    // even number; distances and velocities are not round numbers.
+    let init = state(&[
+        (500.0, 500.0, 3.0, -2.0),
+        (500.0, 500.0, -1.5, 0.5),
+        (507.3, 503.1, 0.25, 4.0),
+        (495.25, 509.0, -6.0, 1.0),
+        (502.0, 488.5, 2.0, 2.5),
+        (511.5, 497.75, -0.5, -3.0),
+    ]);
+    for preset in Preset::MUELLER {
+        let expected = hand_step(&preset.params(), &init);
+        assert!(expected.first_non_finite().is_none());
+        for mode in NeighborMode::ALL {
+            for path in SimdPath::available() {
+                let mut sim = Simulation::new(preset.params(), TANK, init.clone(), mode)
+                    .with_simd(path)
+                    .expect("an available path");
+                run_timed(&mut sim, StrategyName::Seq, &Config::new(1, 1), 1).expect("step runs");
+                assert_same_bits(&sim.state, &expected);
+            }
+        }
+    }
+}

@@ -1,6 +1,8 @@
 //! The lanes of each path: one operation, the squared distances from particle i to eight
 //! candidates and which of them are below the search radius squared.
 
+use super::quad::Quad;
+
 /// The squared distances to eight candidates and the bit mask of those below `hsq` (bit k set
 /// when candidate k is within reach).
 #[derive(Debug, Clone, Copy)]
@@ -12,7 +14,7 @@ pub struct Near8 {
 }
 
 /// One path's instructions.
-pub trait Lanes: Copy + Send + Sync {
+pub trait Lanes: Copy + Send + Sync + Quad {
     /// Runs `f` compiled with this path's instructions enabled: code inlined into `f` (mark
     /// the closure `#[inline(always)]`) may use them, including the compiler's own
     /// vectorisation.
@@ -101,6 +103,12 @@ mod x86 {
     );
 
     impl Avx2 {
+        /// The AVX2 (x86-64-v3) token.
+        #[inline(always)]
+        pub(in crate::simd) fn v3(self) -> V3 {
+            self.0
+        }
+
         #[inline(always)]
         fn near8_inline(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8 {
             let v = self.0;
@@ -129,6 +137,12 @@ mod x86 {
     }
 
     impl Avx512 {
+        /// The AVX2 (x86-64-v3) token, which AVX-512's implies.
+        #[inline(always)]
+        pub(in crate::simd) fn v3(self) -> V3 {
+            *self.0
+        }
+
         #[inline(always)]
         fn near8_inline(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8 {
             let v = self.0;

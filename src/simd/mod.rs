@@ -1,12 +1,16 @@
-//! Which SIMD instructions the neighbour tests run on: a portable path (whatever the compiled
-//! target guarantees: SSE2 on x86-64, NEON on aarch64) and, on x86-64, AVX2 and AVX-512, chosen
-//! at start-up from what the CPU has ([`SimdPath::widest`]) or forced with `--simd`.
+//! Which SIMD instructions the neighbour tests and Müller's force pass run on: a portable path
+//! (whatever the compiled target guarantees: SSE2 on x86-64, NEON on aarch64) and, on x86-64,
+//! AVX2 and AVX-512, chosen at start-up from what the CPU has ([`SimdPath::widest`]) or forced
+//! with `--simd`.
 //!
 //! The all-pairs search tests eight candidates per call ([`Lanes::near8`]); every pass that
 //! searches runs inside [`Lanes::vectorize`], so the compiler may use the path's instructions
-//! for the rest of the pass too. The grid tests its candidates one by one and its passes run
-//! as the target compiles them whatever the path: a row holds only 3–12 candidates, and both
-//! blocks of eight and passes compiled for AVX-512 measured slower there.
+//! for the rest of the pass too. The grid tests its candidates one by one and its search passes
+//! run as the target compiles them whatever the path: a row holds only 3–12 candidates, and
+//! both blocks of eight and passes compiled for AVX-512 measured slower there. Müller's force
+//! pass, on either search, takes two neighbours at a time on the x86 paths, in four lanes
+//! ([`F64x4`], `quad.rs`): its divisions and square roots take the divider's time, which four
+//! lanes halve.
 //!
 //! Every path computes the same bits. What is vectorised is lane-wise IEEE arithmetic in the
 //! scalar code's order (`d = x_j − x_i`, `dx*dx + dy*dy`, then `< HSQ`): no fused multiply-add
@@ -18,6 +22,7 @@
 //! `unsafe` here.
 
 mod lanes;
+mod quad;
 
 use std::sync::atomic::{AtomicU8, Ordering};
 
@@ -26,6 +31,7 @@ use serde::{Deserialize, Serialize};
 #[cfg(target_arch = "x86_64")]
 pub use lanes::{Avx2, Avx512};
 pub use lanes::{Lanes, Near8, Portable};
+pub use quad::{F64x4, Quad};
 
 /// An instruction set the neighbour tests can run on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]

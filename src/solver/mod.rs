@@ -173,7 +173,8 @@ macro_rules! with_search {
 
 /// [`with_search!`], and `$l` bound to the lanes the search tests candidates in: the run's
 /// SIMD path for all-pairs; the portable lanes for the grid, which tests its few candidates
-/// per row one by one (its passes compiled for AVX-512 measured 8–15 % slower here).
+/// per row one by one (its search passes compiled for AVX-512 measured 8–15 % slower here).
+/// Müller's force pass, which searches only for a pile, gets the run's path on every search.
 macro_rules! with_search_lanes {
     ($any:expr, $lanes:expr, ($nb:ident, $lists:ident, $l:ident) => $body:expr) => {
         match $any {
@@ -274,12 +275,13 @@ impl Simulation {
         self.neighbors.grid_keys()
     }
 
-    /// The SIMD path the neighbour tests run on: the chosen one for all-pairs, `portable` for
-    /// the grid (which tests its few candidates per row one by one), so that `--json` and
-    /// `meta.json` name what ran.
+    /// The SIMD path the run's vector code runs on, so that `--json` and `meta.json` name
+    /// what ran: the chosen one for all-pairs' neighbour tests and for Müller's force pass
+    /// (two neighbours at once), `portable` for a `wcsph` run on the grid, which uses neither
+    /// (the grid tests its few candidates per row one by one).
     pub fn simd(&self) -> SimdPath {
-        match self.neighbors {
-            AnyNeighbors::AllPairs(_) => self.lanes.path(),
+        match (&self.neighbors, &self.physics) {
+            (AnyNeighbors::AllPairs(_), _) | (_, Physics::Mueller(_)) => self.lanes.path(),
             _ => SimdPath::Portable,
         }
     }
@@ -340,7 +342,7 @@ impl Simulation {
                 with_search_lanes!(nb, lanes, (nb, lists, l) => mueller::density(exec, l, &*nb, lists, s, prm))
             }
             (Physics::Mueller(prm), Pass::Forces) => {
-                with_search_lanes!(nb, lanes, (nb, lists, l) => mueller::forces(exec, l, &*nb, lists, s, prm))
+                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => mueller::forces(exec, l, &*nb, lists, s, prm)))
             }
             (Physics::Mueller(prm), Pass::Integrate) => {
                 mueller::integrate(exec, s, prm, self.domain)

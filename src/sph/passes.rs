@@ -9,7 +9,7 @@ use glam::DVec2;
 use super::neighbors::{ListWriter, Neighbors, distance_squared};
 use super::params::{Integrator, Params};
 use super::state::{Domain, Fields, Positions};
-use crate::simd::Lanes;
+use crate::simd::{F64x4, Lanes};
 
 /// Density (Müller 2003 eq. 3 with the poly6 kernel, eq. 20; self term included) and
 /// pressure `GAS_CONST · (rho − REST_DENS)` (eq. 12) of particle `i`, plus the number of its
@@ -59,10 +59,13 @@ pub fn density_pressure<N: Neighbors>(
 /// `neighbors` is particle i's list from the density pass when it fit in its slots and its
 /// keys fit their type; without
 /// it the search is asked again. Both give the same j in the same order.
+///
+/// On a path whose vectors hold four lanes ([`Quad::TWO_NEIGHBORS`](crate::simd::Quad::TWO_NEIGHBORS)) a listed particle's
+/// neighbours are taken two at a time (`add_two_pair_forces`), with the same bits.
 #[inline(always)]
-pub fn force<N: Neighbors>(
+pub fn force<N: Neighbors, L: Lanes>(
     i: usize,
-    lanes: impl Lanes,
+    lanes: L,
     input: &Fields<'_>,
     neighbors: Option<&[N::Key]>,
     nb: &N,
@@ -76,6 +79,23 @@ pub fn force<N: Neighbors>(
     };
     let mut acc = (DVec2::ZERO, DVec2::ZERO);
     match neighbors {
+        Some(list) if L::TWO_NEIGHBORS => {
+            let mut held = None;
+            nb.for_each_listed(
+                i,
+                input.pos,
+                list,
+                #[inline(always)]
+                |j| match held.take() {
+                    None => held = Some(j),
+                    Some(a) => add_two_pair_forces(lanes, &mut acc, &me, (a, j), input, prm),
+                },
+            );
+            if let Some(j) = held {
+                let r2 = distance_squared(me.x.x, me.x.y, input.pos.x[j], input.pos.y[j]);
+                add_pair_force(&mut acc, &me, j, r2, input, prm);
+            }
+        }
         Some(list) => nb.for_each_listed(
             i,
             input.pos,
@@ -131,6 +151,50 @@ fn add_pair_force(
         let vj = DVec2::new(input.vx[j], input.vy[j]);
         acc.1 += (((prm.visc_mass * (vj - me.v)) / rho_j) * prm.visc_lap) * hr;
     }
+}
+
+/// Adds neighbour a's terms and then b's, as [`add_pair_force`] would one after the other,
+/// computing both at once: x and y of each in four lanes (`F64x4`), the same operations lane by
+/// lane, so the same bits. A pair at r = H (r2 < HSQ rounded up) or at r = 0 (two particles at
+/// one point) is left to [`add_pair_force`].
+#[inline(always)]
+fn add_two_pair_forces<L: Lanes>(
+    lanes: L,
+    acc: &mut (DVec2, DVec2),
+    me: &Particle,
+    (a, b): (usize, usize),
+    input: &Fields<'_>,
+    prm: &Params,
+) {
+    let pos = input.pos;
+    let r2 = [a, b].map(|j| distance_squared(me.x.x, me.x.y, pos.x[j], pos.y[j]));
+    let [ra, rb] = lanes.sqrt2(r2);
+    let inside = |r: f64| r < prm.h && r > 0.0;
+    if !(inside(ra) && inside(rb)) {
+        add_pair_force(acc, me, a, r2[0], input, prm);
+        add_pair_force(acc, me, b, r2[1], input, prm);
+        return;
+    }
+    // `halves(u, v)`: u in a's lanes, v in b's.
+    let halves = |u, v| F64x4::halves_of(lanes, u, v);
+    let pairs = |u: DVec2, v: DVec2| F64x4::pairs(lanes, u.to_array(), v.to_array());
+    let mine = pairs(me.x, me.x);
+    let d = pairs(pos.at(a), pos.at(b)) - mine;
+    let (hra, hrb) = (prm.h - ra, prm.h - rb);
+    let (rho_a, rho_b) = (input.rho[a], input.rho[b]);
+    let fpress = ((((-d / halves(ra, rb)) * prm.mass)
+        * halves(me.p + input.p[a], me.p + input.p[b]))
+        / halves(2.0 * rho_a, 2.0 * rho_b))
+        * prm.spiky_grad
+        * halves(hra * hra, hrb * hrb);
+    let velocity = |j: usize| DVec2::new(input.vx[j], input.vy[j]);
+    let dv = pairs(velocity(a), velocity(b)) - pairs(me.v, me.v);
+    let fvisc = (((prm.visc_mass * dv) / halves(rho_a, rho_b)) * prm.visc_lap) * halves(hra, hrb);
+    let ([pa, pb], [va, vb]) = (fpress.halves(), fvisc.halves());
+    acc.0 += DVec2::from_array(pa);
+    acc.1 += DVec2::from_array(va);
+    acc.0 += DVec2::from_array(pb);
+    acc.1 += DVec2::from_array(vb);
 }
 
 /// Symplectic Euler step of one particle followed by the wall clamps; returns the new
