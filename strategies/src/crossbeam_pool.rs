@@ -34,7 +34,8 @@
 //! session's thread finds no chunk left, and only the workers already inside it (each busy
 //! with a chunk it took) are waited for. A descheduled worker thus costs the pass its help,
 //! not a scheduling round-trip. And when the pool's threads do not get their cores at all
-//! (the process's CPU time falls short of its threads × wall time), the session's thread runs
+//! (their CPU time falls short of their number × wall time; read from each thread's own
+//! clock, see `thread_clocks`), the session's thread runs
 //! the next passes alone for a while (see the `degrade` module), so a 2-core run on a shared
 //! machine does not fall below the strategy's own 1-core speed. The results are the same
 //! bits.
@@ -53,6 +54,7 @@
 
 use crate::degrade::Degrade;
 use crate::erased_job::JobBoard;
+use crate::thread_clocks::ThreadClocks;
 use crate::thread_start::ThreadStarts;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Placement, Session, Split, Strategy,
@@ -98,8 +100,10 @@ impl Strategy for CrossbeamPool {
     /// Re-raises a panic of `session` itself once the workers have been joined.
     fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError> {
         let board = JobBoard::new();
+        let clocks = ThreadClocks::new(self.cores);
         let executor = PoolExecutor {
             board: &board,
+            clocks: &clocks,
             chunks: self.chunks,
             degrade: RefCell::new(Degrade::new(
                 self.cores,
@@ -108,7 +112,7 @@ impl Strategy for CrossbeamPool {
             not_sync: PhantomData,
         };
         let (cores, placement) = (self.cores, self.placement);
-        let board = &board;
+        let (board, clocks) = (&board, &clocks);
         let outcome = crossbeam::scope(|scope| {
             // Created before the first worker, so that every way out of this closure — a
             // return, a refused thread, a panicking session — releases the workers first.
@@ -120,6 +124,7 @@ impl Strategy for CrossbeamPool {
                         .name(format!("crossbeam-pool-{i}"))
                         .spawn(move |_| {
                             placement.on_start(i);
+                            clocks.register(i);
                             board.serve()
                         })
                 })?;
@@ -130,6 +135,7 @@ impl Strategy for CrossbeamPool {
                     .name("crossbeam-pool-0".to_owned())
                     .spawn(move |_| {
                         placement.on_start(0);
+                        clocks.register(0);
                         session.run(&executor)
                     })
             })?;
@@ -139,16 +145,6 @@ impl Strategy for CrossbeamPool {
         .expect("a crossbeam-pool worker thread panicked");
         outcome.map(|joined| joined.unwrap_or_else(|payload| std::panic::resume_unwind(payload)))
     }
-}
-
-/// CPU time (user + system) of the whole process so far.
-fn process_cpu_time() -> Option<std::time::Duration> {
-    use nix::sys::resource::{UsageWho, getrusage};
-    let usage = getrusage(UsageWho::RUSAGE_SELF).ok()?;
-    let secs = |t: nix::sys::time::TimeVal| {
-        std::time::Duration::new(t.tv_sec() as u64, t.tv_usec() as u32 * 1000)
-    };
-    Some(secs(usage.user_time()) + secs(usage.system_time()))
 }
 
 /// Tells the workers to exit when dropped, including during unwinding.
@@ -166,6 +162,8 @@ impl Drop for ShutDownOnDrop<'_> {
 /// executor and start a nested pass from a worker, which would wait for itself forever.
 struct PoolExecutor<'a> {
     board: &'a JobBoard,
+    /// The CPU clocks of the pool's threads, which `degrade` reads.
+    clocks: &'a ThreadClocks,
     chunks: usize,
     /// Whether the next passes run on the session's thread alone (see `degrade`).
     degrade: RefCell<Degrade>,
@@ -205,7 +203,7 @@ impl Executor for PoolExecutor<'_> {
             // Alone: the same job, every chunk on this thread.
             panic::catch(job)
         } else {
-            degrade.before_parallel_pass(process_cpu_time);
+            degrade.before_parallel_pass(|| self.clocks.total());
             let start = std::time::Instant::now();
             let escaped = self.board.run(&job);
             degrade.after_parallel_pass(start.elapsed());

@@ -8,14 +8,15 @@
 //!
 //! So the session's thread measures what its threads actually get. Over a window (at least
 //! [`WINDOW`] of wall time, of which at least [`MIN_IN_PASSES`] inside passes) it compares
-//! the process's CPU time with the time spent inside passes: a pool of p threads on p free
+//! the CPU time of the pool's threads (each read from its own clock, up to date: see
+//! `thread_clocks`) with the time spent inside passes: a pool of p threads on p free
 //! cores uses about p CPU-seconds per second of pass (waiting threads spin or yield, which
 //! counts), and one CPU-second per second of the serial work between passes (the session's
 //! thread alone, the workers asleep), so the CPU time beyond the serial work, divided by the
 //! time in passes, falling short of p by more than [`SHORTFALL`] means the cores are
-//! shared. The next passes then run on the session's thread alone (the workers
-//! sleep and leave their cores to the competing work): [`FIRST_SOLO`] passes after the first
-//! such window, doubling while the shortfall persists, up to [`MAX_SOLO`]; then a window asks
+//! shared. Once two windows in a row are short, the next passes run on the session's thread
+//! alone (the workers sleep and leave their cores to the competing work): [`FIRST_SOLO`]
+//! passes, doubling while the shortfall persists, up to [`MAX_SOLO`]; then a window asks
 //! for help again, and a window without shortfall ends the degradation. p counts at most the
 //! machine's hardware threads, so deliberate oversubscription (more threads than cores) is
 //! not mistaken for a busy machine.
@@ -28,6 +29,13 @@
 //! outlasts the spinning, found a shortfall on a quiet 2-core VM in about one run in four at
 //! N = 10⁶ and ran all its passes alone. Only the allowance is discounted, so a long cold pass
 //! on shared cores is still judged.
+//!
+//! One short window alone is not enough, because a quiet machine has short moments too: the
+//! first window of a run at N = 10⁶ (the first touches of the warm-up's memory), a page-fault
+//! storm, the virtual machine's host taking a core for a few milliseconds, a program starting
+//! beside the run. Each read as 1.2–1.7 cores on the quiet 2-core VM, in about one run in
+//! six, and the 64 passes alone that followed were the rest of a 10-step run. Real
+//! contention lasts: it is found one window later.
 //!
 //! The results are the same bits either way: every chunk is computed by the same kernel on
 //! the same data, whichever thread runs it. On a quiet machine the pool keeps its cores busy
@@ -77,6 +85,9 @@ pub(crate) struct Degrade {
     left: u32,
     /// The length of the last solo period (0: not degraded).
     span: u32,
+    /// The last window was short, the one before it was not: one more short window and the
+    /// pool runs alone.
+    suspect: bool,
     /// The window being measured (`None`: start one at the next pass with help).
     window: Option<Window>,
     /// Passes run alone so far.
@@ -94,6 +105,7 @@ impl Degrade {
             threads: cores.min(hardware_threads),
             left: 0,
             span: 0,
+            suspect: false,
             window: None,
             solo_total: 0,
             last_end: None,
@@ -111,7 +123,7 @@ impl Degrade {
         true
     }
 
-    /// Called before a pass with help, with the process's CPU time (read only when a window
+    /// Called before a pass with help, with the pool's threads' CPU time (read only when a window
     /// starts or ends).
     pub(crate) fn before_parallel_pass(&mut self, cpu_now: impl Fn() -> Option<Duration>) {
         self.before_parallel_pass_at(Instant::now(), cpu_now);
@@ -164,13 +176,18 @@ impl Degrade {
         }
     }
 
-    /// Ends a window whose passes used `cpu` over `wall`.
+    /// Ends a window whose passes used `cpu` over `wall`. A short window right after one
+    /// that was not short only raises a suspicion: the pool runs alone once a second window
+    /// in a row is short too (see the module's docs).
     fn decide(&mut self, cpu: Duration, wall: Duration) {
-        if short_of_cores(self.threads, cpu, wall) {
+        if !short_of_cores(self.threads, cpu, wall) {
+            (self.span, self.suspect) = (0, false);
+        } else if self.span == 0 && !self.suspect {
+            self.suspect = true;
+        } else {
+            self.suspect = false;
             self.span = (self.span * 2).clamp(FIRST_SOLO, MAX_SOLO);
             self.left = self.span;
-        } else {
-            self.span = 0;
         }
     }
 
@@ -206,15 +223,30 @@ mod tests {
     }
 
     #[test]
+    fn two_short_windows_in_a_row_make_the_pool_run_alone_and_one_alone_does_not() {
+        let (short, full) = ((ms(100), ms(100)), (ms(200), ms(100)));
+        let mut d = Degrade::new(2, 2);
+        d.decide(short.0, short.1);
+        assert!(!d.solo_pass(), "one short window is only a suspicion");
+        d.decide(full.0, full.1);
+        d.decide(short.0, short.1);
+        assert!(!d.solo_pass(), "a full window in between cleared it");
+        d.decide(short.0, short.1);
+        assert_eq!((0..10_000).filter(|_| d.solo_pass()).count(), 64);
+    }
+
+    #[test]
     fn short_windows_make_the_solo_periods_double_and_a_full_window_ends_them() {
         let mut d = Degrade::new(2, 2);
         assert!(!d.solo_pass());
+        d.decide(ms(100), ms(100));
         d.decide(ms(100), ms(100));
         assert_eq!((0..10_000).filter(|_| d.solo_pass()).count(), 64);
         d.decide(ms(100), ms(100));
         assert_eq!((0..10_000).filter(|_| d.solo_pass()).count(), 128);
         d.decide(ms(200), ms(100));
         assert!(!d.solo_pass());
+        d.decide(ms(100), ms(100));
         d.decide(ms(100), ms(100));
         assert_eq!((0..10_000).filter(|_| d.solo_pass()).count(), 64);
         assert_eq!(d.solo_total(), 256);
@@ -236,8 +268,10 @@ mod tests {
 
     #[test]
     fn a_window_closes_only_after_its_minimum_wall_time_and_time_in_passes() {
-        // The CPU clock says nothing was used: a shortfall, once the window is long enough.
+        // The CPU clock says nothing was used: a shortfall, once the window is long enough
+        // (after a short window already, so that this one decides).
         let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
+        d.decide(ms(100), ms(100));
         pass(&mut d, t0, 0.0, 0.5, 0.0); // opens the window; wakes the workers (serial)
         pass(&mut d, t0, 0.55, 1.0, 0.0);
         pass(&mut d, t0, 1.6, 0.0, 0.0);
@@ -268,8 +302,10 @@ mod tests {
     #[test]
     fn a_long_cold_pass_on_shared_cores_is_still_judged() {
         // Every pass cold (the session thread is descheduled between them) and each ran on
-        // one thread: only the allowance is discounted, so the window closes and is short.
+        // one thread: only the allowance is discounted, so the window closes and is short
+        // (the second short window in a row).
         let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
+        d.decide(ms(100), ms(100));
         pass(&mut d, t0, 0.0, 8.0, 0.0);
         pass(&mut d, t0, 10.0, 0.0, 10.0);
         assert!(d.solo_pass());

@@ -40,6 +40,7 @@ mod split;
 pub mod std_static;
 #[cfg(test)]
 mod testing;
+mod thread_clocks;
 mod thread_start;
 
 pub use panic::KernelPanic;
