@@ -49,4 +49,8 @@ impl<E: Executor> Executor for Faulty<'_, E> {
             kernel(first, chunk);
         })
     }
+
+    fn threads(&self) -> usize {
+        self.inner.threads()
+    }
 }

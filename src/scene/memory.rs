@@ -9,7 +9,8 @@
 //! - with `--neighbors grid`, the cell list: particle order and cell (`u32` each), sorted
 //!   positions (`f64` × 2), and one `u32` start per cell of the tank and of the empty ring
 //!   around it; the tank widens with N
-//!   (see [`crate::scene::dam_break`]).
+//!   (see [`crate::scene::dam_break`]); from 65 536 particles on, the scratch of the sort in
+//!   bands ([`Grid::sort_scratch_bytes`]: a `u32` per particle and 1 KiB per 16 384).
 //!
 //! A unit test holds the estimate equal to what a [`crate::solver::Simulation`] allocates.
 //! Fixed costs (the binary, thread stacks, a frame of an animation) are not counted: they are
@@ -20,7 +21,7 @@ use std::mem::size_of;
 use crate::limits::MAX_PARTICLES;
 use crate::scene::{dam_break, tank};
 use crate::solver::SPEED_BLOCK;
-use crate::sph::neighbors::{GridKeys, NeighborMode, SLOTS, WCSPH_SLOTS};
+use crate::sph::neighbors::{Grid, GridKeys, NeighborMode, SLOTS, WCSPH_SLOTS};
 use crate::sph::params::Preset;
 use crate::sph::physics::Physics;
 use crate::sph::state::FIELD_NAMES;
@@ -96,7 +97,8 @@ pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
         let starts = cols.saturating_mul(rows).saturating_add(1);
         bytes = bytes
             .saturating_add(n64.saturating_mul(grid_per_particle as u64))
-            .saturating_add(starts.saturating_mul(size_of::<u32>() as u64));
+            .saturating_add(starts.saturating_mul(size_of::<u32>() as u64))
+            .saturating_add(Grid::<u8>::sort_scratch_bytes(n) as u64);
     }
     bytes
 }
@@ -182,7 +184,7 @@ mod tests {
     fn the_estimate_is_what_a_simulation_allocates() {
         for preset in Preset::ALL {
             for mode in NeighborMode::ALL {
-                for n in [1, 1000, 5000, 70_000] {
+                for n in [1, 1000, 5000, 70_000, 100_000] {
                     let scene = crate::scene::Scene::dam_break(preset, n, 1).unwrap();
                     let state_bytes: usize = scene
                         .state

@@ -43,6 +43,10 @@ impl<E: Executor> Executor for TracingExecutor<'_, E> {
             timed_call(rec, phase, step, first, chunk, &kernel);
         })
     }
+
+    fn threads(&self) -> usize {
+        self.inner.threads()
+    }
 }
 
 /// Runs `kernel(first, chunk)` and records it as one call of `phase` in `step`.

@@ -104,6 +104,7 @@ impl Strategy for CrossbeamPool {
         let executor = PoolExecutor {
             board: &board,
             clocks: &clocks,
+            threads: self.cores,
             chunks: self.chunks,
             degrade: RefCell::new(Degrade::new(
                 self.cores,
@@ -164,6 +165,8 @@ struct PoolExecutor<'a> {
     board: &'a JobBoard,
     /// The CPU clocks of the pool's threads, which `degrade` reads.
     clocks: &'a ThreadClocks,
+    /// The pool's threads, the session's included.
+    threads: usize,
     chunks: usize,
     /// Whether the next passes run on the session's thread alone (see `degrade`).
     degrade: RefCell<Degrade>,
@@ -214,6 +217,10 @@ impl Executor for PoolExecutor<'_> {
             Some(p) => Err(p),
             None => escaped,
         }
+    }
+
+    fn threads(&self) -> usize {
+        self.threads
     }
 }
 

@@ -186,6 +186,12 @@ pub trait Executor {
     where
         O: Split,
         F: Fn(usize, O) + Sync;
+
+    /// How many threads the executor's passes may run on at once: 1 when every pass runs on
+    /// the calling thread. What a kernel computes must not depend on it; a caller may use it
+    /// to choose between ways of computing the same thing (the grid's counting sort runs in
+    /// bands only with more than one thread).
+    fn threads(&self) -> usize;
 }
 
 /// The body of a run: everything that happens while a strategy's threads exist.

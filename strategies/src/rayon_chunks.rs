@@ -80,6 +80,10 @@ impl Executor for RayonChunksExecutor<'_> {
             });
         })
     }
+
+    fn threads(&self) -> usize {
+        self.pool.current_num_threads()
+    }
 }
 
 #[cfg(test)]

@@ -64,6 +64,10 @@ impl Executor for RayonIterExecutor<'_> {
             });
         })
     }
+
+    fn threads(&self) -> usize {
+        self.pool.current_num_threads()
+    }
 }
 
 /// Cuts `(first_index, out)` in two halves, unless it is a single element.

@@ -68,6 +68,10 @@ impl Executor for RayonSpawnExecutor<'_> {
             });
         })
     }
+
+    fn threads(&self) -> usize {
+        self.pool.current_num_threads()
+    }
 }
 
 #[cfg(test)]

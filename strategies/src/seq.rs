@@ -38,4 +38,8 @@ impl Executor for SeqExecutor {
         }
         panic::catch(|| kernel(0, out))
     }
+
+    fn threads(&self) -> usize {
+        1
+    }
 }

@@ -115,6 +115,10 @@ impl Executor for StdStaticExecutor {
             result
         })
     }
+
+    fn threads(&self) -> usize {
+        self.strategy.cores
+    }
 }
 
 #[cfg(test)]

@@ -31,7 +31,7 @@ use hits::{
     rank_sort, sort_small,
 };
 use keys::GridKey;
-use sort::CellSort;
+use sort::{CellSort, GridArrays};
 
 use super::list::written_zeros;
 use super::{Bounds, Neighbors, SumOrder, distance_squared};
@@ -114,7 +114,7 @@ impl<K, O> Grid<K, O> {
             sorted_x: written_zeros(n),
             sorted_y: written_zeros(n),
             cell_of: written_zeros(n),
-            sort: CellSort::new(n, cells),
+            sort: CellSort::new(n),
             marker: PhantomData,
         }
     }
@@ -131,6 +131,11 @@ impl<K, O> Grid<K, O> {
             sort: self.sort,
             marker: PhantomData,
         }
+    }
+
+    /// Bytes of the scratch a grid for `n` particles makes for its counting sort.
+    pub fn sort_scratch_bytes(n: usize) -> usize {
+        CellSort::bytes_for(n)
     }
 
     /// Bytes held by the grid's arrays (capacity): what `scene::memory::estimate` must
@@ -184,12 +189,30 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
     type Key = K;
     type Scratch = GridScratch;
 
-    /// Cell numbers (per particle), the counting sort (`CellSort`) and the gather of sorted
-    /// positions (per slot) run on the executor.
+    /// Cell numbers (per particle) and the gather of sorted positions (per slot) run on the
+    /// executor, and so does the counting sort from `sort::PARALLEL_SORT` particles on (in
+    /// bands, fused with the other two; see `sort`).
     fn rebuild<E: Executor>(&mut self, exec: &E, pos: Positions<'_>) -> Result<(), KernelPanic> {
         let n = pos.len();
         let shape = self.shape;
         self.cell_of.resize(n, 0);
+        self.order.resize(n, 0);
+        self.sorted_x.resize(n, 0.0);
+        self.sorted_y.resize(n, 0.0);
+        if CellSort::in_bands(n, exec.threads()) {
+            self.sort.fit(n);
+            return self.sort.run_in_bands(
+                exec,
+                shape,
+                pos,
+                GridArrays {
+                    cell_of: &mut self.cell_of,
+                    start: &mut self.start,
+                    order: &mut self.order,
+                    sorted: (&mut self.sorted_x, &mut self.sorted_y),
+                },
+            );
+        }
         exec.for_each_chunk(&mut self.cell_of[..], |first, cells| {
             let (xs, ys) = (
                 &pos.x[first..][..cells.len()],
@@ -199,11 +222,7 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
                 *c = shape.cell_of(x, y);
             }
         })?;
-        self.order.resize(n, 0);
-        self.sort
-            .run(exec, &self.cell_of, &mut self.start, &mut self.order)?;
-        self.sorted_x.resize(n, 0.0);
-        self.sorted_y.resize(n, 0.0);
+        CellSort::run(&self.cell_of, &mut self.start, &mut self.order);
         let order = &self.order;
         // One length for both, so that one bounds check covers both reads.
         let (px, py) = (&pos.x[..n], &pos.y[..n]);
