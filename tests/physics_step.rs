@@ -217,7 +217,7 @@ fn a_pair_at_exactly_the_kernel_radius_does_not_interact() {
 #[test]
 fn neighbours_taken_two_at_a_time_give_the_hand_computed_step_on_every_simd_path() {
     use bench_sph::simd::SimdPath;
-    // Particle 0 has four neighbours, one of them at its own point (r = 0: the pair in the
+    // Particle 0 has five neighbours, one of them at its own point (r = 0: the pair in the
     // same four lanes as another is left to the one-at-a-time code), and the others an odd or
     // even number; distances and velocities are not round numbers.
     let init = state(&[

@@ -5,7 +5,7 @@
 
 use sph_strategies::{Calls, Config, StrategyName};
 
-use crate::sph::neighbors::NeighborMode;
+use crate::sph::neighbors::{NeighborMode, PARALLEL_SORT};
 
 /// The most events one trace may record (kernel calls, plus two serial events per step):
 /// about 170 MB of `trace.json` at [`JSON_BYTES_PER_EVENT`], and 64 bytes an event in memory
@@ -39,7 +39,8 @@ pub struct Plan {
     pub steps: usize,
     /// The model's passes per step (3 for Müller's presets, 6 for `wcsph`).
     pub passes: usize,
-    /// Neighbour search: the grid's rebuild adds two kernel calls per step and chunk.
+    /// Neighbour search: the grid's rebuild adds two kernel calls per step and chunk, three
+    /// from [`PARALLEL_SORT`] particles on (counted whatever the cores: an upper bound).
     pub neighbors: NeighborMode,
 }
 
@@ -111,10 +112,12 @@ impl Plan {
             .unwrap_or_else(|| RAYON_ITER_LEAVES_PER_CORE.saturating_mul(self.cores).min(n))
     }
 
-    /// Passes that call kernels per step: the model's passes, and the grid rebuild's two.
+    /// Passes that call kernels per step: the model's passes, and the grid rebuild's two, or
+    /// three where it may sort in bands (see [`PARALLEL_SORT`]).
     pub fn kernel_passes_per_step(&self) -> usize {
         match self.neighbors {
             NeighborMode::AllPairs => self.passes,
+            NeighborMode::Grid if self.n >= PARALLEL_SORT => self.passes + 3,
             NeighborMode::Grid => self.passes + 2,
         }
     }

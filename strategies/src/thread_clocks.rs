@@ -15,22 +15,29 @@
 //! the session's thread adds them up ([`ThreadClocks::total`]): one system call per thread,
 //! made only when a window opens or closes. Threads outside the pool (the caller waiting for
 //! the session) are not counted, which is what the judgement asks about.
+//!
+//! Where those clocks cannot be read (another operating system, or a sandbox that refuses the
+//! clock ids), the pool falls back to the process's CPU time for the rest of the run, once,
+//! so that no window mixes the two.
 
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use nix::time::ClockId;
-use nix::unistd::gettid;
 
 /// Flags of a thread's CPU clock id in Linux's numbering (`include/linux/posix-timers.h`):
 /// `CPUCLOCK_PERTHREAD_MASK` (the id names a thread, not a process) and `CPUCLOCK_SCHED` (the
 /// scheduler's precise run time, not the tick-sampled user + system time).
+#[cfg(target_os = "linux")]
 const PER_THREAD_SCHED: i32 = 4 | 2;
 
 /// The CPU clocks of a fixed number of threads, each named by its thread once it has started.
 #[derive(Debug)]
 pub(crate) struct ThreadClocks {
     clocks: Vec<OnceLock<ClockId>>,
+    /// A clock could not be read: the process's CPU time is used from then on.
+    fallback: AtomicBool,
 }
 
 impl ThreadClocks {
@@ -38,6 +45,7 @@ impl ThreadClocks {
     pub(crate) fn new(threads: usize) -> Self {
         ThreadClocks {
             clocks: (0..threads).map(|_| OnceLock::new()).collect(),
+            fallback: AtomicBool::new(false),
         }
     }
 
@@ -45,25 +53,52 @@ impl ThreadClocks {
     /// an index counts; an index out of range is ignored).
     pub(crate) fn register(&self, index: usize) {
         if let Some(slot) = self.clocks.get(index) {
-            let _ = slot.set(clock_of(gettid().as_raw()));
+            let _ = slot.set(own_clock());
         }
     }
 
     /// The CPU time (user + system) the registered threads have used so far, up to date;
-    /// `None` while some thread has not registered yet, or if a clock cannot be read (a
-    /// thread that has exited).
+    /// `None` while some thread has not registered yet, and once when a clock cannot be read
+    /// (from then on, the process's CPU time, so that no window mixes the two).
     pub(crate) fn total(&self) -> Option<Duration> {
-        self.clocks.iter().try_fold(Duration::ZERO, |sum, slot| {
+        if self.clocks.iter().any(|slot| slot.get().is_none()) {
+            return None;
+        }
+        if self.fallback.load(Ordering::Relaxed) {
+            return process_cpu_time();
+        }
+        let total = self.clocks.iter().try_fold(Duration::ZERO, |sum, slot| {
             let t = slot.get()?.now().ok()?;
             let used = Duration::new(t.tv_sec().try_into().ok()?, t.tv_nsec().try_into().ok()?);
             Some(sum + used)
-        })
+        });
+        if total.is_none() {
+            self.fallback.store(true, Ordering::Relaxed);
+        }
+        total
     }
 }
 
-/// The CPU clock of the thread with id `tid`.
-fn clock_of(tid: i32) -> ClockId {
-    ClockId::from_raw(((!tid) << 3) | PER_THREAD_SCHED)
+/// The calling thread's CPU clock, as other threads of the process can read it: on Linux the
+/// id `pthread_getcpuclockid` gives, from the thread id.
+#[cfg(target_os = "linux")]
+fn own_clock() -> ClockId {
+    ClockId::from_raw(((!nix::unistd::gettid().as_raw()) << 3) | PER_THREAD_SCHED)
+}
+
+/// Elsewhere, an id that reads as unreadable, so that the process's CPU time is used.
+#[cfg(not(target_os = "linux"))]
+fn own_clock() -> ClockId {
+    ClockId::from_raw(-1)
+}
+
+/// CPU time (user + system) of the whole process so far, as the kernel accounted it.
+fn process_cpu_time() -> Option<Duration> {
+    use nix::sys::resource::{UsageWho, getrusage};
+    let usage = getrusage(UsageWho::RUSAGE_SELF).ok()?;
+    let secs =
+        |t: nix::sys::time::TimeVal| Duration::new(t.tv_sec() as u64, t.tv_usec() as u32 * 1000);
+    Some(secs(usage.user_time()) + secs(usage.system_time()))
 }
 
 #[cfg(test)]
@@ -99,6 +134,19 @@ mod tests {
             assert!(clocks.total().is_some());
             registered.wait();
         });
+    }
+
+    #[test]
+    fn a_clock_that_cannot_be_read_gives_way_to_the_process_cpu_time_for_good() {
+        let clocks = ThreadClocks::new(1);
+        clocks.clocks[0].set(ClockId::from_raw(-1)).unwrap(); // not a clock
+        assert_eq!(
+            clocks.total(),
+            None,
+            "the window that would mix the two is not opened"
+        );
+        let first = clocks.total().expect("the process's CPU time");
+        assert!(clocks.total().expect("still") >= first);
     }
 
     #[test]

@@ -11,7 +11,7 @@ pub mod list;
 
 pub use all_pairs::AllPairs;
 pub use grid::keys::{GridKeys, INDEX_KEYS_MAX_BYTES};
-pub use grid::{Grid, GridScratch, InCellOrder, InIndexOrder, VisitOrder};
+pub use grid::{Grid, GridScratch, InCellOrder, InIndexOrder, PARALLEL_SORT, VisitOrder};
 pub use list::{ListKey, ListWriter, NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS};
 
 use serde::Serialize;

@@ -31,6 +31,7 @@ use hits::{
     rank_sort, sort_small,
 };
 use keys::GridKey;
+pub use sort::PARALLEL_SORT;
 use sort::{CellSort, GridArrays};
 
 use super::list::written_zeros;

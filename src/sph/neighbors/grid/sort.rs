@@ -30,7 +30,7 @@ use super::Shape;
 use crate::sph::state::Positions;
 
 /// From this many particles on, the sort runs in bands on the executor.
-pub(super) const PARALLEL_SORT: usize = 1 << 16;
+pub const PARALLEL_SORT: usize = 1 << 16;
 
 /// Particles per block of steps 1 and 3.
 const BLOCK: usize = 1 << 14;
@@ -207,7 +207,9 @@ impl CellSort {
             let end = band_start[band + 1] as usize;
             let band_cells = ((band + 1) << shift).min(cells) - (band << shift);
             done += end - band_start[band] as usize + band_cells / CELLS_PER_PARTICLE;
-            if band + 1 < bands && done < (runs.len() + 1) * work / RUNS {
+            if band + 1 < bands
+                && (done as u64) < (runs.len() as u64 + 1) * work as u64 / RUNS as u64
+            {
                 continue;
             }
             let (first_cell, last_cell) = (from << shift, ((band + 1) << shift).min(cells));
