@@ -15,7 +15,7 @@ use common::{
 };
 
 const TRIAL_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
-    trial,wall_s,cpu_s,checksum,status,reason,foreign_cpu_s,steal_s,load1,pin";
+    trial,wall_s,cpu_s,checksum,status,reason,foreign_cpu_s,steal_s,load1,pin,passes_alone";
 const SUMMARY_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
     trials,mean_s,stddev_s,min_s,median_s,max_s,cpu_mean_s,speedup,efficiency,outliers,\
     oversubscribed,checksum,status,reason,mean_ci_low_s,mean_ci_high_s,speedup_ci_low,\

@@ -66,6 +66,7 @@ struct Meta<'a> {
     warmup_steps: usize,
     wall_s: f64,
     cpu_s: f64,
+    passes_alone: u64,
     kernel_calls: usize,
     worker_threads: usize,
     workers_used: usize,
@@ -119,6 +120,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
         warmup_steps: args.warmup,
         wall_s: run.elapsed.wall_s,
         cpu_s: run.elapsed.cpu_s,
+        passes_alone: run.elapsed.passes_alone,
         kernel_calls: stats.total.kernel_calls,
         worker_threads: stats.total.worker_threads,
         workers_used: stats.total.workers_used,
@@ -129,6 +131,10 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
     };
     write_files(&paths, &run, &stats, &meta)?;
     let removed = claimed.remove_stale(&paths)?;
+    let strategy = args.parallel.strategy.as_str();
+    if let Some(note) = super::simulate::alone_note(meta.passes_alone, strategy, cores) {
+        console::warn(&format!("warning: {note}"));
+    }
 
     let mut lines = summary(&config, args.warmup, &stats, run.elapsed.wall_s);
     if args.compare.is_some() {

@@ -198,6 +198,7 @@ mod tests {
                     steal_s: None,
                     load1: None,
                     pin: r.pin,
+                    passes_alone: None,
                 })
             })
             .collect();

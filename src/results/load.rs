@@ -184,7 +184,11 @@ pub fn read_summary(path: &Path) -> anyhow::Result<(Vec<SummaryRow>, Vec<String>
 /// Reads a `trials.csv` (this version's columns or the first release's), as
 /// [`read_summary`].
 pub fn read_trials(path: &Path) -> anyhow::Result<(Vec<TrialRow>, Vec<String>)> {
-    let widths = [LEGACY_TRIAL_COLUMNS, EARLIER_TRIAL_WIDTHS[0]];
+    let widths = [
+        LEGACY_TRIAL_COLUMNS,
+        EARLIER_TRIAL_WIDTHS[0],
+        EARLIER_TRIAL_WIDTHS[1],
+    ];
     read_csv(path, &TRIAL_COLUMNS, &widths, "trial")
 }
 

@@ -11,10 +11,13 @@
 //! keep working): per trial `foreign_cpu_s, steal_s, load1` ([`crate::contention`]); per cell
 //! the 95 % bootstrap intervals `mean_ci_low_s, mean_ci_high_s, speedup_ci_low,
 //! speedup_ci_high` ([`crate::sweep::bootstrap`]), `foreign_cpu_mean_s` and `contended` (some trial
-//! saw more foreign CPU than [`crate::contention::Threshold::allowed_s`]), then
+//! saw more foreign CPU than [`crate::contention::Threshold::allowed_s`] or ran passes alone),
+//! then
 //! `reference_shard`: in a shard of a sharded sweep (`sweep --shard I/K`) and in a merge of
 //! shards, the shard I whose `seq` cell is the row's speedup denominator, which is the shard
-//! that measured the row; empty in an unsharded sweep.
+//! that measured the row; empty in an unsharded sweep; then `pin` (both files) and `smt`
+//! (summary) of `--pin`; then per trial `passes_alone`
+//! ([`Executor::passes_alone`](sph_strategies::Executor::passes_alone)).
 
 use serde::{Deserialize, Serialize};
 use sph_strategies::StrategyName;
@@ -25,7 +28,7 @@ use crate::sph::params::Preset;
 use crate::topology::Pin;
 
 /// The columns of `trials.csv`, in order.
-pub const TRIAL_COLUMNS: [&str; 18] = [
+pub const TRIAL_COLUMNS: [&str; 19] = [
     "strategy",
     "neighbors",
     "preset",
@@ -44,6 +47,7 @@ pub const TRIAL_COLUMNS: [&str; 18] = [
     "steal_s",
     "load1",
     "pin",
+    "passes_alone",
 ];
 
 /// The columns of `summary.csv`, in order.
@@ -90,8 +94,9 @@ pub const LEGACY_SUMMARY_COLUMNS: usize = 22;
 /// `reference_shard` (28) and before `pin` and `smt` (29). Read as they are (the missing
 /// columns empty), and upgraded to every column by `--resume`.
 pub const EARLIER_SUMMARY_WIDTHS: [usize; 2] = [28, 29];
-/// The width of `trials.csv` before `pin` (17): read as it is, upgraded by `--resume`.
-pub const EARLIER_TRIAL_WIDTHS: [usize; 1] = [17];
+/// The widths of `trials.csv` before `pin` (17) and before `passes_alone` (18): read as they
+/// are (the missing columns empty), upgraded by `--resume`.
+pub const EARLIER_TRIAL_WIDTHS: [usize; 2] = [17, 18];
 
 /// Whether a cell's numbers can be used.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -150,6 +155,11 @@ pub struct TrialRow {
     /// files written before `--pin`, read as `none`).
     #[serde(default, deserialize_with = "pin_or_none")]
     pub pin: Pin,
+    /// Passes the strategy ran on one thread although it had more (`crossbeam-pool` on cores
+    /// it found shared: the trial's time is then not a time on its cores); 0 for every other
+    /// strategy, empty in files written before this column.
+    #[serde(default)]
+    pub passes_alone: Option<u64>,
 }
 
 /// One row of `summary.csv`: one cell. Its first columns repeat [`TrialRow`]'s cell key on
@@ -218,7 +228,8 @@ pub struct SummaryRow {
     /// Mean foreign CPU seconds per trial.
     #[serde(default)]
     pub foreign_cpu_mean_s: Option<f64>,
-    /// Whether some trial saw more foreign CPU than the threshold (empty where unknown).
+    /// Whether some trial saw more foreign CPU than the threshold or ran passes alone
+    /// ([`TrialRow::passes_alone`]); empty where neither is known.
     #[serde(default)]
     pub contended: Option<bool>,
     /// The shard (1-based) whose `seq` cell is this row's speedup denominator: the shard that

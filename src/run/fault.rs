@@ -53,4 +53,8 @@ impl<E: Executor> Executor for Faulty<'_, E> {
     fn threads(&self) -> usize {
         self.inner.threads()
     }
+
+    fn passes_alone(&self) -> u64 {
+        self.inner.passes_alone()
+    }
 }

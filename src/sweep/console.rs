@@ -165,7 +165,7 @@ pub fn cell_line(position: usize, total: usize, cell: &Cell, row: &SummaryRow) -
         line.push_str("  (oversubscribed)");
     }
     if row.contended == Some(true) {
-        line.push_str("  (CONTENDED: other work used the machine)");
+        line.push_str("  (CONTENDED: other work used the machine, or passes ran alone)");
     }
     line
 }
@@ -189,8 +189,10 @@ pub fn contended_cells(rows: &[SummaryRow]) -> Option<String> {
         return None;
     }
     let mut text = format!(
-        "warning: {} saw other work on the machine (contended=true in summary.csv); \
-         their times are not trustworthy and the report leaves them out of its findings:",
+        "warning: {} saw other work on the machine or ran passes on one thread because their \
+         threads got less than their cores (contended=true in summary.csv; passes_alone in \
+         trials.csv); their times are not trustworthy and the report leaves them out of its \
+         findings:",
         plural(names.len(), "cell", "cells")
     );
     for name in names {
@@ -319,6 +321,7 @@ mod tests {
             .iter()
             .map(|&w| Measured {
                 elapsed: Elapsed {
+                    passes_alone: 0,
                     wall_s: w,
                     cpu_s: w,
                     foreign: None,

@@ -86,6 +86,7 @@ mod tests {
             .iter()
             .map(|&(wall_s, cpu_s)| Measured {
                 elapsed: Elapsed {
+                    passes_alone: 0,
                     wall_s,
                     cpu_s,
                     foreign: Some(Foreign {
@@ -131,8 +132,8 @@ mod tests {
             String::from_utf8(t).unwrap(),
             format!(
                 "{}\n\
-                 rayon-chunks,grid,seed,60,3,2,5,12,1,0.5,1.0,0123456789abcdef,ok,,0.01,0.0,0.5,none\n\
-                 rayon-chunks,grid,seed,60,3,2,5,12,2,0.25,0.5,0123456789abcdef,ok,,0.01,0.0,0.5,none\n",
+                 rayon-chunks,grid,seed,60,3,2,5,12,1,0.5,1.0,0123456789abcdef,ok,,0.01,0.0,0.5,none,0\n\
+                 rayon-chunks,grid,seed,60,3,2,5,12,2,0.25,0.5,0123456789abcdef,ok,,0.01,0.0,0.5,none,0\n",
                 TRIAL_COLUMNS.join(",")
             )
         );

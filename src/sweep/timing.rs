@@ -140,6 +140,7 @@ mod tests {
 
     const MEASURED: Trial = Trial {
         elapsed: Elapsed {
+            passes_alone: 0,
             wall_s: 9.0,
             cpu_s: 9.0,
             foreign: None,

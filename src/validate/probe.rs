@@ -115,6 +115,7 @@ impl Probe {
             next: 1,
             samples: Vec::new(),
             elapsed: Elapsed {
+                passes_alone: 0,
                 wall_s: 0.0,
                 cpu_s: 0.0,
                 foreign: None,

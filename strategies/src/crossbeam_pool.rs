@@ -222,6 +222,10 @@ impl Executor for PoolExecutor<'_> {
     fn threads(&self) -> usize {
         self.threads
     }
+
+    fn passes_alone(&self) -> u64 {
+        self.degrade.borrow().solo_total()
+    }
 }
 
 #[cfg(test)]
@@ -241,6 +245,33 @@ mod tests {
         let all: Vec<_> = passes.concat();
         assert!(distinct(&all) <= 3, "{passes:?}");
         assert!(!all.contains(&std::thread::current().id()));
+    }
+
+    #[test]
+    fn passes_run_alone_are_counted_and_run_on_the_calling_thread() {
+        // No worker serves the board: a pass that asked for help would wait forever, so
+        // finishing shows every pass ran alone (the degraded state lasts exactly 3 passes).
+        let (board, clocks) = (JobBoard::new(), ThreadClocks::new(2));
+        let executor = PoolExecutor {
+            board: &board,
+            clocks: &clocks,
+            threads: 2,
+            chunks: 4,
+            degrade: RefCell::new(Degrade::alone_for(3)),
+            not_sync: PhantomData,
+        };
+        assert_eq!(executor.passes_alone(), 0);
+        let caller = std::thread::current().id();
+        for pass in 1..=3 {
+            let mut out = [None; 16];
+            executor
+                .for_each_chunk(&mut out[..], |_, chunk| {
+                    chunk.fill(Some(std::thread::current().id()));
+                })
+                .unwrap();
+            assert!(out.iter().all(|&t| t == Some(caller)), "pass {pass}");
+            assert_eq!(executor.passes_alone(), pass);
+        }
     }
 
     #[test]

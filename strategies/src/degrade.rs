@@ -192,9 +192,18 @@ impl Degrade {
     }
 
     /// Passes run alone so far.
-    #[cfg(test)]
     pub(crate) fn solo_total(&self) -> u64 {
         self.solo_total
+    }
+
+    /// A state in which the next `passes` passes run alone (tests of the pool).
+    #[cfg(test)]
+    pub(crate) fn alone_for(passes: u32) -> Degrade {
+        Degrade {
+            left: passes,
+            span: passes,
+            ..Degrade::new(2, 2)
+        }
     }
 }
 

@@ -192,6 +192,12 @@ pub trait Executor {
     /// to choose between ways of computing the same thing (the grid's counting sort runs in
     /// bands only with more than one thread).
     fn threads(&self) -> usize;
+
+    /// How many of its passes so far this executor ran on the calling thread alone although
+    /// it has more threads: `crossbeam-pool`, when it finds its threads short of cores, runs
+    /// passes alone for a while (see `degrade`). 0 for every other executor; a wrapper forwards
+    /// its inner executor's count. A run whose passes ran alone did not measure its cores.
+    fn passes_alone(&self) -> u64;
 }
 
 /// The body of a run: everything that happens while a strategy's threads exist.

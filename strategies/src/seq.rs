@@ -42,4 +42,8 @@ impl Executor for SeqExecutor {
     fn threads(&self) -> usize {
         1
     }
+
+    fn passes_alone(&self) -> u64 {
+        0
+    }
 }

@@ -119,6 +119,10 @@ impl Executor for StdStaticExecutor {
     fn threads(&self) -> usize {
         self.strategy.cores
     }
+
+    fn passes_alone(&self) -> u64 {
+        0
+    }
 }
 
 #[cfg(test)]
