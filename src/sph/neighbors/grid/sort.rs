@@ -112,25 +112,9 @@ impl CellSort {
     /// particle indices sorted by cell and, within a cell, by index, and `start`, where cell c's
     /// particles are `order[start[c]..start[c + 1]]` (so `start[cells] = n`). On this thread.
     pub(super) fn run(cell_of: &[u32], start: &mut [u32], order: &mut [u32]) {
-        start.fill(0);
         let cells = start.len() - 1;
-        for &c in cell_of {
-            start[c as usize] += 1;
-        }
-        // Inclusive prefix sums: start[c] is now where cell c ends.
-        let mut sum = 0;
-        for s in &mut start[..cells] {
-            sum += *s;
-            *s = sum;
-        }
-        start[cells] = sum;
-        // Scatter from the last particle down, filling each cell from its end: each cell keeps
-        // its particles in increasing index, and start[c] ends up where cell c begins.
-        for (i, &c) in cell_of.iter().enumerate().rev() {
-            let slot = &mut start[c as usize];
-            *slot -= 1;
-            order[*slot as usize] = i as u32;
-        }
+        let particles = (0..cell_of.len() as u32).zip(cell_of.iter().copied());
+        start[cells] = counting_sort(particles, &mut start[..cells], 0, order);
     }
 
     /// Computes each particle's cell (`cell_of`), the sort of [`CellSort::run`] (`start`,
@@ -238,6 +222,38 @@ impl CellSort {
     }
 }
 
+/// The stable counting sort that the serial sort and each run of bands do: `particles` (index
+/// and cell, in increasing index; read twice) by cell into `order`, which holds places `base..`
+/// of the whole order (cells numbered from the first of `start`). Writes
+/// `start[c]`, where cell c's particles begin (`base` plus the particles of the cells before
+/// it), and returns where the last cell ends.
+#[inline(always)]
+fn counting_sort(
+    particles: impl DoubleEndedIterator<Item = (u32, u32)> + Clone,
+    start: &mut [u32],
+    base: u32,
+    order: &mut [u32],
+) -> u32 {
+    start.fill(0);
+    for (_, c) in particles.clone() {
+        start[c as usize] += 1;
+    }
+    // Inclusive prefix sums: start[c] is now where cell c ends.
+    let mut sum = base;
+    for s in start.iter_mut() {
+        sum += *s;
+        *s = sum;
+    }
+    // Scatter from the last particle down, filling each cell from its end: each cell keeps its
+    // particles in increasing index, and start[c] ends up where cell c begins.
+    for (i, c) in particles.rev() {
+        let slot = &mut start[c as usize];
+        *slot -= 1;
+        order[(*slot - base) as usize] = i;
+    }
+    sum
+}
+
 /// The grid's arrays that a sort in bands writes (see [`CellSort::run_in_bands`]).
 pub(super) struct GridArrays<'a> {
     /// Each particle's cell.
@@ -269,23 +285,13 @@ impl BandRun<'_> {
     /// by cell, as [`CellSort::run`] does, then the gather of their positions.
     fn sort(&mut self, cell_of: &[u32], by_band: &[AtomicU32], pos: Positions<'_>) {
         let (first_cell, begin) = (self.first_cell, self.begin);
-        let mine = &by_band[begin as usize..][..self.order.len()];
-        let cell = |i: u32| (cell_of[i as usize] - first_cell) as usize;
-        self.start.fill(0);
-        for i in mine {
-            self.start[cell(i.load(Ordering::Relaxed))] += 1;
-        }
-        let mut sum = begin;
-        for s in self.start.iter_mut() {
-            sum += *s;
-            *s = sum;
-        }
-        for i in mine.iter().rev() {
-            let i = i.load(Ordering::Relaxed);
-            let slot = &mut self.start[cell(i)];
-            *slot -= 1;
-            self.order[(*slot - begin) as usize] = i;
-        }
+        let mine = by_band[begin as usize..][..self.order.len()]
+            .iter()
+            .map(|i| {
+                let i = i.load(Ordering::Relaxed);
+                (i, cell_of[i as usize] - first_cell)
+            });
+        counting_sort(mine, self.start, begin, self.order);
         let (xs, ys) = (&mut *self.sorted.0, &mut *self.sorted.1);
         for ((x, y), &j) in xs.iter_mut().zip(ys.iter_mut()).zip(self.order.iter()) {
             (*x, *y) = (pos.x[j as usize], pos.y[j as usize]);
