@@ -80,6 +80,8 @@ struct Meta<'a> {
 struct Comparison {
     untraced: Vec<f64>,
     traced: Vec<f64>,
+    /// Passes run alone over all the compared runs.
+    alone: u64,
 }
 
 /// Runs `trace`: checks the trace's size and claims `--out` before anything runs, then
@@ -207,6 +209,7 @@ fn record(
     let mut comparison = Comparison {
         untraced: Vec::new(),
         traced: Vec::new(),
+        alone: 0,
     };
     let mut last = None;
     for _ in 0..args.compare.unwrap_or(0) {
@@ -222,6 +225,7 @@ fn record(
         let mut sim = fresh();
         let run = traced(&mut sim)?;
         comparison.traced.push(run.elapsed.wall_s);
+        comparison.alone += elapsed.passes_alone + run.elapsed.passes_alone;
         anyhow::ensure!(
             checksum_hex(&sim.state) == checksum_hex(&plain.state),
             "the traced run's final state differs from the untraced run's (a bug)"
@@ -382,7 +386,7 @@ fn comparison_lines(c: &Comparison, stats: &Stats, cost_ns: f64) -> Vec<String> 
     let (tmin, tmed) = min_median(&c.traced);
     let calls = stats.total.kernel_calls as f64;
     let added_s = calls * cost_ns * 1e-9 / stats.workers.len().max(1) as f64;
-    vec![
+    let mut lines = vec![
         format!(
             "compare ({} runs each, alternating): untraced min {:.4} s median {:.4} s; \
              traced min {:.4} s median {:.4} s; overhead {:+.1} % (min), {:+.1} % (median)",
@@ -402,5 +406,13 @@ fn comparison_lines(c: &Comparison, stats: &Stats, cost_ns: f64) -> Vec<String> 
             added_s * 1e3,
             100.0 * added_s / umin
         ),
-    ]
+    ];
+    if c.alone > 0 {
+        lines.push(format!(
+            "warning: the compared runs ran {} on one thread (their threads got less than their \
+             cores): the overhead above compares times that are not times on their cores",
+            console::plural(c.alone as usize, "pass", "passes")
+        ));
+    }
+    lines
 }

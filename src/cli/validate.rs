@@ -44,6 +44,11 @@ pub fn run(args: &ValidateArgs) -> anyhow::Result<()> {
     let v = validate::validate(args.resolution, args.parallel.strategy, &config)?;
     write_files(&paths, &v)?;
     claimed.remove_stale(&paths)?;
+    let info = args.parallel.strategy.info();
+    let cores = info.effective_cores(config.cores);
+    if let Some(note) = super::simulate::alone_note(v.elapsed.passes_alone, info.name, cores) {
+        crate::output::console::warn(&format!("warning: {note}"));
+    }
 
     if args.json {
         let text = serde_json::to_string(&summary::Json::of(&v))?;

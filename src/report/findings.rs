@@ -3,7 +3,8 @@
 //! - A strategy is called **fastest** at a core count only when its 95 % interval of the mean
 //!   does not overlap any other strategy's; otherwise the strategies whose intervals overlap
 //!   the fastest mean's are named as **indistinguishable within the trial spread**.
-//! - Contended cells (other work used the machine) enter no finding; the sentence says how
+//! - Contended cells (other work used the machine, or passes ran alone) enter no finding; the
+//!   sentence says how
 //!   many were left out.
 //! - A speedup above 1 at one core is labelled noise in the reference, never a win.
 //! - The Karp–Flatt serial fraction is given only where the speedup is above 1 on at least 2

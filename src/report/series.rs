@@ -157,7 +157,8 @@ pub struct Point {
     pub hi: f64,
     /// Whether the cell used more threads than the machine has.
     pub oversubscribed: bool,
-    /// Whether other work used the machine while the cell was measured.
+    /// Whether other work used the machine while the cell was measured (or a trial ran
+    /// passes alone: its threads got less than its cores).
     pub contended: bool,
 }
 

@@ -157,6 +157,10 @@ pub struct Statistics {
     pub bootstrap_seed: u64,
     /// Share of the machine's capacity other work may take before a trial is contended.
     pub contended_share: f64,
+    /// Whether a trial that ran passes alone (`passes_alone` > 0) is contended too (false in
+    /// sweeps written before that rule).
+    #[serde(default)]
+    pub contended_when_passes_alone: bool,
 }
 
 impl Statistics {
@@ -167,6 +171,7 @@ impl Statistics {
             confidence: CONFIDENCE,
             bootstrap_seed: seed,
             contended_share: crate::contention::CONTENDED_SHARE,
+            contended_when_passes_alone: true,
         }
     }
 }

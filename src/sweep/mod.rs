@@ -519,7 +519,8 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
     if repaired.upgraded {
         print(&format!(
             "Upgraded '{}': its CSV files were written by an earlier version; the columns it \
-             lacked (reference_shard, pin, smt) are appended, empty (pin empty = none)",
+             lacked (of reference_shard, pin, smt; passes_alone in trials.csv) are appended, \
+             empty (pin empty = none, passes_alone empty = unknown)",
             dir.display()
         ));
     }

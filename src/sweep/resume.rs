@@ -58,7 +58,8 @@ pub struct Repaired {
     /// Summary rows (or broken lines) dropped from `summary.csv`.
     pub dropped_summary_rows: usize,
     /// Whether a file had the columns of an earlier version (`reference_shard`, `pin` or `smt`
-    /// missing): its repaired contents have every column, those empty (the upgrade).
+    /// of `summary.csv`, `pin` or `passes_alone` of `trials.csv` missing): its repaired contents
+    /// have every column, those empty (the upgrade).
     pub upgraded: bool,
 }
 

@@ -150,6 +150,7 @@ impl Observer for Probe {
     fn segment(&mut self, sim: &Simulation, elapsed: Elapsed) -> ControlFlow<()> {
         self.elapsed.wall_s += elapsed.wall_s;
         self.elapsed.cpu_s += elapsed.cpu_s;
+        self.elapsed.passes_alone += elapsed.passes_alone;
         self.observe(sim);
         ControlFlow::Continue(())
     }

@@ -248,9 +248,10 @@ mod tests {
     }
 
     #[test]
-    fn passes_run_alone_are_counted_and_run_on_the_calling_thread() {
-        // No worker serves the board: a pass that asked for help would wait forever, so
-        // finishing shows every pass ran alone (the degraded state lasts exactly 3 passes).
+    fn passes_run_alone_are_counted_and_leave_the_workers_idle() {
+        // One worker serves the board: a pass that asked for help would give it chunks (each
+        // takes a millisecond); a pass run alone gives it none. The degraded state lasts 3
+        // passes.
         let (board, clocks) = (JobBoard::new(), ThreadClocks::new(2));
         let executor = PoolExecutor {
             board: &board,
@@ -260,18 +261,32 @@ mod tests {
             degrade: RefCell::new(Degrade::alone_for(3)),
             not_sync: PhantomData,
         };
-        assert_eq!(executor.passes_alone(), 0);
         let caller = std::thread::current().id();
-        for pass in 1..=3 {
+        let pass = || {
             let mut out = [None; 16];
             executor
                 .for_each_chunk(&mut out[..], |_, chunk| {
+                    std::thread::sleep(std::time::Duration::from_millis(1));
                     chunk.fill(Some(std::thread::current().id()));
                 })
                 .unwrap();
-            assert!(out.iter().all(|&t| t == Some(caller)), "pass {pass}");
-            assert_eq!(executor.passes_alone(), pass);
-        }
+            out
+        };
+        std::thread::scope(|s| {
+            let _stop = ShutDownOnDrop(&board);
+            s.spawn(|| board.serve());
+            assert_eq!(executor.passes_alone(), 0);
+            for k in 1..=3 {
+                assert!(pass().iter().all(|&t| t == Some(caller)), "pass {k}");
+                assert_eq!(executor.passes_alone(), k);
+            }
+            pass();
+            assert_eq!(
+                executor.passes_alone(),
+                3,
+                "a pass with help is not counted"
+            );
+        });
     }
 
     #[test]

@@ -222,7 +222,7 @@ pub enum Mark {
     Dashed(RGBColor),
     /// A hollow dot (oversubscribed).
     Hollow(RGBColor),
-    /// A red ring (contended: other work used the machine).
+    /// A red ring (contended: other work used the machine, or passes ran alone).
     Ring,
     /// A large cross (a line's minimum).
     Cross(RGBColor),
@@ -264,7 +264,7 @@ pub fn oversubscribed_entry(lines: &[Line]) -> Vec<LegendEntry> {
     }
     if lines.iter().any(|l| l.points.iter().any(|p| p.contended)) {
         out.push(LegendEntry::new(
-            "contended: other work used\nthe machine (untrustworthy)",
+            "contended: other work or\ntoo few cores (untrustworthy)",
             Mark::Ring,
         ));
     }
