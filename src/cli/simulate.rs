@@ -161,10 +161,15 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         simd: sim.simd(),
         pin: args.parallel.pin,
     };
-    if let Some(note) = alone_note(report.passes_alone, &report.strategy, report.cores) {
+    warn_if_alone(report.passes_alone, &report.strategy, report.cores);
+    print_report(&report, args.json)
+}
+
+/// Warns on standard error when a run's strategy ran `passes` passes alone ([`alone_note`]).
+pub(crate) fn warn_if_alone(passes: u64, strategy: &str, cores: usize) {
+    if let Some(note) = alone_note(passes, strategy, cores) {
         console::warn(&format!("warning: {note}"));
     }
-    print_report(&report, args.json)
 }
 
 /// What a run whose strategy ran `passes` passes on one thread must say with its time: that

@@ -133,10 +133,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
     };
     write_files(&paths, &run, &stats, &meta)?;
     let removed = claimed.remove_stale(&paths)?;
-    let strategy = args.parallel.strategy.as_str();
-    if let Some(note) = super::simulate::alone_note(meta.passes_alone, strategy, cores) {
-        console::warn(&format!("warning: {note}"));
-    }
+    super::simulate::warn_if_alone(meta.passes_alone, args.parallel.strategy.as_str(), cores);
 
     let mut lines = summary(&config, args.warmup, &stats, run.elapsed.wall_s);
     if args.compare.is_some() {

@@ -46,9 +46,7 @@ pub fn run(args: &ValidateArgs) -> anyhow::Result<()> {
     claimed.remove_stale(&paths)?;
     let info = args.parallel.strategy.info();
     let cores = info.effective_cores(config.cores);
-    if let Some(note) = super::simulate::alone_note(v.elapsed.passes_alone, info.name, cores) {
-        crate::output::console::warn(&format!("warning: {note}"));
-    }
+    super::simulate::warn_if_alone(v.elapsed.passes_alone, info.name, cores);
 
     if args.json {
         let text = serde_json::to_string(&summary::Json::of(&v))?;

@@ -180,7 +180,8 @@ fn contended_banner(md: &mut String, rows: &[SummaryRow]) {
             md,
             "> ⚠ **{} contended**: other work used more than {} % of the machine while {} \
              measured, or `crossbeam-pool` found its threads short of cores and ran passes on \
-             one thread (`passes_alone` in `trials.csv`), so {} not trustworthy. They are marked {CONTENDED} in the tables and \
+             one thread (`passes_alone` in `trials.csv`), so {} not trustworthy. They are marked \
+             {CONTENDED} in the tables and \
              ringed in red in the charts, and left out of every finding. Measure again on a \
              quiet machine.\n",
             crate::output::console::plural(contended.len(), "cell was", "cells were"),

@@ -1,8 +1,8 @@
 //! How a cell's measurements become its rows of `trials.csv` and `summary.csv`
 //! ([`crate::results::rows`]): the statistics, the speedup over the group's `seq`, the
 //! bootstrap intervals ([`super::bootstrap`]) and the contention flag (some trial saw more
-//! foreign CPU than [`Threshold::allowed_s`], or ran passes alone). A failed cell's summary carries no statistic,
-//! speedup or efficiency: a bug must never become a number.
+//! foreign CPU than [`Threshold::allowed_s`], or ran passes alone). A failed cell's summary
+//! carries no statistic, speedup or efficiency: a bug must never become a number.
 
 use super::bootstrap;
 use crate::clock::Elapsed;

@@ -54,7 +54,8 @@ pub fn render(input: &Input<'_>) -> String {
          best cell over every cores value) and whether the 95 % intervals tell it from the \
          next fastest; then, per strategy, its best speedup and efficiency against cores, one \
          line per machine, each cores value's best cell. Contended cells (other work used the \
-         machine, or passes ran alone) are used only where a strategy has nothing else, and are flagged.\n"
+         machine, or passes ran alone) are used only where a strategy has nothing else, and are \
+         flagged.\n"
     );
     if input.plan.compared.is_empty() {
         let _ = writeln!(
