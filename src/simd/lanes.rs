@@ -13,6 +13,32 @@ pub struct Near8 {
     pub r2: [f64; 8],
 }
 
+/// Eight candidates of a grid's row, for [`Lanes::hits8`].
+#[derive(Debug, Clone, Copy)]
+pub struct Row8<'a> {
+    /// Their x.
+    pub xs: &'a [f64; 8],
+    /// Their y.
+    pub ys: &'a [f64; 8],
+    /// Their indices.
+    pub order: &'a [u32; 8],
+    /// The position of the first among the particle's candidates (the others follow).
+    pub first: u32,
+}
+
+/// Eight candidates' hits ([`Lanes::hits8`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Hits8 {
+    /// Every candidate's squared distance, as [`Near8::r2`].
+    pub r2: [f64; 8],
+    /// The hits `(j << 32) | position` in candidate order, in the first `count` places.
+    pub hits: [u64; 8],
+    /// The hits' squared distances, in the first `count` places.
+    pub hit_r2: [f64; 8],
+    /// The number of hits.
+    pub count: usize,
+}
+
 /// One path's instructions.
 pub trait Lanes: Copy + Send + Sync + Quad {
     /// Runs `f` compiled with this path's instructions enabled: code inlined into `f` (mark
@@ -22,6 +48,33 @@ pub trait Lanes: Copy + Send + Sync + Quad {
 
     /// The squared distances from `(xi, yi)` to eight candidates and which are below `hsq`.
     fn near8(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8;
+
+    /// Whether [`Lanes::hits8`] packs the hits in registers (AVX-512's compress), so that a
+    /// grid scans its candidates eight at a time; without it the grid tests them one by one.
+    const PACKS_HITS: bool = false;
+
+    /// Of the eight candidates of `row`, those whose bit is set in `lanes` tested against
+    /// `hsq` from `(xi, yi)`: every squared distance (as [`Lanes::near8`]), and the hits (those
+    /// below) packed at the front in candidate order, a hit `(j << 32) | position`.
+    #[inline(always)]
+    fn hits8(self, (xi, yi): (f64, f64), row: Row8<'_>, lanes: u8, hsq: f64) -> Hits8 {
+        let near = self.near8(xi, yi, row.xs, row.ys, hsq);
+        let mut found = Hits8 {
+            r2: near.r2,
+            hits: [0; 8],
+            hit_r2: [0.0; 8],
+            count: 0,
+        };
+        for (k, &j) in row.order.iter().enumerate() {
+            if near.mask & lanes & (1 << k) != 0 {
+                found.hits[found.count] =
+                    (u64::from(j) << 32) | u64::from(row.first.wrapping_add(k as u32));
+                found.hit_r2[found.count] = near.r2[k];
+                found.count += 1;
+            }
+        }
+        found
+    }
 }
 
 /// The compiled target's own instructions: a plain loop the compiler vectorises as it can.
@@ -53,15 +106,15 @@ pub use x86::{Avx2, Avx512};
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use pulp::x86::{V3, V4};
-    use pulp::{cast, f64x4, f64x8};
+    use pulp::{cast, f64x4, f64x8, u32x8, u64x8};
 
-    use super::{Lanes, Near8};
+    use super::{Hits8, Lanes, Near8, Row8};
 
     /// A path's lanes type around its `pulp` token: detection, `vectorize`, and `near8` as
     /// one call with the features on (inside a vectorised pass it inlines to nothing; called
     /// from elsewhere it is one call, not a call per instruction).
     macro_rules! lanes_of {
-        ($(#[$doc:meta])* $name:ident($token:ident), $detect_doc:literal) => {
+        ($(#[$doc:meta])* $name:ident($token:ident), $detect_doc:literal, $($packs:tt)*) => {
             $(#[$doc])*
             #[derive(Debug, Clone, Copy)]
             pub struct $name($token);
@@ -86,6 +139,8 @@ mod x86 {
                         || self.near8_inline(xi, yi, xs, ys, hsq),
                     )
                 }
+
+                $($packs)*
             }
         };
     }
@@ -93,13 +148,22 @@ mod x86 {
     lanes_of!(
         /// AVX2: two 4-lane halves, each compare turned into four mask bits.
         Avx2(V3),
-        "The lanes, if this CPU has AVX2 (and the rest of x86-64-v3)."
+        "The lanes, if this CPU has AVX2 (and the rest of x86-64-v3).",
     );
 
     lanes_of!(
         /// AVX-512: one 8-lane compare straight into a mask register.
         Avx512(V4),
-        "The lanes, if this CPU has AVX-512 F/BW/CD/DQ/VL (x86-64-v4)."
+        "The lanes, if this CPU has AVX-512 F/BW/CD/DQ/VL (x86-64-v4).",
+        const PACKS_HITS: bool = true;
+
+        #[inline(always)]
+        fn hits8(self, me: (f64, f64), row: Row8<'_>, lanes: u8, hsq: f64) -> Hits8 {
+            self.vectorize(
+                #[inline(always)]
+                || self.hits8_inline(me, row, lanes, hsq),
+            )
+        }
     );
 
     impl Avx2 {
@@ -155,6 +219,33 @@ mod x86 {
                 r2: cast::<f64x8, [f64; 8]>(r2),
             }
         }
+
+        /// [`Lanes::hits8`]: one compare into a mask, the hits packed by `vpcompressq`.
+        #[inline(always)]
+        fn hits8_inline(self, (xi, yi): (f64, f64), row: Row8<'_>, lanes: u8, hsq: f64) -> Hits8 {
+            let v = self.0;
+            let near = self.near8_inline(xi, yi, row.xs, row.ys, hsq);
+            let mask = near.mask & lanes;
+            let j = v
+                .avx512f
+                ._mm512_cvtepu32_epi64(cast(cast::<[u32; 8], u32x8>(*row.order)));
+            // Positions wrap in 32 bits, as the scalar `t0.wrapping_add(k)`.
+            let positions =
+                v.wrapping_add_u32x8(v.splat_u32x8(row.first), cast([0_u32, 1, 2, 3, 4, 5, 6, 7]));
+            let keys = v.avx512f._mm512_or_si512(
+                v.avx512f._mm512_slli_epi64::<32>(j),
+                v.avx512f._mm512_cvtepu32_epi64(cast(positions)),
+            );
+            let hits: u64x8 = cast(v.avx512f._mm512_maskz_compress_epi64(mask, keys));
+            let r2: f64x8 = cast(near.r2);
+            let hit_r2: f64x8 = cast(v.avx512f._mm512_maskz_compress_pd(mask, cast(r2)));
+            Hits8 {
+                r2: near.r2,
+                hits: cast(hits),
+                hit_r2: cast(hit_r2),
+                count: mask.count_ones() as usize,
+            }
+        }
     }
 }
 
@@ -188,6 +279,51 @@ mod tests {
                 11.3137084989848,
             ],
         )
+    }
+
+    #[test]
+    fn every_available_path_packs_the_portable_hits() {
+        let (xs, ys) = awkward();
+        let order = [7, 3, 90, 1, 4_000_000_000, 5, 0, 12];
+        // Positions from 0 and from just below the wrap of 32 bits (the packed scan's first
+        // lanes can lie before its row), every lane, a run's tail, its head, none.
+        for t0 in [0, 40, u32::MAX - 2] {
+            for keep in [u8::MAX, 0b0000_0111, 0b1111_1000, 0b0101_0110, 0] {
+                let row = Row8 {
+                    xs: &xs,
+                    ys: &ys,
+                    order: &order,
+                    first: t0,
+                };
+                let want = Portable.hits8((0.0, 0.0), row, keep, 256.0);
+                let near = Portable.near8(0.0, 0.0, &xs, &ys, 256.0);
+                let expected: Vec<u64> = (0..8)
+                    .filter(|k| near.mask & keep & (1 << k) != 0)
+                    .map(|k| (u64::from(order[k]) << 32) | u64::from(t0.wrapping_add(k as u32)))
+                    .collect();
+                assert_eq!(
+                    want.hits[..want.count],
+                    expected[..],
+                    "t0 {t0}, keep {keep:b}"
+                );
+                for path in SimdPath::available() {
+                    let got = crate::with_lanes!(path.lanes().unwrap(), l => {
+                        l.hits8((0.0, 0.0), row, keep, 256.0)
+                    });
+                    let (n, bits) = (got.count, |r: &[f64]| {
+                        r.iter().map(|r| r.to_bits()).collect::<Vec<_>>()
+                    });
+                    assert_eq!(n, want.count, "{path}");
+                    assert_eq!(
+                        got.hits[..n],
+                        want.hits[..n],
+                        "{path}, t0 {t0}, keep {keep:b}"
+                    );
+                    assert_eq!(bits(&got.hit_r2[..n]), bits(&want.hit_r2[..n]), "{path}");
+                    assert_eq!(bits(&got.r2), bits(&want.r2), "{path}");
+                }
+            }
+        }
     }
 
     #[test]

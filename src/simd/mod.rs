@@ -5,9 +5,11 @@
 //!
 //! The all-pairs search tests eight candidates per call ([`Lanes::near8`]); every pass that
 //! searches runs inside [`Lanes::vectorize`], so the compiler may use the path's instructions
-//! for the rest of the pass too. The grid tests its candidates one by one and its search passes
-//! run as the target compiles them whatever the path: a row holds only 3–12 candidates, and
-//! both blocks of eight and passes compiled for AVX-512 measured slower there. Müller's force
+//! for the rest of the pass too. On AVX-512 the grid scans a row's candidates eight at a time
+//! and packs the hits in registers ([`Lanes::hits8`], `vpcompressq`); on the other paths it
+//! tests them one by one and its search passes run as the target compiles them: a row holds
+//! only 3–12 candidates, and blocks of eight whose hits are taken bit by bit measured slower
+//! there. Müller's force
 //! pass, on either search, takes two neighbours at a time on the x86 paths, in four lanes
 //! ([`F64x4`], `quad.rs`): its divisions and square roots take the divider's time, which four
 //! lanes halve.
@@ -30,7 +32,7 @@ use serde::{Deserialize, Serialize};
 
 #[cfg(target_arch = "x86_64")]
 pub use lanes::{Avx2, Avx512};
-pub use lanes::{Lanes, Near8, Portable};
+pub use lanes::{Hits8, Lanes, Near8, Portable, Row8};
 pub use quad::{F64x4, Quad};
 
 /// An instruction set the neighbour tests can run on.

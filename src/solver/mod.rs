@@ -172,9 +172,10 @@ macro_rules! with_search {
 }
 
 /// [`with_search!`], and `$l` bound to the lanes the search tests candidates in: the run's
-/// SIMD path for all-pairs; the portable lanes for the grid, which tests its few candidates
-/// per row one by one (its search passes compiled for AVX-512 measured 8–15 % slower here).
-/// Müller's force pass, which searches only for a pile, gets the run's path on every search.
+/// SIMD path for all-pairs; for the grid AVX-512's, which packs a row's hits eight candidates
+/// at a time, and otherwise the portable lanes: the grid tests its few candidates per row one
+/// by one there (its search passes compiled for AVX2 gain nothing from it). Müller's force
+/// pass, which searches only for a pile, gets the run's path on every search.
 macro_rules! with_search_lanes {
     ($any:expr, $lanes:expr, ($nb:ident, $lists:ident, $l:ident) => $body:expr) => {
         match $any {
@@ -182,6 +183,11 @@ macro_rules! with_search_lanes {
                 with_lanes!($lanes, $l => $body)
             }
             // Every grid (`with_search!`'s all-pairs arm is never taken here).
+            #[cfg(target_arch = "x86_64")]
+            grid if matches!($lanes, simd::AnyLanes::Avx512(_)) => {
+                let simd::AnyLanes::Avx512($l) = $lanes else { unreachable!() };
+                with_search!(grid, ($nb, $lists) => $body)
+            }
             grid => {
                 let $l = simd::Portable;
                 with_search!(grid, ($nb, $lists) => $body)
@@ -276,12 +282,15 @@ impl Simulation {
     }
 
     /// The SIMD path the run's vector code runs on, so that `--json` and `meta.json` name
-    /// what ran: the chosen one for all-pairs' neighbour tests and for Müller's force pass
-    /// (two neighbours at once), `portable` for a `wcsph` run on the grid, which uses neither
-    /// (the grid tests its few candidates per row one by one).
+    /// what ran: the chosen one for all-pairs' neighbour tests, for Müller's force pass (two
+    /// neighbours at once) and for the grid's packed scan (AVX-512); `portable` for a `wcsph`
+    /// run on the grid on another path, which uses none of them (the grid then tests its few
+    /// candidates per row one by one).
     pub fn simd(&self) -> SimdPath {
-        match (&self.neighbors, &self.physics) {
-            (AnyNeighbors::AllPairs(_), _) | (_, Physics::Mueller(_)) => self.lanes.path(),
+        match (&self.neighbors, &self.physics, self.lanes.path()) {
+            (AnyNeighbors::AllPairs(_), _, path)
+            | (_, Physics::Mueller(_), path)
+            | (_, _, path @ SimdPath::Avx512) => path,
             _ => SimdPath::Portable,
         }
     }

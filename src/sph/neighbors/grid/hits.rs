@@ -35,9 +35,9 @@ pub struct GridScratch {
     /// The hits collected: every candidate is written at the next free place, which only a hit
     /// takes. Up to [`SMALL`] hits are followed by [`SMALL`] places of padding for
     /// [`in_order`] and [`sort_small`] (within the first `2 × SMALL`).
-    pub(super) hits: [u64; INLINE_HITS],
+    pub(super) hits: [u64; INLINE_HITS + 8],
     /// Each candidate's squared distance, by its position in the block.
-    pub(super) r2: [f64; INLINE_HITS],
+    pub(super) r2: [f64; INLINE_HITS + 8],
     /// The hits put in order by [`rank_sort`].
     pub(super) ranked: [u64; RANK_SORT_MAX],
 }
@@ -45,8 +45,8 @@ pub struct GridScratch {
 impl Default for GridScratch {
     fn default() -> Self {
         GridScratch {
-            hits: [0; INLINE_HITS],
-            r2: [0.0; INLINE_HITS],
+            hits: [0; INLINE_HITS + 8],
+            r2: [0.0; INLINE_HITS + 8],
             ranked: [0; RANK_SORT_MAX],
         }
     }
