@@ -35,9 +35,9 @@ pub struct Cli {
     /// What to do.
     #[command(subcommand)]
     pub command: Command,
-    /// Instructions for the all-pairs neighbour tests and Müller's force pass: portable, avx2
-    /// or avx512 [default: the widest this CPU runs]. Every path gives the same bits; a path
-    /// the CPU lacks is an error.
+    /// Instructions for the all-pairs neighbour tests, Müller's force pass and (avx512) the
+    /// grid's candidate scan: portable, avx2 or avx512 [default: the widest this CPU runs].
+    /// Every path gives the same bits; a path the CPU lacks is an error.
     #[arg(long, global = true, value_parser = values::simd())]
     pub simd: Option<crate::simd::SimdPath>,
 }
