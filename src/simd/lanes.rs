@@ -249,6 +249,55 @@ mod x86 {
     }
 }
 
+/// Test-only lanes: the portable instructions, packing their hits ([`Lanes::PACKS_HITS`]) with
+/// [`Lanes::hits8`]'s portable loop, so that the grid's packed scan runs on any machine.
+#[cfg(test)]
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct PackingPortable;
+
+#[cfg(test)]
+impl Lanes for PackingPortable {
+    const PACKS_HITS: bool = true;
+
+    fn vectorize<R>(self, f: impl FnOnce() -> R) -> R {
+        f()
+    }
+
+    fn near8(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8 {
+        Portable.near8(xi, yi, xs, ys, hsq)
+    }
+}
+
+#[cfg(test)]
+impl Quad for PackingPortable {
+    type F4 = [f64; 4];
+    const TWO_NEIGHBORS: bool = false;
+    fn load4(self, lanes: [f64; 4]) -> [f64; 4] {
+        lanes
+    }
+    fn store4(self, v: [f64; 4]) -> [f64; 4] {
+        v
+    }
+    fn add4(self, a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+        Portable.add4(a, b)
+    }
+    fn sub4(self, a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+        Portable.sub4(a, b)
+    }
+    fn mul4(self, a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+        Portable.mul4(a, b)
+    }
+    fn div4(self, a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
+        Portable.div4(a, b)
+    }
+    fn neg4(self, a: [f64; 4]) -> [f64; 4] {
+        Portable.neg4(a)
+    }
+    fn sqrt2(self, a: [f64; 2]) -> [f64; 2] {
+        Portable.sqrt2(a)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,10 +1,11 @@
 //! Four f64 lanes ([`F64x4`]): the force pass's arithmetic on two neighbours at once, the x and
 //! y of each, on the paths whose vectors hold four lanes.
 //!
-//! A pair's force takes three divisions of two lanes and a square root, and the divider is
-//! what the pass waits on: on this project's VMs a division takes the same time on four lanes
-//! as on two (about 4 cycles, a square root about 7.5), so two neighbours at once take half the
-//! divider's time. Every operation is lane-wise IEEE arithmetic, so each lane has the bits the
+//! A pair's force takes three divisions of two lanes and a square root: on this project's VMs
+//! a division takes the same time on four lanes as on two (about 4 cycles, a square root about
+//! 7.5), so two neighbours at once take half the divider's time (6 % off the grid's reference
+//! run; four pairs in eight lanes took no more off: the divider is not all the pass waits on).
+//! Every operation is lane-wise IEEE arithmetic, so each lane has the bits the
 //! scalar code computes.
 
 use std::ops::{Add, Div, Mul, Neg, Sub};

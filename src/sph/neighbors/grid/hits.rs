@@ -34,9 +34,11 @@ pub(super) const SMALL: usize = 8;
 pub struct GridScratch {
     /// The hits collected: every candidate is written at the next free place, which only a hit
     /// takes. Up to [`SMALL`] hits are followed by [`SMALL`] places of padding for
-    /// [`in_order`] and [`sort_small`] (within the first `2 × SMALL`).
+    /// [`in_order`] and [`sort_small`] (within the first `2 × SMALL`). The eight places past
+    /// [`INLINE_HITS`] take the packed scan's whole stores of eight.
     pub(super) hits: [u64; INLINE_HITS + 8],
-    /// Each candidate's squared distance, by its position in the block.
+    /// Each candidate's squared distance, by its position in the block; the hits', by hit,
+    /// where the packed scan collects them for a grid summing in cell order.
     pub(super) r2: [f64; INLINE_HITS + 8],
     /// The hits put in order by [`rank_sort`].
     pub(super) ranked: [u64; RANK_SORT_MAX],

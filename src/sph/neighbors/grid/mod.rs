@@ -262,14 +262,15 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         }
         // Hits are collected without branching: every candidate written at the next free
         // place, which only a hit keeps, and its squared distance at its position, where its
-        // hit finds it again (no position loads when visited). A small block's candidates
+        // hit finds it again (no position loads when visited; the packed scan in cell order
+        // keeps the hits' distances by hit instead). A small block's candidates
         // are scanned in one loop over its three rows (each candidate's place in the sorted
         // order found without a branch), so that the rows' lengths, a few candidates each,
         // are not loop ends to mispredict; a larger block's row by row.
         //
         // Lanes that pack their hits in registers (AVX-512's compress) scan eight candidates
         // of a row at a time instead (`pack_hits`), with the same hits in the same order:
-        // 5–12 % faster at N = 1000 and N = 10⁵ in motion. Without it, blocks of eight with a
+        // 3–12 % faster at N = 1000 and N = 10⁵ in motion. Without it, blocks of eight with a
         // mask, their hits taken bit by bit, measured 8–15 % slower than one by one.
         let GridScratch {
             hits,
@@ -553,7 +554,7 @@ mod tests {
 
     use super::*;
     use crate::scene::splitmix::SplitMix64;
-    use crate::simd::{Portable, SimdPath};
+    use crate::simd::{PackingPortable, Portable, SimdPath};
 
     const H: f64 = 16.0;
 
@@ -687,15 +688,15 @@ mod tests {
         assert!(in_order * 10 > particles * 9, "{in_order} of {particles}");
     }
 
-    /// Every hit of particle i as (j, r2 bits, key), in the order visited, on `lanes`.
+    /// Every hit of particle i as (j, r2 bits, key), in the order visited, on `lanes`, with
+    /// working memory reused from particle to particle (as a pass does).
     fn visits<K: GridKey, O: VisitOrder, L: Lanes>(
         grid: &Grid<K, O>,
         i: usize,
         pos: Positions<'_>,
-        lanes: L,
+        (lanes, scratch): (L, &mut GridScratch),
     ) -> Vec<(usize, u64, u32)> {
         let mut found = Vec::new();
-        let scratch = &mut GridScratch::default();
         lanes.vectorize(
             #[inline(always)]
             || {
@@ -707,39 +708,57 @@ mod tests {
         found
     }
 
-    /// Checks that every path visits every particle's hits as the portable path does; returns
-    /// how many particles have a candidate among the sorted arrays' last eight slots (where
-    /// the packed scan reads its eight from before the row).
-    fn paths_agree<K: GridKey, O: VisitOrder>(x: &[f64], y: &[f64]) -> usize {
+    /// Checks that the packed scan (on any machine, with the portable instructions) and every
+    /// path visit every particle's hits as the portable path's one-by-one scan does. Returns
+    /// how many particles' packed scans read their eight from before a row (the sorted
+    /// arrays' last eight slots) and the most candidates a packed block had.
+    fn paths_agree<K: GridKey, O: VisitOrder>(x: &[f64], y: &[f64]) -> (usize, u32) {
         let (n, pos) = (x.len(), Positions { x, y });
         let grid = grid_over::<K, O>(x, y);
-        for path in SimdPath::available() {
-            for i in 0..n {
-                let want = visits(&grid, i, pos, Portable);
-                let got = crate::with_lanes!(path.lanes().unwrap(), l => visits(&grid, i, pos, l));
+        let scratch = &mut GridScratch::default();
+        for i in 0..n {
+            let want = visits(&grid, i, pos, (Portable, &mut *scratch));
+            let packed = visits(&grid, i, pos, (PackingPortable, &mut *scratch));
+            assert_eq!(packed, want, "packed, n {n}, particle {i}");
+            for path in SimdPath::available() {
+                let got = crate::with_lanes!(path.lanes().unwrap(), l => {
+                    visits(&grid, i, pos, (l, &mut *scratch))
+                });
                 assert_eq!(got, want, "{path}, n {n}, particle {i}");
             }
         }
-        let near_end = |&(lo, hi): &(u32, u32)| hi as usize + 8 > n && lo < hi;
-        (0..n)
-            .filter(|&i| grid.block(x[i], y[i]).runs.iter().any(near_end))
-            .count()
+        let blocks = (0..n).map(|i| grid.block(x[i], y[i]));
+        let packed = blocks.filter(|b| n >= 8 && b.candidates() as usize <= INLINE_HITS);
+        let from_before = |&(lo, hi): &(u32, u32)| (lo..hi).step_by(8).any(|s| s as usize > n - 8);
+        packed.fold((0, 0), |(before, most), b| {
+            let before = before + usize::from(b.runs.iter().any(from_before));
+            (before, most.max(b.candidates()))
+        })
     }
 
     #[test]
     fn every_path_visits_the_portable_hits_with_their_distances_in_either_order() {
-        // From fewer particles than one packed scan reads to many; AVX-512 packs its hits.
-        let mut near_end = 0;
-        for n in [1, 5, 8, 9, 150, 2000] {
-            let (x, y) = scattered(n);
-            near_end += paths_agree::<u8, InIndexOrder>(&x, &y);
-            paths_agree::<u8, InCellOrder>(&x, &y);
-            paths_agree::<u32, InCellOrder>(&x, &y);
+        // From fewer particles than one packed scan reads (not packed) to many, and a pile of
+        // 100 in the grid's last cells (the sorted arrays' end) under the scratch's limit.
+        let mut sets: Vec<_> = [1, 5, 8, 9, 150, 2000].map(scattered).into();
+        let (mut x, mut y) = scattered(300);
+        for k in 0..100 {
+            x.push(290.0 + (k % 20) as f64 * 1.4);
+            y.push(232.0 + (k / 20) as f64 * 1.5);
+        }
+        sets.push((x, y));
+        let (mut from_before, mut most) = (0, 0);
+        for (x, y) in &sets {
+            let (before, m) = paths_agree::<u8, InIndexOrder>(x, y);
+            (from_before, most) = (from_before + before, most.max(m));
+            paths_agree::<u8, InCellOrder>(x, y);
+            paths_agree::<u32, InCellOrder>(x, y);
         }
         assert!(
-            near_end > 10,
-            "{near_end} particles scan the arrays' last slots"
+            from_before > 10,
+            "{from_before} scans read from before their row"
         );
+        assert!(most > 100, "the most candidates of a packed block: {most}");
     }
 
     #[test]
