@@ -58,7 +58,8 @@ pub fn placement(pin: Pin) -> anyhow::Result<Placement> {
         }
     };
     // One hook per pin mode for the whole process: leaked on purpose (at most two).
-    let placement = Placement::new(Box::leak(Box::new(hook)));
+    let cpus = order.iter().collect::<std::collections::HashSet<_>>().len();
+    let placement = Placement::new(Box::leak(Box::new(hook)), cpus);
     hooks.insert(pin, placement);
     Ok(placement)
 }

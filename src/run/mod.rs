@@ -1,8 +1,8 @@
 //! A run: the step loop of a [`Simulation`] inside one session of a named strategy, timed.
 //!
 //! The timed region is the step loop only (grid rebuilds, spawns, barriers and the divergence
-//! check included); building the initial state and the thread pool, warm-up steps, the
-//! checksum and the dump are outside it. CPU time is the process's user + system time over the
+//! check included); building the initial state and the thread pool, waking its threads
+//! (`sph_strategies::wake`), warm-up steps, the checksum and the dump are outside it. CPU time is the process's user + system time over the
 //! same window. A run cut into segments ([`Steps::every`], for frames) times each segment on
 //! its own and shows the simulation to an [`Observer`] between them, outside the timing; all
 //! segments run in the one session, on the one pool.
@@ -91,6 +91,8 @@ impl Observer for LastSegment {
 
 struct Segments<'a, H, O> {
     sim: &'a mut Simulation,
+    /// The CPUs the strategy's threads may use (see [`sph_strategies::wake()`]).
+    cpus: usize,
     steps: Steps,
     hooks: &'a mut H,
     observer: &'a mut O,
@@ -106,6 +108,10 @@ impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
             warmup,
             until_s,
         } = self.steps;
+        sph_strategies::wake(exec, self.cpus).map_err(|source| StepError::Kernel {
+            step: self.sim.steps_done,
+            source,
+        })?;
         if warmup > 0 {
             match self.sim.clone().advance(exec, warmup) {
                 Ok(()) | Err(StepError::Diverged { .. } | StepError::Unphysical { .. }) => {}
@@ -139,7 +145,10 @@ impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
 
 /// Runs `steps` of `sim` in one session of `strategy`, each phase and check through `hooks`,
 /// showing the simulation to `observer` after every segment. With a placement other than the
-/// operating system's, the calling thread is pinned for the run too ([`Pinned`]).
+/// operating system's, the calling thread is pinned for the run too ([`Pinned`]). Before its
+/// steps (and its warm-up) the session wakes the strategy's threads
+/// ([`sph_strategies::wake()`]): untimed passes that spin until the threads run on their cores,
+/// at most 0.15 s.
 pub fn run_steps<H: StepHooks + Send, O: Observer>(
     sim: &mut Simulation,
     strategy: StrategyName,
@@ -150,6 +159,8 @@ pub fn run_steps<H: StepHooks + Send, O: Observer>(
 ) -> Result<(), RunError> {
     let session = Segments {
         sim,
+        // Read before the caller is pinned (a pinned caller may run on one CPU only).
+        cpus: config.placement.parallelism(),
         steps,
         hooks,
         observer,

@@ -106,10 +106,7 @@ impl Strategy for CrossbeamPool {
             clocks: &clocks,
             threads: self.cores,
             chunks: self.chunks,
-            degrade: RefCell::new(Degrade::new(
-                self.cores,
-                std::thread::available_parallelism().map_or(1, |n| n.get()),
-            )),
+            degrade: RefCell::new(Degrade::new(self.cores, self.placement.parallelism())),
             not_sync: PhantomData,
         };
         let (cores, placement) = (self.cores, self.placement);

@@ -16,8 +16,11 @@
 //! time in passes, falling short of p by more than [`SHORTFALL`] means the cores are
 //! shared. Once two windows in a row are short, the next passes run on the session's thread
 //! alone (the workers sleep and leave their cores to the competing work): [`FIRST_SOLO`]
-//! passes, doubling while the shortfall persists, up to [`MAX_SOLO`]; then a window asks
-//! for help again, and a window without shortfall ends the degradation. p counts at most the
+//! passes or [`FIRST_SOLO_TIME`], whichever ends first, both doubling while the shortfall
+//! persists, up to [`MAX_SOLO`] passes; then a window asks for help again, and a window
+//! without shortfall ends the degradation. The time bound matters for long passes: at
+//! N = 10⁶ a pass takes 5–40 ms, and 64 passes alone were the rest of a 10-step run after a
+//! stall of a few milliseconds; now such a stall costs a pass or two. p counts at most the
 //! machine's hardware threads, so deliberate oversubscription (more threads than cores) is
 //! not mistaken for a busy machine.
 //!
@@ -53,8 +56,12 @@ pub(crate) const SHORTFALL: f64 = 0.5;
 /// (1 ms still misfired in 6 runs of 8 at N = 10⁶ on the 2-core VM: its wake-ups can take
 /// milliseconds, and a short pass may end before the worker arrives.)
 pub(crate) const WAKE_ALLOWANCE: Duration = Duration::from_millis(5);
-/// Passes run alone after the first short window.
+/// Passes run alone after the first short window (at most: see [`FIRST_SOLO_TIME`]).
 pub(crate) const FIRST_SOLO: u32 = 64;
+/// The longest time the first passes alone last: when it has passed, the next pass asks for
+/// help again however few passes ran alone. Periods of passes alone double together with
+/// their pass count.
+pub(crate) const FIRST_SOLO_TIME: Duration = Duration::from_millis(20);
 /// The most passes run alone before help is asked for again.
 pub(crate) const MAX_SOLO: u32 = 4096;
 
@@ -83,6 +90,8 @@ pub(crate) struct Degrade {
     threads: usize,
     /// Passes still to run alone.
     left: u32,
+    /// When the passes alone end at the latest (meaningful while `left > 0`).
+    until: Instant,
     /// The length of the last solo period (0: not degraded).
     span: u32,
     /// The last window was short, the one before it was not: one more short window and the
@@ -104,6 +113,7 @@ impl Degrade {
         Degrade {
             threads: cores.min(hardware_threads),
             left: 0,
+            until: Instant::now(),
             span: 0,
             suspect: false,
             window: None,
@@ -115,7 +125,16 @@ impl Degrade {
 
     /// Whether the next pass runs on the session's thread alone (and counts it).
     pub(crate) fn solo_pass(&mut self) -> bool {
+        self.left > 0 && self.solo_pass_at(Instant::now())
+    }
+
+    /// [`Degrade::solo_pass`] at the instant `now` (tests give their own clock).
+    fn solo_pass_at(&mut self, now: Instant) -> bool {
         if self.left == 0 {
+            return false;
+        }
+        if now >= self.until {
+            self.left = 0;
             return false;
         }
         self.left -= 1;
@@ -152,7 +171,7 @@ impl Degrade {
                 // The serial work between passes ran on one thread.
                 let serial = wall.saturating_sub(w.in_passes);
                 let in_passes_cpu = cpu.saturating_sub(w.cpu).saturating_sub(serial);
-                self.decide(in_passes_cpu, w.in_passes);
+                self.decide_at(now, in_passes_cpu, w.in_passes);
             }
             Some(_) => {}
         }
@@ -176,10 +195,10 @@ impl Degrade {
         }
     }
 
-    /// Ends a window whose passes used `cpu` over `wall`. A short window right after one
-    /// that was not short only raises a suspicion: the pool runs alone once a second window
-    /// in a row is short too (see the module's docs).
-    fn decide(&mut self, cpu: Duration, wall: Duration) {
+    /// Ends a window whose passes used `cpu` over `wall`, at the instant `now`. A short window
+    /// right after one that was not short only raises a suspicion: the pool runs alone once a
+    /// second window in a row is short too (see the module's docs).
+    fn decide_at(&mut self, now: Instant, cpu: Duration, wall: Duration) {
         if !short_of_cores(self.threads, cpu, wall) {
             (self.span, self.suspect) = (0, false);
         } else if self.span == 0 && !self.suspect {
@@ -188,6 +207,7 @@ impl Degrade {
             self.suspect = false;
             self.span = (self.span * 2).clamp(FIRST_SOLO, MAX_SOLO);
             self.left = self.span;
+            self.until = now + FIRST_SOLO_TIME * (self.span / FIRST_SOLO);
         }
     }
 
@@ -201,6 +221,7 @@ impl Degrade {
     pub(crate) fn alone_for(passes: u32) -> Degrade {
         Degrade {
             left: passes,
+            until: Instant::now() + Duration::from_secs(3600),
             span: passes,
             ..Degrade::new(2, 2)
         }
@@ -234,38 +255,63 @@ mod tests {
     #[test]
     fn two_short_windows_in_a_row_make_the_pool_run_alone_and_one_alone_does_not() {
         let (short, full) = ((ms(100), ms(100)), (ms(200), ms(100)));
-        let mut d = Degrade::new(2, 2);
-        d.decide(short.0, short.1);
-        assert!(!d.solo_pass(), "one short window is only a suspicion");
-        d.decide(full.0, full.1);
-        d.decide(short.0, short.1);
-        assert!(!d.solo_pass(), "a full window in between cleared it");
-        d.decide(short.0, short.1);
-        assert_eq!((0..10_000).filter(|_| d.solo_pass()).count(), 64);
+        let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
+        d.decide_at(t0, short.0, short.1);
+        assert!(!d.solo_pass_at(t0), "one short window is only a suspicion");
+        d.decide_at(t0, full.0, full.1);
+        d.decide_at(t0, short.0, short.1);
+        assert!(!d.solo_pass_at(t0), "a full window in between cleared it");
+        d.decide_at(t0, short.0, short.1);
+        assert_eq!((0..10_000).filter(|_| d.solo_pass_at(t0)).count(), 64);
     }
 
     #[test]
     fn short_windows_make_the_solo_periods_double_and_a_full_window_ends_them() {
-        let mut d = Degrade::new(2, 2);
-        assert!(!d.solo_pass());
-        d.decide(ms(100), ms(100));
-        d.decide(ms(100), ms(100));
-        assert_eq!((0..10_000).filter(|_| d.solo_pass()).count(), 64);
-        d.decide(ms(100), ms(100));
-        assert_eq!((0..10_000).filter(|_| d.solo_pass()).count(), 128);
-        d.decide(ms(200), ms(100));
-        assert!(!d.solo_pass());
-        d.decide(ms(100), ms(100));
-        d.decide(ms(100), ms(100));
-        assert_eq!((0..10_000).filter(|_| d.solo_pass()).count(), 64);
+        let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
+        assert!(!d.solo_pass_at(t0));
+        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100));
+        assert_eq!((0..10_000).filter(|_| d.solo_pass_at(t0)).count(), 64);
+        d.decide_at(t0, ms(100), ms(100));
+        assert_eq!((0..10_000).filter(|_| d.solo_pass_at(t0)).count(), 128);
+        d.decide_at(t0, ms(200), ms(100));
+        assert!(!d.solo_pass_at(t0));
+        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100));
+        assert_eq!((0..10_000).filter(|_| d.solo_pass_at(t0)).count(), 64);
         assert_eq!(d.solo_total(), 256);
         for _ in 0..20 {
-            d.decide(ms(100), ms(100));
+            d.decide_at(t0, ms(100), ms(100));
         }
         assert_eq!(
-            (0..10_000).filter(|_| d.solo_pass()).count(),
+            (0..10_000).filter(|_| d.solo_pass_at(t0)).count(),
             MAX_SOLO as usize
         );
+    }
+
+    #[test]
+    fn passes_alone_end_after_their_time_however_few_ran() {
+        let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
+        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100));
+        assert_eq!(FIRST_SOLO_TIME, ms(20));
+        // Long passes: three alone in the first 20 ms, then help is asked for again.
+        for t in [1, 10, 19] {
+            assert!(d.solo_pass_at(t0 + ms(t)), "alone at {t} ms");
+        }
+        assert!(!d.solo_pass_at(t0 + ms(20)));
+        assert!(
+            !d.solo_pass_at(t0 + ms(1)),
+            "the period is over, not paused"
+        );
+        assert_eq!(d.solo_total(), 3);
+        // Still short: the next period is twice as long, in passes and in time.
+        let t1 = t0 + ms(30);
+        d.decide_at(t1, ms(100), ms(100));
+        assert!(d.solo_pass_at(t1 + ms(39)));
+        assert!(!d.solo_pass_at(t1 + ms(40)));
+        d.decide_at(t1, ms(100), ms(100));
+        assert_eq!((0..10_000).filter(|_| d.solo_pass_at(t1)).count(), 256);
     }
 
     /// A pass of `len` starting at `t` (ms since `t0`), with the CPU clock reading `cpu`.
@@ -280,19 +326,19 @@ mod tests {
         // The CPU clock says nothing was used: a shortfall, once the window is long enough
         // (after a short window already, so that this one decides).
         let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
-        d.decide(ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100));
         pass(&mut d, t0, 0.0, 0.5, 0.0); // opens the window; wakes the workers (serial)
         pass(&mut d, t0, 0.55, 1.0, 0.0);
         pass(&mut d, t0, 1.6, 0.0, 0.0);
-        assert!(!d.solo_pass(), "the window is still open");
+        assert!(!d.solo_pass_at(t0), "the window is still open");
         pass(&mut d, t0, 6.0, 0.5, 0.0); // long enough, but 1.5 ms in passes: cold, counts 0
-        assert!(!d.solo_pass(), "too little time in passes yet");
+        assert!(!d.solo_pass_at(t0), "too little time in passes yet");
         pass(&mut d, t0, 6.6, 0.5, 0.0); // warm: 1.5 ms
-        assert!(!d.solo_pass(), "still too little");
+        assert!(!d.solo_pass_at(t0), "still too little");
         pass(&mut d, t0, 7.2, 0.5, 0.0); // 2 ms: judged at the next pass
-        assert!(!d.solo_pass());
+        assert!(!d.solo_pass_at(t0));
         pass(&mut d, t0, 7.8, 0.0, 0.0);
-        assert!(d.solo_pass());
+        assert!(d.solo_pass_at(t0));
     }
 
     #[test]
@@ -305,7 +351,7 @@ mod tests {
         let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
         pass(&mut d, t0, 0.0, 8.0, 0.0);
         pass(&mut d, t0, 10.0, 0.0, 13.0);
-        assert!(!d.solo_pass());
+        assert!(!d.solo_pass_at(t0));
     }
 
     #[test]
@@ -314,10 +360,10 @@ mod tests {
         // one thread: only the allowance is discounted, so the window closes and is short
         // (the second short window in a row).
         let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
-        d.decide(ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100));
         pass(&mut d, t0, 0.0, 8.0, 0.0);
         pass(&mut d, t0, 10.0, 0.0, 10.0);
-        assert!(d.solo_pass());
+        assert!(d.solo_pass_at(t0));
     }
 
     #[test]
@@ -327,6 +373,6 @@ mod tests {
         pass(&mut d, t0, 0.0, 0.0, 0.0);
         pass(&mut d, t0, 0.1, 2.0, 0.0);
         pass(&mut d, t0, 6.0, 0.0, 4.0 + 4.0);
-        assert!(!d.solo_pass());
+        assert!(!d.solo_pass_at(t0));
     }
 }

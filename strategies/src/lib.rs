@@ -42,11 +42,13 @@ pub mod std_static;
 mod testing;
 mod thread_clocks;
 mod thread_start;
+pub mod wake;
 
 pub use panic::KernelPanic;
 pub use placement::Placement;
 pub use registry::{StrategyName, UnknownStrategy, run};
 pub use split::{Split, balanced_chunks};
+pub use wake::{Woken, wake};
 
 /// How many threads and chunks a strategy should use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -21,20 +21,39 @@ pub type Hook = dyn Fn(usize) + Sync;
 #[derive(Clone, Copy, Default)]
 pub struct Placement {
     hook: Option<&'static Hook>,
+    /// How many distinct CPUs the hook places workers on (0 without a hook).
+    cpus: usize,
 }
 
 impl Placement {
     /// No hook: the operating system decides where each thread runs.
-    pub const OS: Placement = Placement { hook: None };
+    pub const OS: Placement = Placement {
+        hook: None,
+        cpus: 0,
+    };
 
-    /// Every worker thread calls `hook(index)` on itself first.
-    pub const fn new(hook: &'static Hook) -> Placement {
-        Placement { hook: Some(hook) }
+    /// Every worker thread calls `hook(index)` on itself first, which places it on one of
+    /// `cpus` distinct CPUs (at least 1).
+    pub const fn new(hook: &'static Hook, cpus: usize) -> Placement {
+        Placement {
+            hook: Some(hook),
+            cpus: if cpus == 0 { 1 } else { cpus },
+        }
     }
 
     /// Whether the operating system places the threads (no hook).
     pub fn is_os(&self) -> bool {
         self.hook.is_none()
+    }
+
+    /// How many of a strategy's threads can run at once: the CPUs the hook places them on,
+    /// or, without a hook, the CPUs the calling thread may run on. (A pinned caller may run
+    /// on one CPU only, so that count would be wrong under a hook.)
+    pub fn parallelism(&self) -> usize {
+        match self.hook {
+            Some(_) => self.cpus,
+            None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        }
     }
 
     /// Runs the hook, if any, for worker `index` (on the worker itself).
@@ -46,11 +65,11 @@ impl Placement {
 }
 
 impl PartialEq for Placement {
-    /// The same hook (by address), or both none.
+    /// The same hook (by address) over as many CPUs, or both none.
     fn eq(&self, other: &Placement) -> bool {
         match (self.hook, other.hook) {
             (None, None) => true,
-            (Some(a), Some(b)) => std::ptr::addr_eq(a, b),
+            (Some(a), Some(b)) => std::ptr::addr_eq(a, b) && self.cpus == other.cpus,
             _ => false,
         }
     }
@@ -62,7 +81,27 @@ impl fmt::Debug for Placement {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self.hook {
             None => f.write_str("Placement::OS"),
-            Some(hook) => write!(f, "Placement({:p})", hook as *const Hook as *const ()),
+            Some(hook) => write!(
+                f,
+                "Placement({:p}, {} CPUs)",
+                hook as *const Hook as *const (), self.cpus
+            ),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_hooks_parallelism_is_its_cpus_not_the_callers_mask() {
+        static NOTHING: fn(usize) = |_| {};
+        let os = std::thread::available_parallelism().map_or(1, |n| n.get());
+        assert_eq!(Placement::OS.parallelism(), os);
+        // A caller pinned by the hook may run on one CPU, however many the workers get.
+        assert_eq!(Placement::new(&NOTHING, os + 3).parallelism(), os + 3);
+        assert_eq!(Placement::new(&NOTHING, 0).parallelism(), 1);
+        assert_ne!(Placement::new(&NOTHING, 2), Placement::new(&NOTHING, 3));
     }
 }
