@@ -2,7 +2,8 @@
 # Speed figures of bench-sph as ratios to the plain compiled C++ all-pairs loop (issue 15),
 # measured in the same run: benches/plain-loop/mueller.cpp (seed preset, N = 1000, 1000 steps)
 # against `bench-sph simulate` all-pairs and grid (in index and in cell order) at that size, plus
-# the grid at N = 10^4, 10^5 and 10^6 with every strategy of LARGE_STRATEGIES below.
+# the grid at N = 10^4, 10^5 and 10^6 with every strategy of LARGE_STRATEGIES below, and the
+# 2-core efficiency at N = 10^6 measured paired with seq (`bench-sph speedup`, PAIRED_STRATEGIES).
 #
 # Usage: scripts/speed-bench.sh [--runs K] [--quick] [--simd LIST] [--out FILE [--force]]
 #   --runs K      runs of every configuration, 1..=100 (default 5; 2 with --quick), interleaved
@@ -21,7 +22,8 @@
 # program reports it); for the N = 1000 rows the ratio plain-loop median / row median and its
 # range (plain min / row max .. plain max / row min); for large N the particle-steps/s range
 # (n * steps / wall_s), the parallel efficiency (seq median / (cores * median)) and, at
-# N = 10^6, the peak resident memory per particle. It checks that the plain loop ends in the
+# N = 10^6, the peak resident memory per particle; for the paired runs the efficiency of each
+# run (min, median, max) and of its median step. It checks that the plain loop ends in the
 # same state as `bench-sph simulate --strategy seq` (all-pairs): same checksum. It names every
 # configuration with runs whose strategy ran passes alone (`passes_alone` in the JSON:
 # crossbeam-pool on cores it found short), whose times are then not times on their cores.
@@ -43,11 +45,17 @@ REF_SEARCHES=(all-pairs grid grid-cell)
 LARGE_SIZES=("10000 10" "100000 10" "1000000 10")
 # Strategies of the large-N runs: "STRATEGY CORES CHUNKS"; "-" = the flag is not passed.
 LARGE_STRATEGIES=("seq - -" "rayon-chunks 2 10" "crossbeam-pool 2 10")
+# Paired runs (`bench-sph speedup`: the strategy and seq a step each in turn, in one process, so
+# that the VM's drift slows both alike): "STRATEGY CORES CHUNKS" at PAIRED_N, PAIRED_STEPS.
+PAIRED_STRATEGIES=("crossbeam-pool 2 10" "crossbeam-pool 2 50" "rayon-chunks 2 10" "rayon-chunks 2 50")
+PAIRED_N=1000000
+PAIRED_STEPS=10
 # The N whose peak RSS per particle is reported.
 RSS_N=1000000
 # --quick replaces the step counts.
 QUICK_REF_STEPS=100
 QUICK_LARGE_SIZES=("10000 2" "100000 2" "1000000 1")
+QUICK_PAIRED_STEPS=1
 
 usage() {
     sed -n '2,/^set -euo/{/^set -euo/d;s/^# \{0,1\}//;p}' "$0"
@@ -142,6 +150,7 @@ fi
 if ((QUICK)); then
     REF_STEPS=$QUICK_REF_STEPS
     LARGE_SIZES=("${QUICK_LARGE_SIZES[@]}")
+    PAIRED_STEPS=$QUICK_PAIRED_STEPS
 fi
 
 # A relative CARGO_TARGET_DIR means relative to where the script was started.
@@ -275,7 +284,34 @@ run_one() {
     printf '  run %d/%d  %-44s %10s s\n' "$run" "$RUNS" "$key" "$wall" >&2
 }
 
-# Keys: plain | ref:SEARCH:SIMD | large:N:STEPS:STRATEGY:CORES:CHUNKS:SIMD ("-" = none).
+# run_paired KEY CMD...: a `speedup --json` run; one line in $RESULTS as run_one's, with its
+# efficiency in place of wall_s, and one more under step:KEY with the median of its
+# step-by-step speedups over the cores.
+run_paired() {
+    local key="$1" json eff med sum alone cores
+    shift
+    if ! json="$("$@")"; then
+        echo "Error: this run failed: $*" >&2
+        exit 1
+    fi
+    eff="$(json_field efficiency <<<"$json")"
+    med="$(json_field median <<<"$json")"
+    cores="$(json_field cores <<<"$json")"
+    sum="$(json_field checksum <<<"$json")"
+    alone="$(json_field passes_alone <<<"$json")"
+    if [[ -z "$eff" || -z "$med" || -z "$sum" ]]; then
+        echo "Error: no efficiency/median/checksum in the output of: $*" >&2
+        echo "  $json" >&2
+        exit 1
+    fi
+    echo "$key $eff - $sum ${alone:-0}" >>"$RESULTS"
+    echo "step:$key $(awk -v m="$med" -v c="$cores" 'BEGIN { printf "%.17g", m / c }') - $sum 0" \
+        >>"$RESULTS"
+    printf '  run %d/%d  %-44s eff %s\n' "$run" "$RUNS" "$key" "$eff" >&2
+}
+
+# Keys: plain | ref:SEARCH:SIMD | large:N:STEPS:STRATEGY:CORES:CHUNKS:SIMD ("-" = none) |
+# paired:N:STEPS:STRATEGY:CORES:CHUNKS and step:paired:...
 simd_flag() {
     if [[ -n "$1" ]]; then printf '%s\n' --simd "$1"; fi
 }
@@ -308,6 +344,12 @@ for ((run = 1; run <= RUNS; run++)); do
                     ${extra[@]+"${extra[@]}"} ${sflag[@]+"${sflag[@]}"}
             done
         done
+    done
+    for strat in "${PAIRED_STRATEGIES[@]}"; do
+        read -r strategy cores chunks <<<"$strat"
+        run_paired "paired:$PAIRED_N:$PAIRED_STEPS:$strategy:$cores:$chunks" "$BIN" speedup \
+            --json --strategy "$strategy" --cores "$cores" --chunks "$chunks" --neighbors grid \
+            --n "$PAIRED_N" --steps "$PAIRED_STEPS"
     done
 done
 
@@ -432,6 +474,22 @@ for size in "${LARGE_SIZES[@]}"; do
 done
 say "eff = seq median / (cores x median); RSS B/part = the largest peak RSS of the N = $RSS_N" \
     "runs / N"
+say ""
+say "Paired with seq (bench-sph speedup: a step of the strategy and a step of seq in turn, one" \
+    "process; grid, N = $PAIRED_N, $PAIRED_STEPS steps each)"
+sayf '%-34s %5s %24s %24s\n' configuration runs "efficiency min/med/max" "step-median eff min/med/max"
+for strat in "${PAIRED_STRATEGIES[@]}"; do
+    read -r strategy cores chunks <<<"$strat"
+    key="paired:$PAIRED_N:$PAIRED_STEPS:$strategy:$cores:$chunks"
+    read -r lo med hi <<<"$(stats "$key")"
+    read -r slo smed shi <<<"$(stats "step:$key")"
+    sayf '%-34s %5s %24s %24s\n' "$strategy cores=$cores chunks=$chunks" "$RUNS" \
+        "$(awk -v a="$lo" -v b="$med" -v c="$hi" 'BEGIN { printf "%.2f/%.2f/%.2f", a, b, c }')" \
+        "$(awk -v a="$slo" -v b="$smed" -v c="$shi" 'BEGIN { printf "%.2f/%.2f/%.2f", a, b, c }')"
+done
+say "efficiency = (sum of seq's step times) / (cores x sum of the strategy's); step-median eff ="
+say "the median over the steps of (seq's step time / the strategy's) / cores; both copies end in"
+say "the same checksum (speedup fails otherwise)"
 # How the cost of a particle-step grows with N: seq at the largest size over seq at the smallest.
 read -r first_n _ <<<"${LARGE_SIZES[0]}"
 read -r last_n _ <<<"${LARGE_SIZES[-1]}"

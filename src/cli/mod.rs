@@ -9,6 +9,7 @@ mod render;
 mod report;
 mod scene;
 mod simulate;
+mod speedup;
 mod sweep;
 mod trace;
 mod validate;
@@ -24,6 +25,7 @@ pub use merge::MergeArgs;
 pub use render::RenderArgs;
 pub use report::ReportArgs;
 pub use simulate::SimulateArgs;
+pub use speedup::SpeedupArgs;
 pub use sweep::SweepArgs;
 pub use trace::TraceArgs;
 pub use validate::ValidateArgs;
@@ -52,6 +54,16 @@ pub enum Command {
         bench-sph simulate --steps 100 --dump final.csv --json\n  \
         bench-sph simulate --preset wcsph --resolution 40 --neighbors grid --t-end 0.5  # SI units, 0.5 s")]
     Simulate(SimulateArgs),
+    /// A strategy against seq, a step of each in turn in one process: speedup and efficiency
+    /// with the spread of their step-by-step ratio.
+    #[command(
+        after_help = "The two copies run the same steps from the same state, taking turns step by step         (which goes first alternating), so that a machine whose speed drifts slows both alike; both         must end with the same checksum. Timed: each step, as in simulate; the strategy's threads         are woken first.
+
+        Examples:
+          bench-sph speedup --strategy crossbeam-pool --cores 2 --neighbors grid --n 1000000 --steps 10
+          bench-sph speedup --strategy rayon-chunks --cores 2 --chunks 45 --steps 1000 --json"
+    )]
+    Speedup(SpeedupArgs),
     /// List the parallel strategies, one per line: name, then what it does.
     List,
     /// Animate the dam break: an animated GIF (or PNG frames), one frame every K steps.
@@ -156,6 +168,7 @@ pub fn run() -> anyhow::Result<()> {
     }
     match command {
         Command::Simulate(args) => simulate::run(&args),
+        Command::Speedup(args) => speedup::run(&args),
         Command::List => list::run(&mut std::io::stdout().lock()),
         Command::Render(args) => render::run(&args),
         Command::Sweep(args) => sweep::run(&args),

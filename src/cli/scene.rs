@@ -1,5 +1,5 @@
 //! The options that say which dam break a command simulates, shared (flattened) by `simulate`,
-//! `render` and `trace`, and the one function that turns them into an initial state.
+//! `speedup`, `render` and `trace`, and the one function that turns them into an initial state.
 
 use std::path::PathBuf;
 
@@ -9,7 +9,8 @@ use clap::{ArgMatches, Args, FromArgMatches};
 
 use crate::io::init_csv;
 use crate::scene::{Scene, dam_break, memory, tank};
-use crate::sph::neighbors::NeighborMode;
+use crate::solver::Simulation;
+use crate::sph::neighbors::{NeighborMode, SumOrder};
 use crate::sph::params::Preset;
 
 /// Which scene to simulate, and with which neighbour search.
@@ -104,6 +105,22 @@ impl SceneArgs {
             self.resolution
                 .unwrap_or_else(|| tank::resolution_for(self.n.unwrap_or(1000)))
         })
+    }
+
+    /// The simulation of [`SceneArgs::scene`] with the neighbour search of `--neighbors`,
+    /// summing in `order`, and its count of fluid particles (those that move); warns on
+    /// standard error when `--n` gave way to a `wcsph` resolution.
+    pub fn simulation(&self, order: SumOrder) -> anyhow::Result<(Simulation, usize)> {
+        let scene = self.scene()?;
+        if let Some(note) = self.resolution_note() {
+            crate::output::console::warn(&note);
+        }
+        let fluid = scene.fluid();
+        let sim = scene
+            .simulate(self.neighbors)
+            .with_sum_order(order)
+            .context("--order cell needs --neighbors grid")?;
+        Ok((sim, fluid))
     }
 
     /// A line saying which resolution `wcsph` runs at and why, when it is not the one given

@@ -84,17 +84,9 @@ struct Report {
 
 /// Runs `simulate`.
 pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
-    let scene = args.scene.scene()?;
-    if let Some(note) = args.scene.resolution_note() {
-        console::warn(&note);
-    }
-    // Particles that move: particle-steps count these (wcsph's walls are fixed).
-    let n = scene.fluid();
-    let walls = scene.state.len() - n;
-    let mut sim = scene
-        .simulate(args.scene.neighbors)
-        .with_sum_order(args.order)
-        .context("--order cell needs --neighbors grid")?;
+    // n: the particles that move; particle-steps count these (wcsph's walls are fixed).
+    let (mut sim, n) = args.scene.simulation(args.order)?;
+    let walls = sim.state.len() - n;
     // Open the dump before the run, so a bad path costs nothing. It is written to a
     // temporary file and renamed over FILE at the end: a failed or interrupted run leaves
     // FILE as it was.

@@ -2,12 +2,13 @@
 //!
 //! The timed region is the step loop only (grid rebuilds, spawns, barriers and the divergence
 //! check included); building the initial state and the thread pool, waking its threads
-//! (`sph_strategies::wake`), warm-up steps, the checksum and the dump are outside it. CPU time is the process's user + system time over the
-//! same window. A run cut into segments ([`Steps::every`], for frames) times each segment on
+//! (`sph_strategies::wake`), warm-up steps, the checksum and the dump are outside it. CPU
+//! time is the process's user + system time over the same window. A run cut into segments ([`Steps::every`], for frames) times each segment on
 //! its own and shows the simulation to an [`Observer`] between them, outside the timing; all
 //! segments run in the one session, on the one pool.
 
 pub mod fault;
+pub mod paired;
 
 use std::ops::ControlFlow;
 
