@@ -44,7 +44,7 @@ REF_SEARCHES=(all-pairs grid grid-cell)
 # behaviour alone; more steps would change the physics (a collapsing dam has more neighbours).
 LARGE_SIZES=("10000 10" "100000 10" "1000000 10")
 # Strategies of the large-N runs: "STRATEGY CORES CHUNKS"; "-" = the flag is not passed.
-LARGE_STRATEGIES=("seq - -" "rayon-chunks 2 10" "crossbeam-pool 2 10")
+LARGE_STRATEGIES=("seq - -" "rayon-chunks 2 10" "crossbeam-pool 2 10" "crossbeam-pool 2 50")
 # Paired runs (`bench-sph speedup`: the strategy and seq a step each in turn, in one process, so
 # that the VM's drift slows both alike): "STRATEGY CORES CHUNKS" at PAIRED_N, PAIRED_STEPS.
 PAIRED_STRATEGIES=("crossbeam-pool 2 10" "crossbeam-pool 2 50" "rayon-chunks 2 10" "rayon-chunks 2 50")
@@ -299,8 +299,8 @@ run_paired() {
     cores="$(json_field cores <<<"$json")"
     sum="$(json_field checksum <<<"$json")"
     alone="$(json_field passes_alone <<<"$json")"
-    if [[ -z "$eff" || -z "$med" || -z "$sum" ]]; then
-        echo "Error: no efficiency/median/checksum in the output of: $*" >&2
+    if [[ -z "$eff" || -z "$med" || -z "$cores" || -z "$sum" ]]; then
+        echo "Error: no efficiency/median/cores/checksum in the output of: $*" >&2
         echo "  $json" >&2
         exit 1
     fi
@@ -476,7 +476,8 @@ say "eff = seq median / (cores x median); RSS B/part = the largest peak RSS of t
     "runs / N"
 say ""
 say "Paired with seq (bench-sph speedup: a step of the strategy and a step of seq in turn, one" \
-    "process; grid, N = $PAIRED_N, $PAIRED_STEPS steps each)"
+    "process; grid, N = $PAIRED_N, $PAIRED_STEPS steps each; the default simd path, whatever" \
+    "--simd says)"
 sayf '%-34s %5s %24s %24s\n' configuration runs "efficiency min/med/max" "step-median eff min/med/max"
 for strat in "${PAIRED_STRATEGIES[@]}"; do
     read -r strategy cores chunks <<<"$strat"

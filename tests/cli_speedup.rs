@@ -117,6 +117,6 @@ fn bad_input_is_a_clear_error() {
             "--init",
             init.to_str().unwrap(),
         ],
-        &["Error:", "diverged at step 1"],
+        &["Error: the seq copy: ", "diverged at step 1"],
     );
 }

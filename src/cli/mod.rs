@@ -57,11 +57,13 @@ pub enum Command {
     /// A strategy against seq, a step of each in turn in one process: speedup and efficiency
     /// with the spread of their step-by-step ratio.
     #[command(
-        after_help = "The two copies run the same steps from the same state, taking turns step by step         (which goes first alternating), so that a machine whose speed drifts slows both alike; both         must end with the same checksum. Timed: each step, as in simulate; the strategy's threads         are woken first.
-
-        Examples:
-          bench-sph speedup --strategy crossbeam-pool --cores 2 --neighbors grid --n 1000000 --steps 10
-          bench-sph speedup --strategy rayon-chunks --cores 2 --chunks 45 --steps 1000 --json"
+        after_help = "The two copies run the same steps from the same state, taking turns step by step \
+        (which goes first alternating), so that a machine whose speed drifts slows both alike; both \
+        must end with the same checksum. Each step is timed as simulate times its steps; the \
+        strategy's threads are woken first, and sleep while seq steps.\n\n\
+        Examples:\n  \
+        bench-sph speedup --strategy crossbeam-pool --cores 2 --neighbors grid --n 1000000 --steps 10\n  \
+        bench-sph speedup --strategy rayon-chunks --cores 2 --chunks 45 --steps 1000 --json"
     )]
     Speedup(SpeedupArgs),
     /// List the parallel strategies, one per line: name, then what it does.

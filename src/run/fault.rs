@@ -57,4 +57,8 @@ impl<E: Executor> Executor for Faulty<'_, E> {
     fn passes_alone(&self) -> u64 {
         self.inner.passes_alone()
     }
+
+    fn forget_load(&self) {
+        self.inner.forget_load();
+    }
 }

@@ -4,8 +4,8 @@
 //! On a shared virtual machine the same run takes 0.7 s one second and 1.1 s the next
 //! (`seq` at N = 10⁶, 10 steps, minutes apart on the project's 2-core VM). Separate runs of
 //! `seq` and of a parallel strategy then land in different moments, and their ratio says as
-//! much about the moments as about the strategy: the efficiency of one round of such runs
-//! ranged from 0.64 to 1.48. Here the two copies of one simulation take turns a step at a
+//! much about the moments as about the strategy: over seven rounds of such runs, one round's
+//! efficiency ranged from 0.64 to 1.48. Here the two copies of one simulation take turns a step at a
 //! time (which one goes first alternating), so a slow moment slows both, and each step gives
 //! its own ratio. Both copies run the same steps from the same state, and must end with the
 //! same bits.
@@ -33,14 +33,20 @@ pub struct PairedTimes {
 
 /// Runs `steps` steps of `seq_sim` on the session's thread alone and of `sim` with
 /// `strategy`, in turn, in one session of `strategy` (its threads woken first, as every run's:
-/// see [`super::run_steps`]). Stops at the first failing step of either.
+/// see [`super::run_steps`]). Stops at the first failing step of either, and says which copy
+/// failed.
+///
+/// The strategy's threads sleep while `seq` steps, so each of the strategy's steps begins by
+/// waking them (tens of microseconds on a quiet machine): a cost a run of the strategy alone
+/// pays only where the serial work between its passes outlasts the threads' spinning. The
+/// speedup measured here leans low, if anything.
 pub fn run_paired(
     seq_sim: &mut Simulation,
     sim: &mut Simulation,
     strategy: StrategyName,
     config: &Config,
     steps: usize,
-) -> Result<PairedTimes, RunError> {
+) -> anyhow::Result<PairedTimes> {
     let session = Paired {
         seq_sim,
         sim,
@@ -51,7 +57,10 @@ pub fn run_paired(
     let result = sph_strategies::run(strategy, config, session)
         .map_err(|source| RunError::Build { strategy, source })?;
     pinned.finish().map_err(RunError::Placement)?;
-    Ok(result?)
+    result.map_err(|(copy, source)| {
+        let copy = copy.unwrap_or(strategy.info().name);
+        anyhow::Error::new(RunError::Step(source)).context(format!("the {copy} copy"))
+    })
 }
 
 struct Paired<'a> {
@@ -61,13 +70,20 @@ struct Paired<'a> {
     cpus: usize,
 }
 
+/// Which copy failed: `Some("seq")`, or `None` for the strategy's.
+type Copy = Option<&'static str>;
+
 impl Session for Paired<'_> {
-    type Output = Result<PairedTimes, StepError>;
+    type Output = Result<PairedTimes, (Copy, StepError)>;
 
     fn run<E: Executor>(self, exec: &E) -> Self::Output {
-        sph_strategies::wake(exec, self.cpus).map_err(|source| StepError::Kernel {
-            step: self.sim.steps_done,
-            source,
+        let seq = |e| (Some("seq"), e);
+        let strategy = |e| (None, e);
+        sph_strategies::wake(exec, self.cpus).map_err(|source| {
+            strategy(StepError::Kernel {
+                step: self.sim.steps_done,
+                source,
+            })
         })?;
         let alone = exec.passes_alone();
         let mut times = PairedTimes {
@@ -80,13 +96,15 @@ impl Session for Paired<'_> {
             if seq_first {
                 times
                     .seq_s
-                    .push(timed(|| self.seq_sim.advance(&SeqExecutor, 1))?);
+                    .push(timed(|| self.seq_sim.advance(&SeqExecutor, 1)).map_err(seq)?);
             }
-            times.strategy_s.push(timed(|| self.sim.advance(exec, 1))?);
+            times
+                .strategy_s
+                .push(timed(|| self.sim.advance(exec, 1)).map_err(strategy)?);
             if !seq_first {
                 times
                     .seq_s
-                    .push(timed(|| self.seq_sim.advance(&SeqExecutor, 1))?);
+                    .push(timed(|| self.seq_sim.advance(&SeqExecutor, 1)).map_err(seq)?);
             }
         }
         times.passes_alone = exec.passes_alone() - alone;

@@ -74,6 +74,14 @@ pub struct CrossbeamPool {
     starts: ThreadStarts,
 }
 
+impl CrossbeamPool {
+    /// A fresh degradation state for this pool: its threads can run at once on at most the
+    /// CPUs of its placement (for a pinned pool, not the one CPU its pinned caller may use).
+    fn degrade(&self) -> Degrade {
+        Degrade::new(self.cores, self.placement.parallelism())
+    }
+}
+
 impl Strategy for CrossbeamPool {
     const INFO: Info = Info {
         name: "crossbeam-pool",
@@ -106,7 +114,7 @@ impl Strategy for CrossbeamPool {
             clocks: &clocks,
             threads: self.cores,
             chunks: self.chunks,
-            degrade: RefCell::new(Degrade::new(self.cores, self.placement.parallelism())),
+            degrade: RefCell::new(self.degrade()),
             not_sync: PhantomData,
         };
         let (cores, placement) = (self.cores, self.placement);
@@ -223,6 +231,10 @@ impl Executor for PoolExecutor<'_> {
     fn passes_alone(&self) -> u64 {
         self.degrade.borrow().solo_total()
     }
+
+    fn forget_load(&self) {
+        self.degrade.borrow_mut().forget();
+    }
 }
 
 #[cfg(test)]
@@ -284,6 +296,20 @@ mod tests {
                 "a pass with help is not counted"
             );
         });
+    }
+
+    #[test]
+    fn a_pinned_pool_judges_its_cores_by_its_placements_cpus() {
+        static NOTHING: fn(usize) = |_| {};
+        let pool = |cores, placement| CrossbeamPool {
+            cores,
+            chunks: 8,
+            placement,
+            starts: ThreadStarts::default(),
+        };
+        assert_eq!(pool(2, Placement::new(&NOTHING, 2)).degrade().threads(), 2);
+        assert_eq!(pool(4, Placement::new(&NOTHING, 3)).degrade().threads(), 3);
+        assert_eq!(pool(2, Placement::new(&NOTHING, 1)).degrade().threads(), 1);
     }
 
     #[test]

@@ -21,8 +21,12 @@
 //! without shortfall ends the degradation. The time bound matters for long passes: at
 //! N = 10⁶ a pass takes 5–40 ms, and 64 passes alone were the rest of a 10-step run after a
 //! stall of a few milliseconds; now such a stall costs a pass or two. p counts at most the
-//! machine's hardware threads, so deliberate oversubscription (more threads than cores) is
-//! not mistaken for a busy machine.
+//! CPUs the pool's threads may use (the machine's, or under a placement the CPUs it pins them
+//! to), so deliberate oversubscription (more threads than cores) is not mistaken for a busy
+//! machine.
+//!
+//! The passes that wake a run's threads before it is timed (`wake`) are forgotten
+//! ([`Degrade::forget`]): a late thread there is the start-up they absorb.
 //!
 //! A pass that starts more than the workers' spinning time ([`spin_wait::LIMIT`]) after the
 //! last parallel pass wakes workers that have gone to sleep, and waking a sleeping thread on
@@ -37,8 +41,8 @@
 //! first window of a run at N = 10⁶ (the first touches of the warm-up's memory), a page-fault
 //! storm, the virtual machine's host taking a core for a few milliseconds, a program starting
 //! beside the run. Each read as 1.2–1.7 cores on the quiet 2-core VM, in about one run in
-//! six, and the 64 passes alone that followed were the rest of a 10-step run. Real
-//! contention lasts: it is found one window later.
+//! six, and the 64 passes alone that followed (before the time bound above) were the rest of
+//! a 10-step run. Real contention lasts: it is found one window later.
 //!
 //! The results are the same bits either way: every chunk is computed by the same kernel on
 //! the same data, whichever thread runs it. On a quiet machine the pool keeps its cores busy
@@ -66,7 +70,7 @@ pub(crate) const FIRST_SOLO_TIME: Duration = Duration::from_millis(20);
 pub(crate) const MAX_SOLO: u32 = 4096;
 
 /// Whether a window in which the process used `cpu` over `wall` with a pool of `threads`
-/// threads (at most the hardware threads) fell short of its cores.
+/// threads (at most the CPUs they may use) fell short of its cores.
 pub(crate) fn short_of_cores(threads: usize, cpu: Duration, wall: Duration) -> bool {
     if threads < 2 || wall.is_zero() {
         return false;
@@ -86,7 +90,7 @@ struct Window {
 /// The degradation state of one session (used by its thread only).
 #[derive(Debug, Clone)]
 pub(crate) struct Degrade {
-    /// Pool threads that can run at once: min(cores, hardware threads).
+    /// Pool threads that can run at once: min(cores, the CPUs they may use).
     threads: usize,
     /// Passes still to run alone.
     left: u32,
@@ -108,10 +112,10 @@ pub(crate) struct Degrade {
 }
 
 impl Degrade {
-    /// The state of a pool of `cores` threads on a machine with `hardware_threads`.
-    pub(crate) fn new(cores: usize, hardware_threads: usize) -> Degrade {
+    /// The state of a pool of `cores` threads that may use `cpus` CPUs.
+    pub(crate) fn new(cores: usize, cpus: usize) -> Degrade {
         Degrade {
-            threads: cores.min(hardware_threads),
+            threads: cores.min(cpus),
             left: 0,
             until: Instant::now(),
             span: 0,
@@ -211,6 +215,20 @@ impl Degrade {
         }
     }
 
+    /// Starts judging afresh, as a new pool would, but keeps the count of passes run alone.
+    pub(crate) fn forget(&mut self) {
+        *self = Degrade {
+            solo_total: self.solo_total,
+            ..Degrade::new(self.threads, self.threads)
+        };
+    }
+
+    /// Pool threads that can run at once.
+    #[cfg(test)]
+    pub(crate) fn threads(&self) -> usize {
+        self.threads
+    }
+
     /// Passes run alone so far.
     pub(crate) fn solo_total(&self) -> u64 {
         self.solo_total
@@ -287,6 +305,23 @@ mod tests {
             (0..10_000).filter(|_| d.solo_pass_at(t0)).count(),
             MAX_SOLO as usize
         );
+    }
+
+    #[test]
+    fn forgetting_ends_a_period_alone_and_a_suspicion_and_keeps_the_count() {
+        let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
+        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100));
+        assert!(d.solo_pass_at(t0));
+        d.forget();
+        assert!(!d.solo_pass_at(t0), "no longer alone");
+        assert_eq!(d.solo_total(), 1);
+        // A short window before forgetting no longer counts as the first of two.
+        d.decide_at(t0, ms(100), ms(100));
+        d.forget();
+        d.decide_at(t0, ms(100), ms(100));
+        assert!(!d.solo_pass_at(t0));
+        assert_eq!(d.threads(), 2);
     }
 
     #[test]

@@ -200,6 +200,12 @@ pub trait Executor {
     /// passes alone for a while (see `degrade`). 0 for every other executor; a wrapper forwards
     /// its inner executor's count. A run whose passes ran alone did not measure its cores.
     fn passes_alone(&self) -> u64;
+
+    /// Forgets what its passes so far said about whether its threads get their cores
+    /// (`crossbeam-pool`'s degradation, see `degrade`): the passes that wake the threads
+    /// ([`wake()`]) spin, and a late thread in them is the start-up the wake absorbs, not
+    /// a busy machine. Nothing to forget for every other executor; a wrapper forwards it.
+    fn forget_load(&self) {}
 }
 
 /// The body of a run: everything that happens while a strategy's threads exist.
