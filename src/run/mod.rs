@@ -109,10 +109,7 @@ impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
             warmup,
             until_s,
         } = self.steps;
-        sph_strategies::wake(exec, self.cpus).map_err(|source| StepError::Kernel {
-            step: self.sim.steps_done,
-            source,
-        })?;
+        wake_threads(exec, self.cpus, self.sim.steps_done)?;
         if warmup > 0 {
             match self.sim.clone().advance(exec, warmup) {
                 Ok(()) | Err(StepError::Diverged { .. } | StepError::Unphysical { .. }) => {}
@@ -166,11 +163,28 @@ pub fn run_steps<H: StepHooks + Send, O: Observer>(
         hooks,
         observer,
     };
+    Ok(in_session(strategy, config, session)??)
+}
+
+/// Runs `session` in one session of `strategy`, the calling thread pinned for it as
+/// `config`'s placement asks ([`Pinned`]).
+fn in_session<S: Session>(
+    strategy: StrategyName,
+    config: &Config,
+    session: S,
+) -> Result<S::Output, RunError> {
     let pinned = Pinned::caller(config.placement).map_err(RunError::Placement)?;
     let result = sph_strategies::run(strategy, config, session)
         .map_err(|source| RunError::Build { strategy, source })?;
     pinned.finish().map_err(RunError::Placement)?;
-    Ok(result?)
+    Ok(result)
+}
+
+/// Wakes `exec`'s threads on `cpus` CPUs ([`sph_strategies::wake()`]) before step `step`.
+fn wake_threads<E: Executor>(exec: &E, cpus: usize, step: usize) -> Result<(), StepError> {
+    sph_strategies::wake(exec, cpus)
+        .map(|_| ())
+        .map_err(|source| StepError::Kernel { step, source })
 }
 
 /// Runs `warmup` untimed steps on a copy of `sim` (see [`Steps::warmup`]), then `steps` steps

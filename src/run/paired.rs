@@ -16,7 +16,6 @@ use sph_strategies::seq::SeqExecutor;
 use sph_strategies::{Config, Executor, Session, StrategyName};
 
 use super::RunError;
-use crate::placement::Pinned;
 use crate::solver::{Simulation, StepError};
 
 /// Step times of the two copies, in seconds, step by step.
@@ -53,11 +52,7 @@ pub fn run_paired(
         steps,
         cpus: config.placement.parallelism(),
     };
-    let pinned = Pinned::caller(config.placement).map_err(RunError::Placement)?;
-    let result = sph_strategies::run(strategy, config, session)
-        .map_err(|source| RunError::Build { strategy, source })?;
-    pinned.finish().map_err(RunError::Placement)?;
-    result.map_err(|(copy, source)| {
+    super::in_session(strategy, config, session)?.map_err(|(copy, source)| {
         let copy = copy.unwrap_or(strategy.info().name);
         anyhow::Error::new(RunError::Step(source)).context(format!("the {copy} copy"))
     })
@@ -79,12 +74,7 @@ impl Session for Paired<'_> {
     fn run<E: Executor>(self, exec: &E) -> Self::Output {
         let seq = |e| (Some("seq"), e);
         let strategy = |e| (None, e);
-        sph_strategies::wake(exec, self.cpus).map_err(|source| {
-            strategy(StepError::Kernel {
-                step: self.sim.steps_done,
-                source,
-            })
-        })?;
+        super::wake_threads(exec, self.cpus, self.sim.steps_done).map_err(strategy)?;
         let alone = exec.passes_alone();
         let mut times = PairedTimes {
             seq_s: Vec::with_capacity(self.steps),
