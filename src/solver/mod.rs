@@ -354,7 +354,7 @@ impl Simulation {
                 with_search!(nb, (nb, lists) => with_lanes!(lanes, l => mueller::forces(exec, l, &*nb, lists, s, prm)))
             }
             (Physics::Mueller(prm), Pass::Integrate) => {
-                mueller::integrate(exec, s, prm, self.domain)
+                with_lanes!(lanes, l => mueller::integrate(exec, l, s, prm, self.domain))
             }
             (Physics::Wcsph(prm), Pass::MaxSpeed) => {
                 wcsph::max_speed(exec, s, &mut self.wcsph, prm)

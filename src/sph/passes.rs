@@ -202,7 +202,7 @@ fn add_two_pair_forces<L: Lanes>(
 ///
 /// A component beyond `EPS` of a wall is put back at `EPS` and its velocity multiplied by
 /// `BOUND_DAMPING`.
-#[inline]
+#[inline(always)]
 pub fn integrate(
     x: DVec2,
     v: DVec2,
@@ -216,22 +216,26 @@ pub fn integrate(
         Integrator::Cpp => v + (prm.dt * f) / rho,
     };
     let mut x = x + prm.dt * v;
-    let eps = prm.eps;
-    if x.x - eps < 0.0 {
-        v.x *= prm.bound_damping;
-        x.x = eps;
-    }
-    if x.x + eps > domain.width {
-        v.x *= prm.bound_damping;
-        x.x = domain.width - eps;
-    }
-    if x.y - eps < 0.0 {
-        v.y *= prm.bound_damping;
-        x.y = eps;
-    }
-    if x.y + eps > domain.height {
-        v.y *= prm.bound_damping;
-        x.y = domain.height - eps;
-    }
+    let (eps, damping) = (prm.eps, prm.bound_damping);
+    // Each clamp as selects, not branches, in the same order (the second test of an axis sees
+    // the first's result): the same bits, and a loop over particles the compiler can vectorise.
+    let clamp = |out: bool, x: &mut f64, v: &mut f64, to: f64| {
+        *v = if out { *v * damping } else { *v };
+        *x = if out { to } else { *x };
+    };
+    clamp(x.x - eps < 0.0, &mut x.x, &mut v.x, eps);
+    clamp(
+        x.x + eps > domain.width,
+        &mut x.x,
+        &mut v.x,
+        domain.width - eps,
+    );
+    clamp(x.y - eps < 0.0, &mut x.y, &mut v.y, eps);
+    clamp(
+        x.y + eps > domain.height,
+        &mut x.y,
+        &mut v.y,
+        domain.height - eps,
+    );
     (x, v)
 }

@@ -60,28 +60,41 @@ pub fn forces<E: Executor, N: Neighbors, L: Lanes>(
     })
 }
 
-/// Writes positions and velocities (each particle only its own); reads fx, fy, rho.
-pub fn integrate<E: Executor>(
+/// Writes positions and velocities (each particle only its own); reads fx, fy, rho. Runs inside
+/// [`Lanes::vectorize`], on inputs cut to each chunk's length, so that the compiler may take
+/// several particles per instruction on the path's registers (the clamps are selects).
+pub fn integrate<E: Executor, L: Lanes>(
     exec: &E,
+    lanes: L,
     s: &mut State,
     prm: &Params,
     domain: Domain,
 ) -> Result<(), KernelPanic> {
-    let (fx, fy, rho) = (&s.fx, &s.fy, &s.rho);
+    let (fx, fy, rho) = (&s.fx[..], &s.fy[..], &s.rho[..]);
     let out = (&mut s.x[..], &mut s.y[..], &mut s.vx[..], &mut s.vy[..]);
     exec.for_each_chunk(out, |first, (x, y, vx, vy)| {
-        for (k, (((x, y), vx), vy)) in x.iter_mut().zip(y).zip(vx).zip(vy).enumerate() {
-            let i = first + k;
-            let f = DVec2::new(fx[i], fy[i]);
-            let (p, v) = passes::integrate(
-                DVec2::new(*x, *y),
-                DVec2::new(*vx, *vy),
-                f,
-                rho[i],
-                prm,
-                domain,
-            );
-            (*x, *y, *vx, *vy) = (p.x, p.y, v.x, v.y);
-        }
+        let len = x.len();
+        let (fx, fy, rho) = (
+            &fx[first..][..len],
+            &fy[first..][..len],
+            &rho[first..][..len],
+        );
+        lanes.vectorize(
+            #[inline(always)]
+            || {
+                let (y, vx, vy) = (&mut y[..len], &mut vx[..len], &mut vy[..len]);
+                for k in 0..len {
+                    let (p, v) = passes::integrate(
+                        DVec2::new(x[k], y[k]),
+                        DVec2::new(vx[k], vy[k]),
+                        DVec2::new(fx[k], fy[k]),
+                        rho[k],
+                        prm,
+                        domain,
+                    );
+                    (x[k], y[k], vx[k], vy[k]) = (p.x, p.y, v.x, v.y);
+                }
+            },
+        )
     })
 }

@@ -269,16 +269,16 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         // are not loop ends to mispredict; a larger block's row by row.
         //
         // Lanes that pack their hits in registers (AVX-512's compress) scan eight candidates
-        // of a row at a time instead (`pack_hits`), with the same hits in the same order:
-        // 3–12 % faster at N = 1000 and N = 10⁵ in motion. Without it, blocks of eight with a
-        // mask, their hits taken bit by bit, measured 8–15 % slower than one by one.
+        // of a row at a time instead (`pack_hits`), with the same hits in the same order, up to
+        // PACK_MAX particles. Without it, blocks of eight with a mask, their hits taken bit by
+        // bit, measured 8–15 % slower than one by one.
         let GridScratch {
             hits,
             r2: dists,
             ranked,
         } = scratch;
         let mut len = 0;
-        let packs = L::PACKS_HITS && self.order.len() >= 8;
+        let packs = L::PACKS_HITS && (8..=PACK_MAX).contains(&self.order.len());
         if packs {
             len = self.pack_hits(&block, lanes, (xi, yi), hsq, hits, dists);
         }
@@ -365,6 +365,16 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         }
     }
 }
+
+/// The most particles whose grid scans its candidates eight at a time when the lanes pack hits
+/// ([`Lanes::PACKS_HITS`]); a larger grid scans them one by one. On the EPYC VM of this
+/// project's early sessions the packed scan was 3–12 % faster at N = 1000 and N = 10⁵; on its
+/// Xeon VM (3 December, each size run with and without it, interleaved) it was 4–10 % faster at
+/// N = 1000 on one core but 3–5 % slower at N = 10⁴–10⁵, and 14–16 % slower on 2 cores at
+/// N = 10⁵ and 10⁶ (why is not settled: a row holds three to four candidates at every one of
+/// these sizes, and two single-threaded runs side by side did not slow each other). Both scans
+/// find the same hits in the same order.
+const PACK_MAX: usize = 4096;
 
 /// The eight places of `a` from `at`.
 #[inline(always)]
