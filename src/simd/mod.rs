@@ -6,9 +6,10 @@
 //! The all-pairs search tests eight candidates per call ([`Lanes::near8`]); every pass that
 //! searches runs inside [`Lanes::vectorize`], so the compiler may use the path's instructions
 //! for the rest of the pass too, and so does Müller's integrate pass (its wall clamps written as
-//! selects, the compiler takes eight particles an instruction on AVX-512). On AVX-512 the grid of up to 4096 particles scans a row's
-//! candidates eight at a time and packs the hits in registers ([`Lanes::hits8`], `vpcompressq`;
-//! a larger grid measured faster one by one); on the other paths it
+//! selects, the compiler takes eight particles an instruction on AVX-512). On AVX-512 the grid
+//! of up to 4096 particles, and a larger grid's blocks of 16 candidates or more, scan a row's
+//! candidates eight at a time and pack the hits in registers ([`Lanes::hits8`], `vpcompressq`;
+//! a larger grid's sparse blocks measured faster one by one); on the other paths it
 //! tests them one by one and its search passes run as the target compiles them: a row holds
 //! only 3–12 candidates, and blocks of eight whose hits are taken bit by bit measured slower
 //! there. Müller's force

@@ -269,8 +269,8 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         // are not loop ends to mispredict; a larger block's row by row.
         //
         // Lanes that pack their hits in registers (AVX-512's compress) scan eight candidates
-        // of a row at a time instead (`pack_hits`), with the same hits in the same order, up to
-        // PACK_MAX particles. Without it, blocks of eight with a mask, their hits taken bit by
+        // of a row at a time instead (`pack_hits`), with the same hits in the same order, in a
+        // grid of up to PACK_MAX particles or a block of PACK_CANDIDATES or more. Without it, blocks of eight with a mask, their hits taken bit by
         // bit, measured 8–15 % slower than one by one.
         let GridScratch {
             hits,
@@ -278,7 +278,8 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
             ranked,
         } = scratch;
         let mut len = 0;
-        let packs = L::PACKS_HITS && (8..=PACK_MAX).contains(&self.order.len());
+        let n = self.order.len();
+        let packs = L::PACKS_HITS && n >= 8 && (n <= PACK_MAX || candidates >= PACK_CANDIDATES);
         if packs {
             len = self.pack_hits(&block, lanes, (xi, yi), hsq, hits, dists);
         }
@@ -366,8 +367,9 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
     }
 }
 
-/// The most particles whose grid scans its candidates eight at a time when the lanes pack hits
-/// ([`Lanes::PACKS_HITS`]); a larger grid scans them one by one. On the EPYC VM of this
+/// The most particles whose grid scans every block's candidates eight at a time when the lanes
+/// pack hits ([`Lanes::PACKS_HITS`]); a larger grid scans them one by one, unless the block
+/// holds [`PACK_CANDIDATES`] or more. On the EPYC VM of this
 /// project's early sessions the packed scan was 3–12 % faster at N = 1000 and N = 10⁵; on its
 /// Xeon VM (3 December, each size run with and without it, interleaved) it was 4–10 % faster at
 /// N = 1000 on one core but 3–5 % slower at N = 10⁴–10⁵, and 14–16 % slower on 2 cores at
@@ -375,6 +377,12 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
 /// these sizes, and two single-threaded runs side by side did not slow each other). Both scans
 /// find the same hits in the same order.
 const PACK_MAX: usize = 4096;
+
+/// From this many candidates on, a block of a grid larger than [`PACK_MAX`] is scanned eight at
+/// a time all the same: in `wcsph`'s blocks (20–100 candidates) the packed scan measured 5 %
+/// faster at R = 60 (about 8,000 particles) on one core and on two, where Müller's dam at rest
+/// (about 9 candidates a block from N = 10⁴ on) ran faster one by one.
+const PACK_CANDIDATES: u32 = 16;
 
 /// The eight places of `a` from `at`.
 #[inline(always)]
