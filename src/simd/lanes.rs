@@ -50,7 +50,9 @@ pub trait Lanes: Copy + Send + Sync + Quad {
     fn near8(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8;
 
     /// Whether [`Lanes::hits8`] packs the hits in registers (AVX-512's compress), so that a
-    /// grid scans its candidates eight at a time; without it the grid tests them one by one.
+    /// grid scans its candidates eight at a time (a grid of up to 4096 particles, or a larger
+    /// grid's blocks of 16 candidates or more: the grid's `scans_packed`); without it the grid
+    /// tests them one by one.
     const PACKS_HITS: bool = false;
 
     /// Of the eight candidates of `row`, those whose bit is set in `lanes` tested against

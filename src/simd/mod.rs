@@ -1,7 +1,7 @@
-//! Which SIMD instructions the neighbour tests and Müller's force pass run on: a portable path
-//! (whatever the compiled target guarantees: SSE2 on x86-64, NEON on aarch64) and, on x86-64,
-//! AVX2 and AVX-512, chosen at start-up from what the CPU has ([`SimdPath::widest`]) or forced
-//! with `--simd`.
+//! Which SIMD instructions the neighbour tests and Müller's force and integrate passes run on:
+//! a portable path (whatever the compiled target guarantees: SSE2 on x86-64, NEON on aarch64)
+//! and, on x86-64, AVX2 and AVX-512, chosen at start-up from what the CPU has
+//! ([`SimdPath::widest`]) or forced with `--simd`.
 //!
 //! The all-pairs search tests eight candidates per call ([`Lanes::near8`]); every pass that
 //! searches runs inside [`Lanes::vectorize`], so the compiler may use the path's instructions
@@ -9,10 +9,10 @@
 //! selects, the compiler takes eight particles an instruction on AVX-512). On AVX-512 the grid
 //! of up to 4096 particles, and a larger grid's blocks of 16 candidates or more, scan a row's
 //! candidates eight at a time and pack the hits in registers ([`Lanes::hits8`], `vpcompressq`;
-//! a larger grid's sparse blocks measured faster one by one); on the other paths it
-//! tests them one by one and its search passes run as the target compiles them: a row holds
-//! only 3–12 candidates, and blocks of eight whose hits are taken bit by bit measured slower
-//! there. Müller's force
+//! a larger grid's sparse blocks measured faster one by one; the grid's `scans_packed`
+//! decides). Otherwise, and on the other paths, the grid tests them one by one and its search
+//! passes run as the target compiles them: a row holds only 3–12 candidates, and blocks of
+//! eight whose hits are taken bit by bit measured slower there. Müller's force
 //! pass, on either search, takes two neighbours at a time on the x86 paths, in four lanes
 //! ([`F64x4`], `quad.rs`), which halves its divisions and square roots (measured 6 % faster;
 //! four pairs at a time in eight lanes measured no faster again: the pass is not bound by the

@@ -219,9 +219,9 @@ pub fn integrate(
     let (eps, damping) = (prm.eps, prm.bound_damping);
     // Each clamp as selects, not branches, in the same order (the second test of an axis sees
     // the first's result): the same bits, and a loop over particles the compiler can vectorise.
-    let clamp = |out: bool, x: &mut f64, v: &mut f64, to: f64| {
-        *v = if out { *v * damping } else { *v };
-        *x = if out { to } else { *x };
+    let clamp = |beyond: bool, coord: &mut f64, speed: &mut f64, to: f64| {
+        *speed = if beyond { *speed * damping } else { *speed };
+        *coord = if beyond { to } else { *coord };
     };
     clamp(x.x - eps < 0.0, &mut x.x, &mut v.x, eps);
     clamp(

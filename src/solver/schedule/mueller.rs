@@ -82,6 +82,7 @@ pub fn integrate<E: Executor, L: Lanes>(
         lanes.vectorize(
             #[inline(always)]
             || {
+                // Cut to one length, so that one bounds check covers every read and write.
                 let (y, vx, vy) = (&mut y[..len], &mut vx[..len], &mut vy[..len]);
                 for k in 0..len {
                     let (p, v) = passes::integrate(

@@ -269,17 +269,16 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         // are not loop ends to mispredict; a larger block's row by row.
         //
         // Lanes that pack their hits in registers (AVX-512's compress) scan eight candidates
-        // of a row at a time instead (`pack_hits`), with the same hits in the same order, in a
-        // grid of up to PACK_MAX particles or a block of PACK_CANDIDATES or more. Without it, blocks of eight with a mask, their hits taken bit by
-        // bit, measured 8–15 % slower than one by one.
+        // of a row at a time instead (`pack_hits`), with the same hits in the same order,
+        // where `scans_packed` says so. Without it, blocks of eight with a mask, their hits
+        // taken bit by bit, measured 8–15 % slower than one by one.
         let GridScratch {
             hits,
             r2: dists,
             ranked,
         } = scratch;
         let mut len = 0;
-        let n = self.order.len();
-        let packs = L::PACKS_HITS && n >= 8 && (n <= PACK_MAX || candidates >= PACK_CANDIDATES);
+        let packs = L::PACKS_HITS && scans_packed(self.order.len(), candidates);
         if packs {
             len = self.pack_hits(&block, lanes, (xi, yi), hsq, hits, dists);
         }
@@ -367,21 +366,29 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
     }
 }
 
-/// The most particles whose grid scans every block's candidates eight at a time when the lanes
-/// pack hits ([`Lanes::PACKS_HITS`]); a larger grid scans them one by one, unless the block
-/// holds [`PACK_CANDIDATES`] or more. On the EPYC VM of this
-/// project's early sessions the packed scan was 3–12 % faster at N = 1000 and N = 10⁵; on its
-/// Xeon VM (3 December, each size run with and without it, interleaved) it was 4–10 % faster at
-/// N = 1000 on one core but 3–5 % slower at N = 10⁴–10⁵, and 14–16 % slower on 2 cores at
-/// N = 10⁵ and 10⁶ (why is not settled: a row holds three to four candidates at every one of
-/// these sizes, and two single-threaded runs side by side did not slow each other). Both scans
-/// find the same hits in the same order.
+/// Whether lanes that pack hits ([`Lanes::PACKS_HITS`]) scan a block of `candidates` (at most
+/// [`INLINE_HITS`]) in a grid of `n` particles eight at a time: from 8 particles (one packed
+/// scan's read) up to [`PACK_MAX`], and beyond in blocks of [`PACK_CANDIDATES`] or more.
+#[inline(always)]
+fn scans_packed(n: usize, candidates: u32) -> bool {
+    n >= 8 && (n <= PACK_MAX || candidates >= PACK_CANDIDATES)
+}
+
+/// The most particles whose grid scans every block (of up to [`INLINE_HITS`] candidates) eight
+/// at a time when the lanes pack hits; a larger grid scans a block one by one, unless it holds
+/// [`PACK_CANDIDATES`] or more. On the EPYC VM of this project's early sessions the packed scan
+/// was 3–12 % faster at N = 1000 and N = 10⁵; on its Xeon VM (3 December, each size run with
+/// and without it, interleaved) it was 4–10 % faster at N = 1000 on one core but 3–5 % slower
+/// at N = 10⁴–10⁵, and 14–16 % slower on 2 cores at N = 10⁵ and 10⁶ (why is not settled: a
+/// row holds three to four candidates at every one of these sizes, and two single-threaded
+/// runs side by side did not slow each other). Both scans find the same hits in the same order.
 const PACK_MAX: usize = 4096;
 
 /// From this many candidates on, a block of a grid larger than [`PACK_MAX`] is scanned eight at
 /// a time all the same: in `wcsph`'s blocks (20–100 candidates) the packed scan measured 5 %
-/// faster at R = 60 (about 8,000 particles) on one core and on two, where Müller's dam at rest
-/// (about 9 candidates a block from N = 10⁴ on) ran faster one by one.
+/// faster at R = 60 (about 8,000 particles) on one core and on two. Müller's dam at rest
+/// (about 9 candidates a block from N = 10⁴ on) stays below it and keeps the faster one-by-one
+/// scan.
 const PACK_CANDIDATES: u32 = 16;
 
 /// The eight places of `a` from `at`.
@@ -579,13 +586,19 @@ mod tests {
     /// Particles in a pile that fills a block past the scratch's places.
     const PILE: usize = INLINE_HITS + 22;
 
+    /// The tests' usual bounds: 20 × 15 cells.
+    const BOUNDS: Bounds = Bounds {
+        min_x: 0.0,
+        min_y: 0.0,
+        max_x: 320.0,
+        max_y: 240.0,
+    };
+
     fn grid_over<K: GridKey, O: VisitOrder>(x: &[f64], y: &[f64]) -> Grid<K, O> {
-        let bounds = Bounds {
-            min_x: 0.0,
-            min_y: 0.0,
-            max_x: 320.0,
-            max_y: 240.0,
-        };
+        grid_in(BOUNDS, x, y)
+    }
+
+    fn grid_in<K: GridKey, O: VisitOrder>(bounds: Bounds, x: &[f64], y: &[f64]) -> Grid<K, O> {
         let mut grid = Grid::<K, O>::new(bounds, H, x.len());
         grid.rebuild(&SeqExecutor, Positions { x, y }).unwrap();
         grid
@@ -731,8 +744,17 @@ mod tests {
     /// how many particles' packed scans read their eight from before a row (the sorted
     /// arrays' last eight slots) and the most candidates a packed block had.
     fn paths_agree<K: GridKey, O: VisitOrder>(x: &[f64], y: &[f64]) -> (usize, u32) {
+        paths_agree_in::<K, O>(BOUNDS, x, y)
+    }
+
+    /// [`paths_agree`] in a grid over `bounds`.
+    fn paths_agree_in<K: GridKey, O: VisitOrder>(
+        bounds: Bounds,
+        x: &[f64],
+        y: &[f64],
+    ) -> (usize, u32) {
         let (n, pos) = (x.len(), Positions { x, y });
-        let grid = grid_over::<K, O>(x, y);
+        let grid = grid_in::<K, O>(bounds, x, y);
         let scratch = &mut GridScratch::default();
         for i in 0..n {
             let want = visits(&grid, i, pos, (Portable, &mut *scratch));
@@ -746,7 +768,8 @@ mod tests {
             }
         }
         let blocks = (0..n).map(|i| grid.block(x[i], y[i]));
-        let packed = blocks.filter(|b| n >= 8 && b.candidates() as usize <= INLINE_HITS);
+        let packed = blocks
+            .filter(|b| b.candidates() as usize <= INLINE_HITS && scans_packed(n, b.candidates()));
         let from_before = |&(lo, hi): &(u32, u32)| (lo..hi).step_by(8).any(|s| s as usize > n - 8);
         packed.fold((0, 0), |(before, most), b| {
             let before = before + usize::from(b.runs.iter().any(from_before));
@@ -777,6 +800,46 @@ mod tests {
             "{from_before} scans read from before their row"
         );
         assert!(most > 100, "the most candidates of a packed block: {most}");
+    }
+
+    #[test]
+    fn a_grid_over_pack_max_packs_its_crowded_blocks_and_scans_the_others_one_by_one() {
+        // One particle a cell, jittered, over more particles than PACK_MAX (blocks of about 9
+        // candidates: one by one), and a pile whose blocks hold PACK_CANDIDATES or more
+        // (packed), numbered in no spatial order.
+        let (cols, rows) = (80, 60);
+        let bounds = Bounds {
+            min_x: 0.0,
+            min_y: 0.0,
+            max_x: cols as f64 * H,
+            max_y: rows as f64 * H,
+        };
+        let mut rng = SplitMix64::new(11);
+        let mut points: Vec<(f64, f64)> = (0..cols * rows)
+            .map(|k| {
+                let (c, r) = ((k % cols) as f64, (k / cols) as f64);
+                let mut jitter = || 0.1 + 0.8 * rng.next_f64();
+                ((c + jitter()) * H, (r + jitter()) * H)
+            })
+            .collect();
+        points
+            .extend((0..30).map(|k| (400.0 + (k % 6) as f64 * 2.5, 300.0 + (k / 6) as f64 * 2.5)));
+        for k in (1..points.len()).rev() {
+            points.swap(k, (rng.next_f64() * (k + 1) as f64) as usize);
+        }
+        let (x, y): (Vec<f64>, Vec<f64>) = points.into_iter().unzip();
+        let grid = grid_in::<u8, InIndexOrder>(bounds, &x, &y);
+        let packed = (0..x.len())
+            .filter(|&i| scans_packed(x.len(), grid.block(x[i], y[i]).candidates()))
+            .count();
+        assert!(x.len() > PACK_MAX);
+        assert!(
+            packed > 0 && packed < x.len() / 10,
+            "{packed} packed blocks"
+        );
+        paths_agree_in::<u8, InIndexOrder>(bounds, &x, &y);
+        paths_agree_in::<u8, InCellOrder>(bounds, &x, &y);
+        paths_agree_in::<u32, InCellOrder>(bounds, &x, &y);
     }
 
     #[test]
