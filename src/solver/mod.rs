@@ -173,9 +173,9 @@ macro_rules! with_search {
 
 /// [`with_search!`], and `$l` bound to the lanes the search tests candidates in: the run's
 /// SIMD path for all-pairs; for the grid AVX-512's, which packs a row's hits eight candidates
-/// at a time (where the grid's `scans_packed` says so), and otherwise the portable lanes: the grid tests its few candidates per row one
-/// by one there, compiled for the target. Müller's force
-/// pass, which searches only for a pile, gets the run's path on every search.
+/// at a time (where the grid's `scans_packed` says so), and otherwise the portable lanes: the
+/// grid tests its few candidates per row one by one there, compiled for the target. Müller's
+/// force pass, which searches only for a pile, gets the run's path on every search.
 macro_rules! with_search_lanes {
     ($any:expr, $lanes:expr, ($nb:ident, $lists:ident, $l:ident) => $body:expr) => {
         match $any {

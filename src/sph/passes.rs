@@ -217,25 +217,17 @@ pub fn integrate(
     };
     let mut x = x + prm.dt * v;
     let (eps, damping) = (prm.eps, prm.bound_damping);
-    // Each clamp as selects, not branches, in the same order (the second test of an axis sees
-    // the first's result): the same bits, and a loop over particles the compiler can vectorise.
+    // Each clamp as selects, not branches, in the same order (the upper wall's test sees the
+    // lower's result): the same bits, and a loop over particles the compiler can vectorise.
     let clamp = |beyond: bool, coord: &mut f64, speed: &mut f64, to: f64| {
         *speed = if beyond { *speed * damping } else { *speed };
         *coord = if beyond { to } else { *coord };
     };
-    clamp(x.x - eps < 0.0, &mut x.x, &mut v.x, eps);
-    clamp(
-        x.x + eps > domain.width,
-        &mut x.x,
-        &mut v.x,
-        domain.width - eps,
-    );
-    clamp(x.y - eps < 0.0, &mut x.y, &mut v.y, eps);
-    clamp(
-        x.y + eps > domain.height,
-        &mut x.y,
-        &mut v.y,
-        domain.height - eps,
-    );
+    let walls = |coord: &mut f64, speed: &mut f64, extent: f64| {
+        clamp(*coord - eps < 0.0, coord, speed, eps);
+        clamp(*coord + eps > extent, coord, speed, extent - eps);
+    };
+    walls(&mut x.x, &mut v.x, domain.width);
+    walls(&mut x.y, &mut v.y, domain.height);
     (x, v)
 }

@@ -160,19 +160,19 @@ mod tests {
 
     #[test]
     fn a_pass_is_on_all_cores_within_half_again_its_calls_spread_over_them() {
-        let spin = TIMES;
+        let times = TIMES;
         // 8 calls on 2 cores: 4 rounds, 2 ms; one core alone takes 4 ms.
         assert_eq!((SPIN, SLACK), (TIMES.spin, TIMES.slack));
-        assert!(on_all_cores(2 * MS, 8, 2, spin));
-        assert!(on_all_cores(3 * MS + MS / 5, 8, 2, spin));
-        assert!(!on_all_cores(3 * MS + MS / 4, 8, 2, spin));
-        assert!(!on_all_cores(4 * MS, 8, 2, spin), "one core of two");
+        assert!(on_all_cores(2 * MS, 8, 2, times));
+        assert!(on_all_cores(3 * MS + MS / 5, 8, 2, times));
+        assert!(!on_all_cores(3 * MS + MS / 4, 8, 2, times));
+        assert!(!on_all_cores(4 * MS, 8, 2, times), "one core of two");
         // 5 calls on 2 cores: 3 rounds, 1.5 ms.
-        assert!(on_all_cores(2 * MS, 5, 2, spin));
-        assert!(!on_all_cores(3 * MS, 5, 2, spin));
+        assert!(on_all_cores(2 * MS, 5, 2, times));
+        assert!(!on_all_cores(3 * MS, 5, 2, times));
         // std-static: a call per thread, 0.5 ms; one core takes 1 ms.
-        assert!(on_all_cores(MS * 9 / 10, 2, 2, spin));
-        assert!(!on_all_cores(MS, 2, 2, spin));
+        assert!(on_all_cores(MS * 9 / 10, 2, 2, times));
+        assert!(!on_all_cores(MS, 2, 2, times));
     }
 
     #[test]
