@@ -3,8 +3,8 @@
 //! the grid at N = 100 000, each from the seed dam break after 100 steps. Chunked strategies
 //! use 10 chunks per core. The `simd/...` groups run `seq` on each SIMD path this CPU has
 //! (`--simd`): the density pass, where the neighbour tests run, and a whole step, on both
-//! scenes and on the grid at N = 1000 in cell order. Run with `cargo bench` or `cargo criterion` (install it with
-//! `cargo install cargo-criterion`).
+//! scenes and on the grid at N = 1000 in cell order. Run with `cargo bench` or
+//! `cargo criterion` (install it with `cargo install cargo-criterion`).
 
 use std::time::{Duration, Instant};
 

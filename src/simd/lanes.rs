@@ -199,7 +199,14 @@ mod x86 {
         const PACKS_HITS: bool = true;
 
         #[inline(always)]
-        fn near8_of(self, me: (f64, f64), xs: &[f64; 8], ys: &[f64; 8], hsq: f64, lanes: u8) -> Near8 {
+        fn near8_of(
+            self,
+            me: (f64, f64),
+            xs: &[f64; 8],
+            ys: &[f64; 8],
+            hsq: f64,
+            lanes: u8,
+        ) -> Near8 {
             self.vectorize(
                 #[inline(always)]
                 || {

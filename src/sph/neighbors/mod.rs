@@ -124,9 +124,9 @@ pub trait Neighbors: Sync {
         visit: impl FnMut(usize, f64, u32),
     );
 
-    /// Whether a pass that can sums its contributions in eight lanes ([`Neighbors::for_each_eight`]):
-    /// the grid in [`SumOrder::Cell`]. Otherwise a pass sums one hit after another in the visit
-    /// order of [`Neighbors::for_each_within`].
+    /// Whether a pass that can sums its contributions in eight lanes
+    /// ([`Neighbors::for_each_eight`]): the grid in [`SumOrder::Cell`]. Otherwise a pass sums
+    /// one hit after another in the visit order of [`Neighbors::for_each_within`].
     const SUMS_IN_LANES: bool = false;
 
     /// Calls `visit(eight)` for the candidates of particle `i` (itself included) eight lanes at

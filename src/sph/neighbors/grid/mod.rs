@@ -8,8 +8,8 @@
 //! order before they are visited, so sums run in the same order as all-pairs and give the same
 //! bits; in [`SumOrder::Cell`] they are visited in the order found, faster but rounding
 //! differently, and Müller's density takes each row's candidates eight at a time, summed in
-//! eight lanes ([`Neighbors::for_each_eight`]). Collecting and sorting them works in a [`GridScratch`] the caller makes once
-//! per run of particles (`hits.rs`).
+//! eight lanes ([`Neighbors::for_each_eight`]). Collecting and sorting them works in a
+//! [`GridScratch`] the caller makes once per run of particles (`hits.rs`).
 //!
 //! A neighbour list names a hit by its index or, in a large run, by its position among the
 //! particle's candidates, counted row by row: one byte instead of a four-byte index (Müller's
