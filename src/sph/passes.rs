@@ -16,10 +16,9 @@ use crate::simd::{F64x4, Lanes};
 /// neighbours j ≠ i. Candidates are tested in `lanes` (every path finds the same).
 ///
 /// Contributions `(MASS·POLY6) · ((u·u)·u)`, `u = HSQ − r2`, are summed in the search's visit
-/// order (index order unless a grid in cell order) from 0, or in eight lanes where the search
-/// sums in lanes ([`Neighbors::SUMS_IN_LANES`]: the grid in cell order; see
-/// `density_in_lanes`). The neighbours j ≠ i are written to `list` in that order; the returned
-/// count is its [`ListWriter::finish`]. `scratch` is the search's working memory (see
+/// order (index order unless a grid in cell order) from 0. The neighbours j ≠ i are written to
+/// `list` in that order; the returned count is its
+/// [`ListWriter::finish`]. `scratch` is the search's working memory (see
 /// [`Neighbors::Scratch`]).
 #[inline(always)]
 pub fn density_pressure<N: Neighbors>(
@@ -31,10 +30,6 @@ pub fn density_pressure<N: Neighbors>(
     prm: &Params,
     mut list: ListWriter<'_, N::Key>,
 ) -> (f64, f64, u32) {
-    if N::SUMS_IN_LANES {
-        let rho = density_in_lanes(i, scratch, lanes, pos, nb, prm, &mut list);
-        return (rho, prm.gas_const * (rho - prm.rest_density), list.finish());
-    }
     let mut rho = 0.0;
     nb.for_each_within(
         scratch,
@@ -51,48 +46,6 @@ pub fn density_pressure<N: Neighbors>(
     );
     let count = list.finish();
     (rho, prm.gas_const * (rho - prm.rest_density), count)
-}
-
-/// The density of [`density_pressure`] summed in eight lanes ([`Neighbors::for_each_eight`]):
-/// each lane's contributions in call order from 0, then the lanes added in a fixed tree, lane
-/// k to lane k + 4, those four sums k to k + 2, then the two:
-/// `((s0 + s4) + (s2 + s6)) + ((s1 + s5) + (s3 + s7))`. Each contribution has the bits the
-/// scalar formula gives it; only the order of the additions differs.
-#[inline(always)]
-fn density_in_lanes<N: Neighbors, L: Lanes>(
-    i: usize,
-    scratch: &mut N::Scratch,
-    lanes: L,
-    pos: Positions<'_>,
-    nb: &N,
-    prm: &Params,
-    list: &mut ListWriter<'_, N::Key>,
-) -> f64 {
-    // The eight sums in two vectors of four. A lane without a hit has hsq − r2 ≤ 0 (r2 is +∞
-    // in a lane without a candidate), so u = +0 and it adds +0, which changes no sum (each is
-    // +0 or more); a hit's u is hsq − r2 itself.
-    let zero = F64x4::new(lanes, [0.0; 4]);
-    let hsq = F64x4::new(lanes, [prm.hsq; 4]);
-    let mut sums = [zero; 2];
-    nb.for_each_eight(
-        scratch,
-        lanes,
-        i,
-        pos,
-        prm.hsq,
-        #[inline(always)]
-        |eight| {
-            let (fours, _) = eight.r2.as_chunks::<4>();
-            for (sum, &r2) in sums.iter_mut().zip(fours) {
-                let u = (hsq - F64x4::new(lanes, r2)).positive();
-                *sum = *sum + prm.mass_poly6 * ((u * u) * u);
-            }
-            let keep = eight.within & lanes.ne8(eight.j, i as u32);
-            list.push_eight(&eight.key, &lanes.compress8(eight.key, keep), keep);
-        },
-    );
-    let [[s04, s15], [s26, s37]] = (sums[0] + sums[1]).halves();
-    (s04 + s26) + (s15 + s37)
 }
 
 /// Force on particle `i` from this step's densities and pressures in `input`: pressure (Müller
