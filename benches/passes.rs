@@ -2,15 +2,16 @@
 //! registry, at 1 core and at all hardware threads, on the paper's all-pairs N = 1000 and on
 //! the grid at N = 100 000, each from the seed dam break after 100 steps. Chunked strategies
 //! use 10 chunks per core. The `simd/...` groups run `seq` on each SIMD path this CPU has
-//! (`--simd`): the density pass, where the neighbour tests run, and a whole step. Run with `cargo bench` or `cargo criterion` (install it with
-//! `cargo install cargo-criterion`).
+//! (`--simd`): the density pass, where the neighbour tests run, and a whole step, on both
+//! scenes and on the grid at N = 1000 in cell order. Run with `cargo bench` or
+//! `cargo criterion` (install it with `cargo install cargo-criterion`).
 
 use std::time::{Duration, Instant};
 
 use bench_sph::scene::dam_break;
 use bench_sph::simd::SimdPath;
 use bench_sph::solver::{Pass, Simulation};
-use bench_sph::sph::neighbors::NeighborMode;
+use bench_sph::sph::neighbors::{NeighborMode, SumOrder};
 use bench_sph::sph::params::Preset;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use sph_strategies::seq::SeqExecutor;
@@ -152,16 +153,30 @@ fn grid_100k(c: &mut Criterion) {
     bench_scene(c, "grid-n100000", NeighborMode::Grid, 100_000);
 }
 
-/// Each SIMD path this CPU runs, sequentially, on both scenes: the density pass (the
-/// neighbour tests) and a whole step.
+/// Each SIMD path this CPU runs, sequentially, on both scenes and on the grid at N = 1000 in
+/// cell order (whose density sums in eight lanes): the density pass (the neighbour tests)
+/// and a whole step.
 fn simd_paths(c: &mut Criterion) {
     let scenes = [
-        ("all-pairs-n1000", NeighborMode::AllPairs, 1000),
-        ("grid-n100000", NeighborMode::Grid, 100_000),
+        (
+            "all-pairs-n1000",
+            NeighborMode::AllPairs,
+            1000,
+            SumOrder::Index,
+        ),
+        ("grid-n100000", NeighborMode::Grid, 100_000, SumOrder::Index),
+        (
+            "grid-n1000-cell-order",
+            NeighborMode::Grid,
+            1000,
+            SumOrder::Cell,
+        ),
     ];
     let seq = Config::new(1, 1);
-    for (label, mode, n) in scenes {
-        let settled = settled(mode, n);
+    for (label, mode, n, order) in scenes {
+        let settled = settled(mode, n)
+            .with_sum_order(order)
+            .expect("the grid has cell order");
         for work in [Work::Pass(Pass::Density), Work::Step] {
             let mut group = c.benchmark_group(format!("simd/{label}/{}", work.name()));
             group

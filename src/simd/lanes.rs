@@ -49,6 +49,45 @@ pub trait Lanes: Copy + Send + Sync + Quad {
     /// The squared distances from `(xi, yi)` to eight candidates and which are below `hsq`.
     fn near8(self, xi: f64, yi: f64, xs: &[f64; 8], ys: &[f64; 8], hsq: f64) -> Near8;
 
+    /// [`Lanes::near8`] of the candidates whose bit is set in `lanes` alone: the other lanes'
+    /// squared distances are `+∞` and their bits clear.
+    #[inline(always)]
+    fn near8_of(self, me: (f64, f64), xs: &[f64; 8], ys: &[f64; 8], hsq: f64, lanes: u8) -> Near8 {
+        let mut near = self.near8(me.0, me.1, xs, ys, hsq);
+        for (k, r2) in near.r2.iter_mut().enumerate() {
+            *r2 = if lanes & (1 << k) != 0 {
+                *r2
+            } else {
+                f64::INFINITY
+            };
+        }
+        near.mask &= lanes;
+        near
+    }
+
+    /// Bit k set where `v[k] != x`.
+    #[inline(always)]
+    fn ne8(self, v: [u32; 8], x: u32) -> u8 {
+        (0..8).fold(0, |m, k| m | (u8::from(v[k] != x) << k))
+    }
+
+    /// The values of `v` whose bit is set in `mask`, packed at the front in lane order (the
+    /// other places zero).
+    #[inline(always)]
+    fn compress8(self, v: [u32; 8], mask: u8) -> [u32; 8] {
+        let mut packed = [0; 8];
+        let mut len = 0;
+        for (k, &x) in v.iter().enumerate() {
+            packed[len % 8] = x;
+            len += usize::from(mask & (1 << k) != 0);
+        }
+        // Places past the packed values hold leftovers: cleared.
+        for (k, p) in packed.iter_mut().enumerate() {
+            *p = if k < len { *p } else { 0 };
+        }
+        packed
+    }
+
     /// Whether [`Lanes::hits8`] packs the hits in registers (AVX-512's compress), so that a
     /// grid scans its candidates eight at a time (a grid of up to 4096 particles, or a larger
     /// grid's blocks of 16 candidates or more: the grid's `scans_packed`); without it the grid
@@ -158,6 +197,52 @@ mod x86 {
         Avx512(V4),
         "The lanes, if this CPU has AVX-512 F/BW/CD/DQ/VL (x86-64-v4).",
         const PACKS_HITS: bool = true;
+
+        #[inline(always)]
+        fn near8_of(
+            self,
+            me: (f64, f64),
+            xs: &[f64; 8],
+            ys: &[f64; 8],
+            hsq: f64,
+            lanes: u8,
+        ) -> Near8 {
+            self.vectorize(
+                #[inline(always)]
+                || {
+                    let near = self.near8_inline(me.0, me.1, xs, ys, hsq);
+                    let v = self.0;
+                    let r2 = v.avx512f._mm512_mask_blend_pd(
+                        lanes,
+                        cast(v.splat_f64x8(f64::INFINITY)),
+                        cast(near.r2),
+                    );
+                    Near8 {
+                        mask: near.mask & lanes,
+                        r2: cast(r2),
+                    }
+                },
+            )
+        }
+
+        #[inline(always)]
+        fn ne8(self, v: [u32; 8], x: u32) -> u8 {
+            self.vectorize(
+                #[inline(always)]
+                || {
+                    let v4 = self.0;
+                    v4.avx512f._mm256_cmpneq_epu32_mask(cast(v), cast(v4.splat_u32x8(x)))
+                },
+            )
+        }
+
+        #[inline(always)]
+        fn compress8(self, v: [u32; 8], mask: u8) -> [u32; 8] {
+            self.vectorize(
+                #[inline(always)]
+                || cast(self.0.avx512f._mm256_maskz_compress_epi32(mask, cast(v))),
+            )
+        }
 
         #[inline(always)]
         fn hits8(self, me: (f64, f64), row: Row8<'_>, lanes: u8, hsq: f64) -> Hits8 {
@@ -295,6 +380,9 @@ impl Quad for PackingPortable {
     fn neg4(self, a: [f64; 4]) -> [f64; 4] {
         Portable.neg4(a)
     }
+    fn positive4(self, a: [f64; 4]) -> [f64; 4] {
+        Portable.positive4(a)
+    }
     fn sqrt2(self, a: [f64; 2]) -> [f64; 2] {
         Portable.sqrt2(a)
     }
@@ -393,6 +481,61 @@ mod tests {
             assert_eq!(got.mask, want.mask, "{path}");
             let bits = |r: [f64; 8]| r.map(f64::to_bits);
             assert_eq!(bits(got.r2), bits(want.r2), "{path}");
+        }
+    }
+
+    #[test]
+    fn every_available_path_tests_only_the_lanes_asked_and_leaves_the_others_infinitely_far() {
+        let (xs, ys) = awkward();
+        for lanes in [u8::MAX, 0b0000_0111, 0b1111_1000, 0b0101_0110, 0] {
+            let near = Portable.near8(0.0, 0.0, &xs, &ys, 256.0);
+            let want = Portable.near8_of((0.0, 0.0), &xs, &ys, 256.0, lanes);
+            assert_eq!(want.mask, near.mask & lanes, "{lanes:b}");
+            for k in 0..8 {
+                let expected = if lanes & (1 << k) != 0 {
+                    near.r2[k]
+                } else {
+                    f64::INFINITY
+                };
+                assert_eq!(
+                    want.r2[k].to_bits(),
+                    expected.to_bits(),
+                    "{lanes:b}: lane {k}"
+                );
+            }
+            for path in SimdPath::available() {
+                let got = crate::with_lanes!(path.lanes().unwrap(), l => {
+                    l.near8_of((0.0, 0.0), &xs, &ys, 256.0, lanes)
+                });
+                assert_eq!(got.mask, want.mask, "{path}");
+                assert_eq!(
+                    got.r2.map(f64::to_bits),
+                    want.r2.map(f64::to_bits),
+                    "{path}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn every_available_path_compares_and_packs_lanes_of_indices_as_the_portable_path() {
+        let v = [7, 3, 90, 3, 4_000_000_000, 5, 0, 3];
+        assert_eq!(Portable.ne8(v, 3), 0b0111_0101);
+        assert_eq!(
+            Portable.compress8(v, 0b1001_0110),
+            [3, 90, 4_000_000_000, 3, 0, 0, 0, 0]
+        );
+        assert_eq!(Portable.compress8(v, u8::MAX), v);
+        assert_eq!(Portable.compress8(v, 0), [0; 8]);
+        for path in SimdPath::available() {
+            for x in [3, 0, 4_000_000_000, 11] {
+                let got = crate::with_lanes!(path.lanes().unwrap(), l => l.ne8(v, x));
+                assert_eq!(got, Portable.ne8(v, x), "{path}: {x}");
+            }
+            for mask in 0..=u8::MAX {
+                let got = crate::with_lanes!(path.lanes().unwrap(), l => l.compress8(v, mask));
+                assert_eq!(got, Portable.compress8(v, mask), "{path}: {mask:08b}");
+            }
         }
     }
 }

@@ -34,6 +34,8 @@ pub trait Quad: Copy {
     fn div4(self, a: Self::F4, b: Self::F4) -> Self::F4;
     /// Lane-wise `−a` (the sign flipped, as the scalar `-x`: not `0 − a`).
     fn neg4(self, a: Self::F4) -> Self::F4;
+    /// Lane-wise `a` where `a > 0`, else `+0` (NaN included).
+    fn positive4(self, a: Self::F4) -> Self::F4;
     /// The square roots of two values at once.
     fn sqrt2(self, a: [f64; 2]) -> [f64; 2];
 }
@@ -75,6 +77,11 @@ impl Quad for Portable {
     #[inline(always)]
     fn neg4(self, a: [f64; 4]) -> [f64; 4] {
         a.map(|x| -x)
+    }
+
+    #[inline(always)]
+    fn positive4(self, a: [f64; 4]) -> [f64; 4] {
+        a.map(|x| if x > 0.0 { x } else { 0.0 })
     }
 
     #[inline(always)]
@@ -135,6 +142,14 @@ mod x86 {
                 }
 
                 #[inline(always)]
+                fn positive4(self, a: f64x4) -> f64x4 {
+                    // `maxpd` gives its second operand, +0, unless the first is above it
+                    // (a NaN or a zero of either sign included).
+                    let v3 = self.v3();
+                    cast(v3.avx._mm256_max_pd(cast(a), cast(v3.splat_f64x4(0.0))))
+                }
+
+                #[inline(always)]
                 fn sqrt2(self, a: [f64; 2]) -> [f64; 2] {
                     cast(self.v3().sqrt_f64x2(cast(a)))
                 }
@@ -175,6 +190,12 @@ impl<L: Quad> F64x4<L> {
     #[inline(always)]
     pub fn halves_of(lanes: L, a: f64, b: f64) -> Self {
         Self::new(lanes, [a, a, b, b])
+    }
+
+    /// Each lane where above zero, else `+0`.
+    #[inline(always)]
+    pub fn positive(self) -> Self {
+        self.with(self.lanes.positive4(self.v))
     }
 
     /// The first two lanes and the last two.
@@ -286,7 +307,7 @@ mod tests {
                     F64x4::new(l, [x, y, -x, 2.5]),
                     F64x4::new(l, [y, x, 0.1, -y]),
                 );
-                for v in [a + b, a - b, a * b, a / b, -a, a * y, x * b] {
+                for v in [a + b, a - b, a * b, a / b, -a, a * y, x * b, a.positive()] {
                     out.extend(bits(v));
                 }
                 out.extend(l.sqrt2([x, y.abs()]).map(f64::to_bits));

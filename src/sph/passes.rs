@@ -16,9 +16,10 @@ use crate::simd::{F64x4, Lanes};
 /// neighbours j ≠ i. Candidates are tested in `lanes` (every path finds the same).
 ///
 /// Contributions `(MASS·POLY6) · ((u·u)·u)`, `u = HSQ − r2`, are summed in the search's visit
-/// order (index order unless a grid in cell order) from 0. The neighbours j ≠ i are written to
-/// `list` in that order; the returned count is its
-/// [`ListWriter::finish`]. `scratch` is the search's working memory (see
+/// order (index order unless a grid in cell order) from 0, or in eight lanes where the search
+/// sums in lanes ([`Neighbors::sums_in_lanes`]: the grid in cell order in a small run; see
+/// `density_in_lanes`). The neighbours j ≠ i are written to `list` in that order; the returned
+/// count is its [`ListWriter::finish`]. `scratch` is the search's working memory (see
 /// [`Neighbors::Scratch`]).
 #[inline(always)]
 pub fn density_pressure<N: Neighbors>(
@@ -30,6 +31,10 @@ pub fn density_pressure<N: Neighbors>(
     prm: &Params,
     mut list: ListWriter<'_, N::Key>,
 ) -> (f64, f64, u32) {
+    if nb.sums_in_lanes() {
+        let rho = density_in_lanes(i, scratch, lanes, pos, nb, prm, &mut list);
+        return (rho, prm.gas_const * (rho - prm.rest_density), list.finish());
+    }
     let mut rho = 0.0;
     nb.for_each_within(
         scratch,
@@ -46,6 +51,74 @@ pub fn density_pressure<N: Neighbors>(
     );
     let count = list.finish();
     (rho, prm.gas_const * (rho - prm.rest_density), count)
+}
+
+/// The density of [`density_pressure`] summed in eight lanes: each lane's contributions in
+/// order from 0, then the lanes added in a fixed tree, lane k to lane k + 4, those four sums k
+/// to k + 2, then the two: `((s0 + s4) + (s2 + s6)) + ((s1 + s5) + (s3 + s7))`. Each
+/// contribution has the bits the scalar formula gives it; only the order of the additions
+/// differs.
+///
+/// A lane without a hit adds +0, which changes no sum (each is +0 or more): `u = max(hsq − r2,
+/// +0)` is +0 there (r2 ≥ hsq, +∞ in a lane without a candidate, or NaN), and a hit's u is
+/// hsq − r2 itself. Lanes that pack hits in registers (AVX-512) take a row's eight candidates
+/// at once ([`Neighbors::for_each_eight`]), the others one candidate at a time into its lane
+/// ([`Neighbors::for_each_in_lanes`]), which measured faster there: both add the same
+/// contributions to the same lanes in the same order, so every path gives the same bits.
+#[inline(always)]
+fn density_in_lanes<N: Neighbors, L: Lanes>(
+    i: usize,
+    scratch: &mut N::Scratch,
+    lanes: L,
+    pos: Positions<'_>,
+    nb: &N,
+    prm: &Params,
+    list: &mut ListWriter<'_, N::Key>,
+) -> f64 {
+    if !L::PACKS_HITS {
+        let mut sums = [0.0f64; 8];
+        nb.for_each_in_lanes(
+            scratch,
+            lanes,
+            i,
+            pos,
+            prm.hsq,
+            #[inline(always)]
+            |lane, j, r2, key| {
+                // As `positive` (`Quad::positive4`) computes it.
+                let d = prm.hsq - r2;
+                let u = if d > 0.0 { d } else { 0.0 };
+                // lane < 8: the mask spares a bounds check.
+                sums[lane & 7] += prm.mass_poly6 * ((u * u) * u);
+                list.push(key, r2 < prm.hsq && j != i);
+            },
+        );
+        let [s0, s1, s2, s3, s4, s5, s6, s7] = sums;
+        return ((s0 + s4) + (s2 + s6)) + ((s1 + s5) + (s3 + s7));
+    }
+    // The eight sums in two vectors of four.
+    let zero = F64x4::new(lanes, [0.0; 4]);
+    let hsq = F64x4::new(lanes, [prm.hsq; 4]);
+    let mut sums = [zero; 2];
+    nb.for_each_eight(
+        scratch,
+        lanes,
+        i,
+        pos,
+        prm.hsq,
+        #[inline(always)]
+        |eight| {
+            let (fours, _) = eight.r2.as_chunks::<4>();
+            for (sum, &r2) in sums.iter_mut().zip(fours) {
+                let u = (hsq - F64x4::new(lanes, r2)).positive();
+                *sum = *sum + prm.mass_poly6 * ((u * u) * u);
+            }
+            let keep = eight.within & lanes.ne8(eight.j, i as u32);
+            list.push_eight(&eight.key, &lanes.compress8(eight.key, keep), keep);
+        },
+    );
+    let [[s04, s15], [s26, s37]] = (sums[0] + sums[1]).halves();
+    (s04 + s26) + (s15 + s37)
 }
 
 /// Force on particle `i` from this step's densities and pressures in `input`: pressure (Müller

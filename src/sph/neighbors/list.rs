@@ -110,6 +110,29 @@ impl<'a, K: ListKey> ListWriter<'a, K> {
         self.len += usize::from(keep);
     }
 
+    /// Writes the keys whose bit is set in `keep`, in lane order, where `packed` holds them at
+    /// its front ([`Lanes::compress8`](crate::simd::Lanes::compress8)); `keys` are all eight,
+    /// for the check that the kept ones fit the key type.
+    #[inline(always)]
+    pub fn push_eight(&mut self, keys: &[u32; 8], packed: &[u32; 8], keep: u8) {
+        let over = (0..8).fold(0u8, |m, k| m | (u8::from(keys[k] > K::MAX) << k));
+        self.fits &= over & keep == 0;
+        let count = keep.count_ones() as usize;
+        if self.len + 8 <= self.scratch {
+            let to: &mut [K; 8] = (&mut self.slots[self.len..self.len + 8])
+                .try_into()
+                .expect("eight slots");
+            *to = packed.map(K::truncate);
+        } else {
+            for &key in &packed[..count] {
+                self.slots[self.len.min(self.scratch)] = K::truncate(key);
+                self.len += 1;
+            }
+            return;
+        }
+        self.len += count;
+    }
+
     /// The count to store: the neighbours kept, or a count no list holds when a key did not
     /// fit.
     #[inline(always)]
@@ -266,5 +289,56 @@ mod tests {
         }
         assert_eq!(lists.of(0), Some(&[1u8, 2, 3][..]));
         assert_eq!(lists.of(1), None);
+    }
+
+    #[test]
+    fn eight_keys_at_once_are_written_as_one_at_a_time_up_to_a_full_list() {
+        let keys = [3u32, 9, 300, 12, 0, 255, 256, 40];
+        let packed = |keep: u8| {
+            let mut p = [0; 8];
+            let kept: Vec<u32> = (0..8)
+                .filter(|k| keep & (1 << k) != 0)
+                .map(|k| keys[k])
+                .collect();
+            p[..kept.len()].copy_from_slice(&kept);
+            p
+        };
+        // From empty to nearly full and beyond (width 12: 11 listed at most), keys that fit a
+        // byte and keys that do not, kept and not.
+        for before in [0usize, 2, 4, 9, 11, 14] {
+            for keep in [
+                0u8,
+                0b0000_0001,
+                0b1011_1011,
+                0b0100_0000,
+                0b0010_1101,
+                u8::MAX,
+            ] {
+                let mut one = vec![0u8; 12];
+                let mut all = vec![0u8; 12];
+                let (mut a, mut b) = (ListWriter::new(&mut one), ListWriter::new(&mut all));
+                for k in 0..before as u32 {
+                    a.push(k, true);
+                    b.push(k, true);
+                }
+                for (k, &key) in keys.iter().enumerate() {
+                    a.push(key, keep & (1 << k) != 0);
+                }
+                b.push_eight(&keys, &packed(keep), keep);
+                let count = a.finish();
+                assert_eq!(b.finish(), count, "{before} before, keep {keep:08b}");
+                // A list is read only when its count is below its width.
+                let listed = if (count as usize) < 12 {
+                    count as usize
+                } else {
+                    0
+                };
+                assert_eq!(
+                    all[..listed],
+                    one[..listed],
+                    "{before} before, keep {keep:08b}"
+                );
+            }
+        }
     }
 }

@@ -20,6 +20,12 @@ use sph_strategies::{Executor, KernelPanic};
 use crate::simd::Lanes;
 use crate::sph::state::{Domain, Positions};
 
+/// The most particles whose grid in [`SumOrder::Cell`] sums Müller's density in eight lanes
+/// ([`Neighbors::sums_in_lanes`]); a larger run sums it one hit after another. On this
+/// project's Xeon VM (4 December) the lanes took 11 % off the grid's reference run (N = 1000)
+/// on AVX-512 and 3 % on the other paths, but added 8–12 % at N = 10⁴ and 10⁵.
+pub const CELL_LANES_MAX: usize = 4096;
+
 /// The order a particle's neighbours are visited in, and so the order its sums run in.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -31,8 +37,16 @@ pub enum SumOrder {
     /// The grid's candidate order: cell rows bottom to top, cells left to right, increasing
     /// index within a cell. No sort per particle, so the grid runs faster, but the sums round
     /// differently: not the sources' bits, though still the same bits on every strategy,
-    /// core count and chunk count (the order depends only on the positions). All-pairs
-    /// visits candidates in index order, so it has only [`SumOrder::Index`].
+    /// core count, chunk count and SIMD path (the order depends only on the positions).
+    /// All-pairs visits candidates in index order, so it has only [`SumOrder::Index`].
+    ///
+    /// Up to [`CELL_LANES_MAX`] particles, Müller's density sums in eight lanes instead
+    /// ([`Neighbors::for_each_eight`]): each
+    /// row's candidate k in lane k mod 8, lane sums in candidate order, then the lanes added
+    /// in a fixed tree, `((s0 + s4) + (s2 + s6)) + ((s1 + s5) + (s3 + s7))`. AVX-512 takes a
+    /// row's eight candidates at once, the other paths one at a time
+    /// ([`Neighbors::for_each_in_lanes`]): the same lanes, so the same bits. The force pass
+    /// and `wcsph`'s passes sum one neighbour after another in candidate order.
     Cell,
 }
 
@@ -119,6 +133,73 @@ pub trait Neighbors: Sync {
         visit: impl FnMut(usize, f64, u32),
     );
 
+    /// Whether a pass that can sums its contributions in eight lanes
+    /// ([`Neighbors::for_each_eight`], [`Neighbors::for_each_in_lanes`]): the grid in
+    /// [`SumOrder::Cell`] over up to [`CELL_LANES_MAX`] particles. Otherwise a pass sums one
+    /// hit after another in the visit order of [`Neighbors::for_each_within`]. It depends on
+    /// the search and the number of particles alone, so every strategy and path sums alike.
+    #[inline(always)]
+    fn sums_in_lanes(&self) -> bool {
+        false
+    }
+
+    /// The lanes of [`Neighbors::for_each_eight`] one candidate at a time, for code that
+    /// takes one lane per instruction: calls `visit(lane, j, r2, key)` for every hit of
+    /// particle `i` in its lane (0..8), in the order of its lane's sum, with the same r2 and
+    /// key, and possibly for candidates that are not hits (`r2 ≥ hsq` or NaN, which a pass
+    /// adds as +0 and does not list). The grid visits every candidate of its block, without a
+    /// branch; by default, the hits of [`Neighbors::for_each_eight`].
+    #[inline(always)]
+    fn for_each_in_lanes<L: Lanes>(
+        &self,
+        scratch: &mut Self::Scratch,
+        lanes: L,
+        i: usize,
+        pos: Positions<'_>,
+        hsq: f64,
+        mut visit: impl FnMut(usize, usize, f64, u32),
+    ) {
+        self.for_each_eight(scratch, lanes, i, pos, hsq, |eight| {
+            for k in 0..8 {
+                if eight.within & (1 << k) != 0 {
+                    visit(k, eight.j[k] as usize, eight.r2[k], eight.key[k]);
+                }
+            }
+        });
+    }
+
+    /// Calls `visit(eight)` for the candidates of particle `i` (itself included) eight lanes at
+    /// a time, every hit of [`Neighbors::for_each_within`] (`r2 < hsq`) in one lane of one call,
+    /// its bit set in [`Eight::within`], with the same r2 and key. A pass summing in lanes adds
+    /// each call's lanes to eight sums, lane by lane, then the eight sums in a fixed tree
+    /// (Müller's density: `passes::density_pressure`). Which lane a hit falls in is the
+    /// search's: by default hit h of the visit order is in lane h mod 8 of call h / 8; the
+    /// grid's lanes are its candidates' places in their rows.
+    #[inline(always)]
+    fn for_each_eight<L: Lanes>(
+        &self,
+        scratch: &mut Self::Scratch,
+        lanes: L,
+        i: usize,
+        pos: Positions<'_>,
+        hsq: f64,
+        mut visit: impl FnMut(&Eight),
+    ) {
+        let mut eight = Eight::EMPTY;
+        self.for_each_within(scratch, lanes, i, pos, hsq, |j, r2, key| {
+            let k = eight.within.count_ones() as usize;
+            (eight.r2[k], eight.j[k], eight.key[k]) = (r2, j as u32, key);
+            eight.within |= 1 << k;
+            if k == 7 {
+                visit(&eight);
+                eight = Eight::EMPTY;
+            }
+        });
+        if eight.within != 0 {
+            visit(&eight);
+        }
+    }
+
     /// Calls `visit(j)` for the neighbour each key of `list` names, in order: `list` holds keys
     /// that [`Neighbors::for_each_within`] gave for particle `i` since the last rebuild, with
     /// `pos` unchanged.
@@ -153,6 +234,30 @@ impl<N: Neighbors> Searched<N> {
     fn relist(&mut self, width: usize) {
         self.lists = NeighborLists::with_slots(self.lists.len(), width);
     }
+}
+
+/// Eight lanes of a particle's candidates ([`Neighbors::for_each_eight`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Eight {
+    /// Bit k: lane k holds a hit, a candidate j with `r2 < hsq` (self included).
+    pub within: u8,
+    /// Each lane's squared distance, as [`distance_squared`] computes it; `+∞` in a lane that
+    /// holds no candidate, so that `r2 < hsq` is the lane's bit.
+    pub r2: [f64; 8],
+    /// Each lane's index j.
+    pub j: [u32; 8],
+    /// Each lane's key (see [`Neighbors::for_each_within`]).
+    pub key: [u32; 8],
+}
+
+impl Eight {
+    /// No hits.
+    const EMPTY: Eight = Eight {
+        within: 0,
+        r2: [f64::INFINITY; 8],
+        j: [0; 8],
+        key: [0; 8],
+    };
 }
 
 /// Squared distance exactly as the sources compute it: `d = x_j − x_i`, `d.x*d.x + d.y*d.y`.

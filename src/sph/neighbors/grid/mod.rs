@@ -7,11 +7,12 @@
 //! cells are contiguous in the sorted order, so each row is one slice. The hits are put in index
 //! order before they are visited, so sums run in the same order as all-pairs and give the same
 //! bits; in [`SumOrder::Cell`] they are visited in the order found, faster but rounding
-//! differently. Collecting and sorting them works in a [`GridScratch`] the caller makes once
-//! per run of particles (`hits.rs`). A particle's block is found from the cell the rebuild
-//! stored for it, not from its position again: one load instead of converting and clamping two
-//! coordinates, which took 9 % off the grid's reference run in cell order on AVX-512 (5 % in
-//! index order).
+//! differently, and Müller's density sums each row's candidate k in lane k mod 8
+//! ([`Neighbors::for_each_eight`], [`Neighbors::for_each_in_lanes`]). Collecting and sorting
+//! them works in a [`GridScratch`] the caller makes once per run of particles (`hits.rs`). A
+//! particle's block is found from the cell the rebuild stored for it, not from its position
+//! again: one load instead of converting and clamping two coordinates, which took 9 % off the
+//! grid's reference run in cell order on AVX-512 (5 % in index order).
 //!
 //! A neighbour list names a hit by its index or, in a large run, by its position among the
 //! particle's candidates, counted row by row: one byte instead of a four-byte index (Müller's
@@ -38,7 +39,7 @@ pub use sort::PARALLEL_SORT;
 use sort::{CellSort, GridArrays};
 
 use super::list::written_zeros;
-use super::{Bounds, Neighbors, SumOrder, distance_squared};
+use super::{Bounds, Eight, Neighbors, SumOrder, distance_squared};
 use crate::simd::{Lanes, Row8};
 use crate::sph::state::Positions;
 
@@ -345,6 +346,78 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         }
     }
 
+    #[inline(always)]
+    fn sums_in_lanes(&self) -> bool {
+        matches!(O::ORDER, SumOrder::Cell) && self.order.len() <= super::CELL_LANES_MAX
+    }
+
+    /// Each row of the block, bottom to top, eight candidates at a time in the sorted order:
+    /// a row's candidate `8g + k` in lane k of the row's g-th call. Every path tests them in
+    /// [`Lanes::near8`], so every path puts the same hits in the same lanes.
+    #[inline(always)]
+    fn for_each_eight<L: Lanes>(
+        &self,
+        _scratch: &mut GridScratch,
+        lanes: L,
+        i: usize,
+        pos: Positions<'_>,
+        hsq: f64,
+        mut visit: impl FnMut(&Eight),
+    ) {
+        let (xi, yi) = (pos.x[i], pos.y[i]);
+        let block = self.block_of(i);
+        for (&(lo, hi), &base) in block.runs.iter().zip(&block.base) {
+            let (lo, hi) = (lo as usize, hi as usize);
+            let mut s = lo;
+            while s < hi {
+                let first = base + (s - lo) as u32;
+                self.eight(lanes, (xi, yi), hsq, (s, hi, first), &mut visit);
+                s += 8;
+            }
+        }
+    }
+
+    /// Every candidate of the block, hit or not, in the lane [`Grid::for_each_eight`] gives it
+    /// (its place in its row, mod 8), without a branch: a small block in one loop over its
+    /// rows, as `for_each_within` scans it, a larger one row by row.
+    #[inline(always)]
+    fn for_each_in_lanes<L: Lanes>(
+        &self,
+        _scratch: &mut GridScratch,
+        _lanes: L,
+        i: usize,
+        pos: Positions<'_>,
+        _hsq: f64,
+        mut visit: impl FnMut(usize, usize, f64, u32),
+    ) {
+        let (xi, yi) = (pos.x[i], pos.y[i]);
+        let block = self.block_of(i);
+        let n = self.order.len();
+        let (xs, ys, order) = (&self.sorted_x[..n], &self.sorted_y[..n], &self.order[..n]);
+        let candidates = block.candidates();
+        let [_, b1, b2] = block.base;
+        // The candidate at position t is the (t − base)-th of its row.
+        let lane = |t: u32| {
+            let row_base = select_unpredictable(t >= b1, b1, 0);
+            let row_base = select_unpredictable(t >= b2, b2, row_base);
+            ((t - row_base) & 7) as usize
+        };
+        if candidates <= ONE_LOOP_MAX {
+            let slots = block.slots();
+            for t in 0..candidates {
+                let s = slots.of(t);
+                let (xj, yj, j) = (xs[s], ys[s], order[s]);
+                let r2 = distance_squared(xi, yi, xj, yj);
+                visit(lane(t), j as usize, r2, key::<K>(j, t));
+            }
+            return;
+        }
+        self.for_each_by_row(&block, |t, (xj, yj, j)| {
+            let r2 = distance_squared(xi, yi, xj, yj);
+            visit(lane(t), j as usize, r2, key::<K>(j, t));
+        });
+    }
+
     /// An index key is the neighbour. A position key is a hit's position among its block's
     /// candidates, counted along the block's rows: it is one addition and one load away from
     /// the neighbour's index.
@@ -393,6 +466,12 @@ const PACK_MAX: usize = 4096;
 /// (about 9 candidates a block from N = 10⁴ on) stays below it and keeps the faster one-by-one
 /// scan.
 const PACK_CANDIDATES: u32 = 16;
+
+/// The eight values of `a` from `at`.
+#[inline(always)]
+fn eight_at<T>(a: &[T], at: usize) -> &[T; 8] {
+    (&a[at..at + 8]).try_into().expect("eight values")
+}
 
 /// The eight places of `a` from `at`.
 #[inline(always)]
@@ -544,6 +623,44 @@ impl<K, O: VisitOrder> Grid<K, O> {
     }
 }
 
+impl<K: GridKey, O> Grid<K, O> {
+    /// Calls `visit` with the eight slots from `s` of a row that ends before slot `hi`, whose
+    /// slot `s` is the particle's candidate `first` (lanes from `hi` on are empty).
+    #[inline(always)]
+    fn eight<L: Lanes>(
+        &self,
+        lanes: L,
+        me: (f64, f64),
+        hsq: f64,
+        (s, hi, first): (usize, usize, u32),
+        visit: &mut impl FnMut(&Eight),
+    ) {
+        let n = self.order.len();
+        let (xs, ys, order) = (&self.sorted_x[..n], &self.sorted_y[..n], &self.order[..n]);
+        let (bx, by, bj) = if s + 8 <= n {
+            (*eight_at(xs, s), *eight_at(ys, s), *eight_at(order, s))
+        } else {
+            // The last slots of the grid: copied, the lanes past them left empty.
+            let tail = |a: &[f64]| std::array::from_fn(|k| a.get(s + k).map_or(0.0, |&v| v));
+            let js = std::array::from_fn(|k| order.get(s + k).map_or(0, |&j| j));
+            (tail(xs), tail(ys), js)
+        };
+        let present = ((1u16 << hi.saturating_sub(s).min(8)) - 1) as u8;
+        let near = lanes.near8_of(me, &bx, &by, hsq, present);
+        let key = if K::BY_INDEX {
+            bj
+        } else {
+            std::array::from_fn(|k| first + k as u32)
+        };
+        visit(&Eight {
+            within: near.mask,
+            r2: near.r2,
+            j: bj,
+            key,
+        });
+    }
+}
+
 impl Block {
     /// The block's candidates.
     #[inline(always)]
@@ -597,6 +714,7 @@ mod tests {
     use super::*;
     use crate::scene::splitmix::SplitMix64;
     use crate::simd::{PackingPortable, Portable, SimdPath};
+    use crate::sph::neighbors::AllPairs;
 
     const H: f64 = 16.0;
 
@@ -836,6 +954,232 @@ mod tests {
             "{from_before} scans read from before their row"
         );
         assert!(most > 100, "the most candidates of a packed block: {most}");
+    }
+
+    /// A hit as a test sees it: (j, r2 bits, key).
+    type Visit = (usize, u64, u32);
+
+    /// Each call of `for_each_eight` for particle i: its bits and its hits in lane order.
+    fn eights<N: Neighbors, L: Lanes>(
+        nb: &N,
+        i: usize,
+        pos: Positions<'_>,
+        lanes: L,
+    ) -> Vec<(u8, Vec<Visit>)> {
+        let mut calls = Vec::new();
+        let scratch = &mut N::Scratch::default();
+        lanes.vectorize(
+            #[inline(always)]
+            || {
+                nb.for_each_eight(scratch, lanes, i, pos, H * H, |e| {
+                    let hits = (0..8).filter(|&k| e.within & (1 << k) != 0);
+                    let hits = hits.map(|k| (e.j[k] as usize, e.r2[k].to_bits(), e.key[k]));
+                    for k in (0..8).filter(|&k| e.within & (1 << k) == 0) {
+                        let r2 = e.r2[k];
+                        assert!(
+                            r2 >= H * H || r2.is_nan(),
+                            "lane {k} without a hit: r2 {r2}"
+                        );
+                    }
+                    calls.push((e.within, hits.collect()));
+                })
+            },
+        );
+        calls
+    }
+
+    /// Each lane's hits as `for_each_in_lanes` gives them for particle i, in order, with the
+    /// non-hits it also visits checked and left out.
+    fn in_lanes<N: Neighbors, L: Lanes>(
+        nb: &N,
+        i: usize,
+        pos: Positions<'_>,
+        lanes: L,
+    ) -> [Vec<Visit>; 8] {
+        let mut found: [Vec<Visit>; 8] = Default::default();
+        let scratch = &mut N::Scratch::default();
+        lanes.vectorize(
+            #[inline(always)]
+            || {
+                nb.for_each_in_lanes(scratch, lanes, i, pos, H * H, |lane, j, r2, key| {
+                    if r2 < H * H {
+                        found[lane].push((j, r2.to_bits(), key));
+                    } else {
+                        assert!(r2 >= H * H || r2.is_nan(), "particle {i}: r2 {r2}");
+                    }
+                })
+            },
+        );
+        found
+    }
+
+    /// The hits of `eights` per lane, in call order.
+    fn by_lane(calls: &[(u8, Vec<Visit>)]) -> [Vec<Visit>; 8] {
+        let mut found: [Vec<Visit>; 8] = Default::default();
+        for (bits, hits) in calls {
+            let lanes = (0..8).filter(|k| bits & (1 << k) != 0);
+            for (k, &hit) in lanes.zip(hits) {
+                found[k].push(hit);
+            }
+        }
+        found
+    }
+
+    /// Checks that the grid's eights on every path hold the hits `for_each_within` visits in
+    /// cell order, in that order, one row's candidates a call in their places, and returns
+    /// how many calls had a hit past lane 0 of a row's second eight.
+    fn eights_agree<K: GridKey>(bounds: Bounds, x: &[f64], y: &[f64]) -> usize {
+        let (n, pos) = (x.len(), Positions { x, y });
+        let grid = grid_in::<K, InCellOrder>(bounds, x, y);
+        let by_position = grid_in::<u8, InCellOrder>(bounds, x, y);
+        let scratch = &mut GridScratch::default();
+        let mut later_eights = 0;
+        for i in 0..n {
+            let want = eights(&grid, i, pos, Portable);
+            let flat: Vec<_> = want.iter().flat_map(|(_, hits)| hits.clone()).collect();
+            assert_eq!(
+                flat,
+                visits(&grid, i, pos, (Portable, &mut *scratch)),
+                "particle {i}"
+            );
+            // A hit's lane is its place in its row (its position key less the row's first)
+            // modulo 8, and a call holds one eight of one row.
+            let block = grid.block(x[i], y[i]);
+            for (bits, hits) in eights(&by_position, i, pos, Portable) {
+                let lanes = (0..8).filter(|k| bits & (1 << k) != 0);
+                let mut places = lanes.zip(&hits).map(|(k, &(_, _, t))| {
+                    let row = (0..3).rev().find(|&r| t >= block.base[r]).expect("a row");
+                    let place = t - block.base[row];
+                    assert_eq!(place % 8, k, "particle {i}: key {t}");
+                    (row, place / 8)
+                });
+                if let Some(first) = places.next() {
+                    assert!(
+                        places.all(|p| p == first),
+                        "particle {i}: one eight of one row"
+                    );
+                    later_eights += usize::from(first.1 > 0);
+                }
+            }
+            for path in SimdPath::available() {
+                let got = crate::with_lanes!(path.lanes().unwrap(), l => eights(&grid, i, pos, l));
+                assert_eq!(got, want, "{path}, n {n}, particle {i}");
+            }
+            // One candidate at a time: the same hits in the same lanes, in the same order.
+            let want = by_lane(&want);
+            assert_eq!(
+                in_lanes(&grid, i, pos, Portable),
+                want,
+                "n {n}, particle {i}"
+            );
+            let want = by_lane(&eights(&by_position, i, pos, Portable));
+            assert_eq!(
+                in_lanes(&by_position, i, pos, Portable),
+                want,
+                "n {n}, particle {i}"
+            );
+        }
+        later_eights
+    }
+
+    #[test]
+    fn every_path_gives_the_grids_eights_in_cell_order_a_rows_candidate_k_in_lane_k_mod_8() {
+        // Fewer particles than eight (every read from the arrays' tail), sparse to crowded,
+        // and a pile past the scratch's limit in the grid's last cells.
+        let mut sets: Vec<_> = [1, 5, 9, 150, 2000].map(scattered).into();
+        let (mut x, mut y) = scattered(300);
+        for k in 0..INLINE_HITS + 30 {
+            x.push(290.0 + (k % 20) as f64 * 0.7);
+            y.push(232.0 + (k / 20) as f64 * 0.8);
+        }
+        sets.push((x, y));
+        let mut later_eights = 0;
+        for (x, y) in &sets {
+            later_eights += eights_agree::<u8>(BOUNDS, x, y);
+            later_eights += eights_agree::<u32>(BOUNDS, x, y);
+        }
+        assert!(
+            later_eights > 100,
+            "{later_eights} hits past a row's first eight"
+        );
+    }
+
+    #[test]
+    fn mueller_density_in_lanes_has_the_same_bits_one_candidate_or_eight_at_a_time() {
+        use crate::sph::neighbors::NeighborLists;
+        use crate::sph::params::Preset;
+        use crate::sph::passes::density_pressure;
+
+        // Sparse to crowded, with a pile past the scratch's limit: the eights' path (packing
+        // lanes, on any machine) and the one-at-a-time path (portable) give the same density
+        // and list for every particle.
+        let prm = Preset::Seed.params();
+        let (mut x, mut y) = scattered(3000);
+        for k in 0..INLINE_HITS + 30 {
+            x.push(290.0 + (k % 20) as f64 * 0.7);
+            y.push(232.0 + (k / 20) as f64 * 0.8);
+        }
+        let pos = Positions { x: &x, y: &y };
+        let grid = grid_over::<u32, InCellOrder>(&x, &y);
+        let density = |i: usize, packing: bool| {
+            let mut lists = NeighborLists::<u32>::with_slots(1, 32);
+            let (counts, mut slots) = lists.split_mut();
+            let (scratch, list) = (&mut GridScratch::default(), slots.particle(0));
+            let (rho, p, count) = if packing {
+                density_pressure(i, scratch, PackingPortable, pos, &grid, &prm, list)
+            } else {
+                density_pressure(i, scratch, Portable, pos, &grid, &prm, list)
+            };
+            counts[0] = count;
+            let listed = lists.of(0).map(<[u32]>::to_vec);
+            (rho.to_bits(), p.to_bits(), count, listed)
+        };
+        let mut crowded = 0;
+        for i in 0..x.len() {
+            let (one, eight) = (density(i, false), density(i, true));
+            assert_eq!(one, eight, "particle {i}");
+            crowded += usize::from(one.2 > 8);
+        }
+        assert!(
+            crowded > 100,
+            "{crowded} particles with more than 8 neighbours"
+        );
+    }
+
+    #[test]
+    fn only_a_grid_in_cell_order_of_up_to_cell_lanes_max_particles_sums_in_lanes() {
+        use crate::sph::neighbors::CELL_LANES_MAX;
+
+        for n in [1, CELL_LANES_MAX, CELL_LANES_MAX + 1] {
+            let (x, y) = scattered(n);
+            let small = n <= CELL_LANES_MAX;
+            assert_eq!(grid_over::<u8, InCellOrder>(&x, &y).sums_in_lanes(), small);
+            assert_eq!(grid_over::<u32, InCellOrder>(&x, &y).sums_in_lanes(), small);
+            assert!(!grid_over::<u32, InIndexOrder>(&x, &y).sums_in_lanes());
+        }
+        assert!(!AllPairs.sums_in_lanes());
+    }
+
+    #[test]
+    fn all_pairs_eights_hold_its_hits_in_index_order_eight_a_call() {
+        let (x, y) = scattered(600);
+        let pos = Positions { x: &x, y: &y };
+        for i in 0..x.len() {
+            let calls = eights(&AllPairs, i, pos, Portable);
+            let mut want = Vec::new();
+            AllPairs.for_each_within(&mut (), Portable, i, pos, H * H, |j, r2, key| {
+                want.push((j, r2.to_bits(), key))
+            });
+            let flat: Vec<_> = calls.iter().flat_map(|(_, hits)| hits.clone()).collect();
+            assert_eq!(flat, want, "particle {i}");
+            assert_eq!(in_lanes(&AllPairs, i, pos, Portable), by_lane(&calls));
+            let full = calls.len().saturating_sub(1);
+            assert!(calls[..full].iter().all(|(bits, _)| *bits == u8::MAX));
+            assert!(
+                calls.iter().all(|(bits, _)| (bits + 1) & bits == 0),
+                "lanes from 0"
+            );
+        }
     }
 
     #[test]
