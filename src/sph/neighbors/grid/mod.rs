@@ -395,13 +395,7 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         let n = self.order.len();
         let (xs, ys, order) = (&self.sorted_x[..n], &self.sorted_y[..n], &self.order[..n]);
         let candidates = block.candidates();
-        let [_, b1, b2] = block.base;
-        // The candidate at position t is the (t − base)-th of its row.
-        let lane = |t: u32| {
-            let row_base = select_unpredictable(t >= b1, b1, 0);
-            let row_base = select_unpredictable(t >= b2, b2, row_base);
-            ((t - row_base) & 7) as usize
-        };
+        let lane = |t: u32| (block.place_in_row(t) % 8) as usize;
         if candidates <= ONE_LOOP_MAX {
             let slots = block.slots();
             for t in 0..candidates {
@@ -662,6 +656,16 @@ impl<K: GridKey, O> Grid<K, O> {
 }
 
 impl Block {
+    /// The place of the candidate at `position` in its row (0 for a row's first), without a
+    /// branch, whichever row it is in.
+    #[inline(always)]
+    fn place_in_row(&self, position: u32) -> u32 {
+        let [_, b1, b2] = self.base;
+        let first = select_unpredictable(position >= b1, b1, 0);
+        let first = select_unpredictable(position >= b2, b2, first);
+        position - first
+    }
+
     /// The block's candidates.
     #[inline(always)]
     fn candidates(&self) -> u32 {
