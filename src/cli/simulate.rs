@@ -169,9 +169,10 @@ pub(crate) fn warn_if_alone(passes: u64, strategy: &str, cores: usize) {
 pub(crate) fn alone_note(passes: u64, strategy: &str, cores: usize) -> Option<String> {
     (passes > 0).then(|| {
         format!(
-            "{strategy} ran {} on one thread: its threads got less than {cores} cores' CPU \
-             time (another program busy, or a stall of the machine), so it left them to that \
-             work for a while; this run's time is not a {cores}-core time",
+            "{strategy} ran {} on one thread: its threads got less CPU time than its \
+             chunks had work for on {cores} cores (another program busy, or a stall of the \
+             machine), so it left them to that work for a while; this run's time is not a \
+             {cores}-core time",
             console::plural(passes as usize, "pass", "passes")
         )
     })

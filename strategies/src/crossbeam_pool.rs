@@ -188,6 +188,7 @@ impl Executor for PoolExecutor<'_> {
             return Ok(());
         }
         let chunks = balanced_chunks(out, self.chunks);
+        let chunk_count = chunks.len();
         // Not empty (`out` is not), so the capacity is at least 1 as `ArrayQueue` requires.
         let queue = ArrayQueue::new(chunks.len());
         for chunk in chunks {
@@ -214,7 +215,7 @@ impl Executor for PoolExecutor<'_> {
             degrade.before_parallel_pass(|| self.clocks.total());
             let start = std::time::Instant::now();
             let escaped = self.board.run(&job);
-            degrade.after_parallel_pass(start.elapsed());
+            degrade.after_parallel_pass(start.elapsed(), chunk_count);
             escaped
         };
 
@@ -296,6 +297,41 @@ mod tests {
                 "a pass with help is not counted"
             );
         });
+    }
+
+    #[test]
+    fn passes_of_one_chunk_never_run_alone_however_little_cpu_they_use() {
+        // One chunk per pass keeps one thread busy: there is no help to give up, so the
+        // sleeping kernel (next to no CPU time over many windows) is not taken for a machine
+        // whose other work took the cores.
+        let (board, clocks) = (JobBoard::new(), ThreadClocks::new(2));
+        let executor = PoolExecutor {
+            board: &board,
+            clocks: &clocks,
+            threads: 2,
+            chunks: 1,
+            degrade: RefCell::new(Degrade::new(2, 2)),
+            not_sync: PhantomData,
+        };
+        clocks.register(0);
+        std::thread::scope(|s| {
+            let _stop = ShutDownOnDrop(&board);
+            s.spawn(|| {
+                clocks.register(1);
+                board.serve();
+            });
+            for _ in 0..40 {
+                let mut out = [0u8; 16];
+                executor
+                    .for_each_chunk(&mut out[..], |_, chunk| {
+                        std::thread::sleep(std::time::Duration::from_micros(600));
+                        chunk.fill(1);
+                    })
+                    .unwrap();
+                assert!(out.iter().all(|&v| v == 1));
+            }
+        });
+        assert_eq!(executor.passes_alone(), 0);
     }
 
     #[test]

@@ -37,6 +37,15 @@
 //! N = 10⁶ and ran all its passes alone. Only the allowance is discounted, so a long cold pass
 //! on shared cores is still judged.
 //!
+//! A pass cannot use more threads than its chunks keep busy: k equal chunks on p threads take
+//! ⌈k/p⌉ rounds, so the pass holds k/⌈k/p⌉ threads' worth of work ([`parallelism`]; 16 chunks
+//! on 12 threads: two rounds, 8 threads' worth), and the threads without a chunk soon sleep.
+//! Each pass is measured against that, not against p. Measured against p, a quiet 16-core
+//! machine ran 20 of the 30 passes of a 10-step run at N = 10⁶ alone with 16 chunks on 12 or
+//! 16 threads (and said that other work had taken the cores), and a quiet 2-core one ran
+//! every pass alone with 1 chunk and a few with 3. A pass of one chunk has no help to give up
+//! and is not judged.
+//!
 //! One short window alone is not enough, because a quiet machine has short moments too: the
 //! first window of a run at N = 10⁶ (the first touches of the warm-up's memory), a page-fault
 //! storm, the virtual machine's host taking a core for a few milliseconds, a program starting
@@ -69,22 +78,31 @@ pub(crate) const FIRST_SOLO_TIME: Duration = Duration::from_millis(20);
 /// The most passes run alone before help is asked for again.
 pub(crate) const MAX_SOLO: u32 = 4096;
 
-/// Whether a window in which the process used `cpu` over `wall` with a pool of `threads`
-/// threads (at most the CPUs they may use) fell short of its cores.
-pub(crate) fn short_of_cores(threads: usize, cpu: Duration, wall: Duration) -> bool {
-    if threads < 2 || wall.is_zero() {
-        return false;
-    }
-    cpu.as_secs_f64() / wall.as_secs_f64() < threads as f64 - SHORTFALL
+/// How many of `threads` threads a pass of `chunks` equal chunks keeps busy: the chunks over
+/// the rounds they take (see the module's docs).
+pub(crate) fn parallelism(threads: usize, chunks: usize) -> f64 {
+    let (threads, chunks) = (threads.max(1), chunks.max(1));
+    chunks as f64 / chunks.div_ceil(threads) as f64
 }
 
-/// A measuring window: when it started, the CPU time then, and the time spent inside passes
-/// since.
+/// Whether passes that used `cpu` over `wall`, with work for `parallelism` threads (at most
+/// the CPUs they may use), fell short of their cores.
+pub(crate) fn short_of_cores(parallelism: f64, cpu: Duration, wall: Duration) -> bool {
+    if parallelism <= 1.0 || wall.is_zero() {
+        return false;
+    }
+    cpu.as_secs_f64() / wall.as_secs_f64() < parallelism - SHORTFALL
+}
+
+/// A measuring window: when it started, the CPU time then, the time spent inside passes
+/// since, and the thread-time those passes had work for (each pass's time × its
+/// [`parallelism`]).
 #[derive(Debug, Clone, Copy)]
 struct Window {
     wall: Instant,
     cpu: Duration,
     in_passes: Duration,
+    work: Duration,
 }
 
 /// The degradation state of one session (used by its thread only).
@@ -166,6 +184,7 @@ impl Degrade {
                     wall: now,
                     cpu,
                     in_passes: Duration::ZERO,
+                    work: Duration::ZERO,
                 });
             }
             Some(w) if now - w.wall >= WINDOW && w.in_passes >= MIN_IN_PASSES => {
@@ -175,19 +194,20 @@ impl Degrade {
                 // The serial work between passes ran on one thread.
                 let serial = wall.saturating_sub(w.in_passes);
                 let in_passes_cpu = cpu.saturating_sub(w.cpu).saturating_sub(serial);
-                self.decide_at(now, in_passes_cpu, w.in_passes);
+                let parallelism = w.work.as_secs_f64() / w.in_passes.as_secs_f64();
+                self.decide_at(now, in_passes_cpu, w.in_passes, parallelism);
             }
             Some(_) => {}
         }
     }
 
-    /// Called after a pass with help that took `elapsed`.
-    pub(crate) fn after_parallel_pass(&mut self, elapsed: Duration) {
-        self.after_parallel_pass_at(Instant::now(), elapsed);
+    /// Called after a pass with help of `chunks` chunks that took `elapsed`.
+    pub(crate) fn after_parallel_pass(&mut self, elapsed: Duration, chunks: usize) {
+        self.after_parallel_pass_at(Instant::now(), elapsed, chunks);
     }
 
     /// [`Degrade::after_parallel_pass`] at the instant `now`.
-    fn after_parallel_pass_at(&mut self, now: Instant, elapsed: Duration) {
+    fn after_parallel_pass_at(&mut self, now: Instant, elapsed: Duration, chunks: usize) {
         self.last_end = Some(now);
         let counted = if self.cold {
             elapsed.saturating_sub(WAKE_ALLOWANCE)
@@ -196,14 +216,16 @@ impl Degrade {
         };
         if let Some(w) = &mut self.window {
             w.in_passes += counted;
+            w.work += counted.mul_f64(parallelism(self.threads, chunks));
         }
     }
 
-    /// Ends a window whose passes used `cpu` over `wall`, at the instant `now`. A short window
-    /// right after one that was not short only raises a suspicion: the pool runs alone once a
-    /// second window in a row is short too (see the module's docs).
-    fn decide_at(&mut self, now: Instant, cpu: Duration, wall: Duration) {
-        if !short_of_cores(self.threads, cpu, wall) {
+    /// Ends a window whose passes used `cpu` over `wall` with work for `parallelism` threads,
+    /// at the instant `now`. A short window right after one that was not short only raises a
+    /// suspicion: the pool runs alone once a second window in a row is short too (see the
+    /// module's docs).
+    fn decide_at(&mut self, now: Instant, cpu: Duration, wall: Duration, parallelism: f64) {
+        if !short_of_cores(parallelism, cpu, wall) {
             (self.span, self.suspect) = (0, false);
         } else if self.span == 0 && !self.suspect {
             self.suspect = true;
@@ -256,13 +278,13 @@ mod tests {
 
     #[test]
     fn a_pool_that_gets_its_cores_is_not_short_and_one_that_shares_them_is() {
-        assert!(!short_of_cores(2, ms(198), ms(100)));
+        assert!(!short_of_cores(2.0, ms(198), ms(100)));
         assert!(
-            short_of_cores(2, ms(100), ms(100)),
+            short_of_cores(2.0, ms(100), ms(100)),
             "two threads on one core"
         );
         assert!(
-            !short_of_cores(1, ms(10), ms(100)),
+            !short_of_cores(1.0, ms(10), ms(100)),
             "one thread never degrades"
         );
         // 4 threads on a 2-core machine are capped at 2: oversubscription is not contention.
@@ -274,12 +296,12 @@ mod tests {
     fn two_short_windows_in_a_row_make_the_pool_run_alone_and_one_alone_does_not() {
         let (short, full) = ((ms(100), ms(100)), (ms(200), ms(100)));
         let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
-        d.decide_at(t0, short.0, short.1);
+        d.decide_at(t0, short.0, short.1, 2.0);
         assert!(!d.solo_pass_at(t0), "one short window is only a suspicion");
-        d.decide_at(t0, full.0, full.1);
-        d.decide_at(t0, short.0, short.1);
+        d.decide_at(t0, full.0, full.1, 2.0);
+        d.decide_at(t0, short.0, short.1, 2.0);
         assert!(!d.solo_pass_at(t0), "a full window in between cleared it");
-        d.decide_at(t0, short.0, short.1);
+        d.decide_at(t0, short.0, short.1, 2.0);
         assert_eq!((0..10_000).filter(|_| d.solo_pass_at(t0)).count(), 64);
     }
 
@@ -287,19 +309,19 @@ mod tests {
     fn short_windows_make_the_solo_periods_double_and_a_full_window_ends_them() {
         let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
         assert!(!d.solo_pass_at(t0));
-        d.decide_at(t0, ms(100), ms(100));
-        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100), 2.0);
+        d.decide_at(t0, ms(100), ms(100), 2.0);
         assert_eq!((0..10_000).filter(|_| d.solo_pass_at(t0)).count(), 64);
-        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100), 2.0);
         assert_eq!((0..10_000).filter(|_| d.solo_pass_at(t0)).count(), 128);
-        d.decide_at(t0, ms(200), ms(100));
+        d.decide_at(t0, ms(200), ms(100), 2.0);
         assert!(!d.solo_pass_at(t0));
-        d.decide_at(t0, ms(100), ms(100));
-        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100), 2.0);
+        d.decide_at(t0, ms(100), ms(100), 2.0);
         assert_eq!((0..10_000).filter(|_| d.solo_pass_at(t0)).count(), 64);
         assert_eq!(d.solo_total(), 256);
         for _ in 0..20 {
-            d.decide_at(t0, ms(100), ms(100));
+            d.decide_at(t0, ms(100), ms(100), 2.0);
         }
         assert_eq!(
             (0..10_000).filter(|_| d.solo_pass_at(t0)).count(),
@@ -310,16 +332,16 @@ mod tests {
     #[test]
     fn forgetting_ends_a_period_alone_and_a_suspicion_and_keeps_the_count() {
         let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
-        d.decide_at(t0, ms(100), ms(100));
-        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100), 2.0);
+        d.decide_at(t0, ms(100), ms(100), 2.0);
         assert!(d.solo_pass_at(t0));
         d.forget();
         assert!(!d.solo_pass_at(t0), "no longer alone");
         assert_eq!(d.solo_total(), 1);
         // A short window before forgetting no longer counts as the first of two.
-        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100), 2.0);
         d.forget();
-        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100), 2.0);
         assert!(!d.solo_pass_at(t0));
         assert_eq!(d.threads(), 2);
     }
@@ -327,8 +349,8 @@ mod tests {
     #[test]
     fn passes_alone_end_after_their_time_however_few_ran() {
         let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
-        d.decide_at(t0, ms(100), ms(100));
-        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100), 2.0);
+        d.decide_at(t0, ms(100), ms(100), 2.0);
         assert_eq!(FIRST_SOLO_TIME, ms(20));
         // Long passes: three alone in the first 20 ms, then help is asked for again.
         for t in [1, 10, 19] {
@@ -342,18 +364,66 @@ mod tests {
         assert_eq!(d.solo_total(), 3);
         // Still short: the next period is twice as long, in passes and in time.
         let t1 = t0 + ms(30);
-        d.decide_at(t1, ms(100), ms(100));
+        d.decide_at(t1, ms(100), ms(100), 2.0);
         assert!(d.solo_pass_at(t1 + ms(39)));
         assert!(!d.solo_pass_at(t1 + ms(40)));
-        d.decide_at(t1, ms(100), ms(100));
+        d.decide_at(t1, ms(100), ms(100), 2.0);
         assert_eq!((0..10_000).filter(|_| d.solo_pass_at(t1)).count(), 256);
     }
 
-    /// A pass of `len` starting at `t` (ms since `t0`), with the CPU clock reading `cpu`.
+    /// A pass of `len` starting at `t` (ms since `t0`), with the CPU clock reading `cpu`, in
+    /// as many chunks as the pool has threads.
     fn pass(d: &mut Degrade, t0: Instant, t: f64, len: f64, cpu: f64) {
+        let chunks = d.threads;
+        pass_of(d, t0, t, len, cpu, chunks);
+    }
+
+    /// [`pass`] in `chunks` chunks.
+    fn pass_of(d: &mut Degrade, t0: Instant, t: f64, len: f64, cpu: f64, chunks: usize) {
         let at = |ms: f64| t0 + Duration::from_secs_f64(ms / 1000.0);
         d.before_parallel_pass_at(at(t), || Some(Duration::from_secs_f64(cpu / 1000.0)));
-        d.after_parallel_pass_at(at(t + len), Duration::from_secs_f64(len / 1000.0));
+        d.after_parallel_pass_at(at(t + len), Duration::from_secs_f64(len / 1000.0), chunks);
+    }
+
+    #[test]
+    fn a_pass_keeps_busy_the_threads_its_chunks_fill_in_their_rounds() {
+        assert_eq!(parallelism(12, 16), 8.0, "two rounds: 12 chunks, then 4");
+        assert_eq!(parallelism(16, 16), 16.0);
+        assert_eq!(parallelism(2, 1), 1.0);
+        assert_eq!(parallelism(2, 3), 1.5);
+        assert_eq!(parallelism(2, 50), 50.0 / 25.0);
+        assert_eq!(parallelism(12, 256), 256.0 / 22.0);
+        assert_eq!(parallelism(0, 0), 1.0, "no threads or chunks count as one");
+    }
+
+    /// Two windows of 10 passes of 1 ms each in `chunks` chunks on `threads` threads, whose
+    /// CPU clock runs at `busy` threads per second of pass; whether the pool then runs alone.
+    fn runs_alone_after(threads: usize, chunks: usize, busy: f64) -> bool {
+        let (mut d, t0) = (Degrade::new(threads, threads), Instant::now());
+        let mut cpu = 0.0;
+        for k in 0..=20 {
+            let t = f64::from(k) * 0.6;
+            pass_of(&mut d, t0, t, 0.5, cpu, chunks);
+            cpu += 0.5 * busy;
+        }
+        d.solo_pass_at(t0)
+    }
+
+    #[test]
+    fn a_pass_is_judged_by_the_threads_its_chunks_keep_busy_not_by_the_pools_size() {
+        // 16 chunks on 12 threads keep 8 busy: 8 threads' CPU is every core they could use,
+        // 4 threads' is short.
+        assert!(!runs_alone_after(12, 16, 8.0));
+        assert!(runs_alone_after(12, 16, 4.0));
+        assert!(runs_alone_after(12, 24, 8.0), "24 chunks keep all 12 busy");
+        // One chunk has no help to give up, however little CPU its pass used; two do.
+        assert!(!runs_alone_after(2, 1, 0.5));
+        assert!(runs_alone_after(2, 2, 1.0));
+        assert!(
+            !runs_alone_after(2, 3, 1.5),
+            "3 chunks on 2 threads: 1.5 threads' work"
+        );
+        assert!(runs_alone_after(2, 3, 0.9));
     }
 
     #[test]
@@ -361,7 +431,7 @@ mod tests {
         // The CPU clock says nothing was used: a shortfall, once the window is long enough
         // (after a short window already, so that this one decides).
         let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
-        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100), 2.0);
         pass(&mut d, t0, 0.0, 0.5, 0.0); // opens the window; wakes the workers (serial)
         pass(&mut d, t0, 0.55, 1.0, 0.0);
         pass(&mut d, t0, 1.6, 0.0, 0.0);
@@ -395,7 +465,7 @@ mod tests {
         // one thread: only the allowance is discounted, so the window closes and is short
         // (the second short window in a row).
         let (mut d, t0) = (Degrade::new(2, 2), Instant::now());
-        d.decide_at(t0, ms(100), ms(100));
+        d.decide_at(t0, ms(100), ms(100), 2.0);
         pass(&mut d, t0, 0.0, 8.0, 0.0);
         pass(&mut d, t0, 10.0, 0.0, 10.0);
         assert!(d.solo_pass_at(t0));
