@@ -11,7 +11,9 @@
 use sph_strategies::{Executor, KernelPanic};
 
 use super::{Pass, Simulation, StepError};
+use crate::simd::Lanes;
 use crate::sph::physics::Physics;
+use crate::with_lanes;
 
 /// What a kernel call computes: part of the neighbour search's rebuild (the grid's, which
 /// runs its per-particle parts on the executor), or one of the model's passes.
@@ -191,20 +193,22 @@ impl Simulation {
         // later. So checking velocities, densities and pressures (4 arrays rather than 8)
         // catches every divergence in the step it happens; the full scan then names the
         // first field.
-        let s = &self.state;
+        let (s, lanes) = (&self.state, self.lanes);
         let finite = if s.len() < PARALLEL_CHECK {
-            s.velocities_finite() && s.densities_finite() && s.pressures_finite()
+            with_lanes!(lanes, l => l.vectorize(
+                #[inline(always)]
+                || s.guarded_fields_finite(0..s.len())
+            ))
         } else {
             let mut ok = vec![true; s.len().div_ceil(CHECK_BLOCK)];
             exec.for_each_chunk(&mut ok[..], |first, ok| {
                 for (b, ok) in ok.iter_mut().enumerate() {
                     let start = (first + b) * CHECK_BLOCK;
                     let block = start..(start + CHECK_BLOCK).min(s.len());
-                    *ok = [&s.vx, &s.vy, &s.rho, &s.p].iter().all(|field| {
-                        field[block.clone()]
-                            .iter()
-                            .fold(true, |ok, v| ok & v.is_finite())
-                    });
+                    *ok = with_lanes!(lanes, l => l.vectorize(
+                        #[inline(always)]
+                        || s.guarded_fields_finite(block)
+                    ));
                 }
             })?;
             ok.iter().all(|&ok| ok)
