@@ -46,6 +46,14 @@
 //! every pass alone with 1 chunk and a few with 3. A pass of one chunk has no help to give up
 //! and is not judged.
 //!
+//! And running alone pays only when the pool gets little more than what one thread alone
+//! gets, one core's worth: the pool runs alone only below [`ALONE_BELOW`] (1.5) cores' worth,
+//! whatever its size. On two threads that is the shortfall above; on more it is far below it.
+//! Judged by the shortfall alone, even measured against its chunks, a pool of 16 threads on a
+//! quiet 16-core machine (chunks of unequal work: the threads done first sleep until the pass
+//! ends) ran 15–20 of a 10-step run's passes alone at N = 10⁶ with 16 and 64 chunks, and took
+//! 0.18–0.40 s where 256 chunks, no pass alone, took 0.11 s.
+//!
 //! One short window alone is not enough, because a quiet machine has short moments too: the
 //! first window of a run at N = 10⁶ (the first touches of the warm-up's memory), a page-fault
 //! storm, the virtual machine's host taking a core for a few milliseconds, a program starting
@@ -65,6 +73,11 @@ pub(crate) const WINDOW: Duration = Duration::from_millis(5);
 pub(crate) const MIN_IN_PASSES: Duration = Duration::from_millis(2);
 /// How many cores' worth of CPU time may be missing before the pool runs alone.
 pub(crate) const SHORTFALL: f64 = 0.5;
+/// The pool runs alone only when its passes get less than this many cores' worth of CPU time,
+/// however many threads they had work for: alone, the session's thread gets one core's worth,
+/// without hand-overs and without waiting for a descheduled thread; a pool that gets more is
+/// faster than that (see the module's docs).
+pub(crate) const ALONE_BELOW: f64 = 2.0 - SHORTFALL;
 /// How much of a pass that wakes sleeping workers counts as serial work.
 /// (1 ms still misfired in 6 runs of 8 at N = 10⁶ on the 2-core VM: its wake-ups can take
 /// milliseconds, and a short pass may end before the worker arrives.)
@@ -86,12 +99,13 @@ pub(crate) fn parallelism(threads: usize, chunks: usize) -> f64 {
 }
 
 /// Whether passes that used `cpu` over `wall`, with work for `parallelism` threads (at most
-/// the CPUs they may use), fell short of their cores.
+/// the CPUs they may use), fell so short of their cores that one thread alone would do as
+/// well: less than `parallelism` − [`SHORTFALL`] cores' worth, and less than [`ALONE_BELOW`].
 pub(crate) fn short_of_cores(parallelism: f64, cpu: Duration, wall: Duration) -> bool {
     if parallelism <= 1.0 || wall.is_zero() {
         return false;
     }
-    cpu.as_secs_f64() / wall.as_secs_f64() < parallelism - SHORTFALL
+    cpu.as_secs_f64() / wall.as_secs_f64() < (parallelism - SHORTFALL).min(ALONE_BELOW)
 }
 
 /// A measuring window: when it started, the CPU time then, the time spent inside passes
@@ -410,12 +424,27 @@ mod tests {
     }
 
     #[test]
+    fn a_large_pool_runs_alone_only_when_it_gets_less_than_one_and_a_half_cores() {
+        // 16 threads with work for all: 14 cores' worth (unequal chunks, a thread descheduled
+        // now and then) is 14 times what one thread alone gets; 1.4 is not even 1.5.
+        assert!(!runs_alone_after(16, 16, 14.0));
+        assert!(!runs_alone_after(16, 64, 3.0));
+        assert!(runs_alone_after(16, 64, 1.4));
+        assert_eq!(
+            ALONE_BELOW, 1.5,
+            "on two threads, the shortfall's own threshold"
+        );
+        assert!(!short_of_cores(2.0, ms(151), ms(100)));
+        assert!(short_of_cores(2.0, ms(149), ms(100)));
+    }
+
+    #[test]
     fn a_pass_is_judged_by_the_threads_its_chunks_keep_busy_not_by_the_pools_size() {
-        // 16 chunks on 12 threads keep 8 busy: 8 threads' CPU is every core they could use,
-        // 4 threads' is short.
+        // 16 chunks on 12 threads keep 8 busy: 8 threads' CPU is every core they could use.
         assert!(!runs_alone_after(12, 16, 8.0));
-        assert!(runs_alone_after(12, 16, 4.0));
-        assert!(runs_alone_after(12, 24, 8.0), "24 chunks keep all 12 busy");
+        // 3 chunks on 2 threads keep 1.5 busy: 1.2 cores' worth is not short of that, though
+        // short of the two threads.
+        assert!(!runs_alone_after(2, 3, 1.2));
         // One chunk has no help to give up, however little CPU its pass used; two do.
         assert!(!runs_alone_after(2, 1, 0.5));
         assert!(runs_alone_after(2, 2, 1.0));
