@@ -19,15 +19,15 @@ fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
     LIVE.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// Makes Ctrl-C, SIGTERM or SIGHUP remove every temporary file being written, then exit with
-/// status 130 (the destinations keep their earlier contents). Harmless to call twice; a
-/// process has one handler.
+/// Makes Ctrl-C remove every temporary file being written, then exit with status 130 (the
+/// destinations keep their earlier contents). Harmless to call twice; a process has one
+/// handler.
 pub fn remove_temporaries_on_ctrl_c() {
     let _ = ctrlc::set_handler(|| {
         for tmp in live().iter() {
             let _ = std::fs::remove_file(tmp);
         }
-        super::console::warn("\nCtrl-C or termination signal: stopped; nothing was written");
+        super::console::warn("\nCtrl-C: stopped; nothing was written");
         std::process::exit(130);
     });
 }

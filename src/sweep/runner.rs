@@ -39,20 +39,17 @@ pub fn interrupted() -> bool {
     INTERRUPTED.load(Ordering::SeqCst) || crate::output::console::closed()
 }
 
-/// Makes Ctrl-C, SIGTERM or SIGHUP (a batch system's time limit, `timeout`, a closed
-/// terminal) stop the sweep between runs; a second one exits at once. Harmless to call twice:
-/// a process has one handler.
+/// Makes Ctrl-C stop the sweep between runs (a second Ctrl-C exits at once). Harmless to
+/// call twice: a process has one handler.
 pub fn install_ctrlc_handler() {
     let _ = ctrlc::set_handler(|| {
         if INTERRUPTED.swap(true, Ordering::SeqCst) {
-            crate::output::console::warn(
-                "\nCtrl-C or termination signal again: quitting now; finished cells are saved",
-            );
+            crate::output::console::warn("\nCtrl-C again: quitting now; finished cells are saved");
             std::process::exit(130);
         }
         crate::output::console::warn(
-            "\nCtrl-C or termination signal: stopping after the current run; the cell in \
-             progress is discarded (Ctrl-C again to quit at once)",
+            "\nCtrl-C: stopping after the current run; the cell in progress is discarded \
+             (Ctrl-C again to quit at once)",
         );
     });
 }
