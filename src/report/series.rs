@@ -158,7 +158,7 @@ pub struct Point {
     /// Whether the cell used more threads than the machine has.
     pub oversubscribed: bool,
     /// Whether other work used the machine while the cell was measured (or a trial ran
-    /// passes alone: its threads got less than its cores).
+    /// passes alone: its threads got less CPU time than its chunks had work for).
     pub contended: bool,
 }
 

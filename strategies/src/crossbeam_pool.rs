@@ -34,8 +34,9 @@
 //! session's thread finds no chunk left, and only the workers already inside it (each busy
 //! with a chunk it took) are waited for. A descheduled worker thus costs the pass its help,
 //! not a scheduling round-trip. And when the pool's threads do not get their cores at all
-//! (their CPU time falls short of their number × wall time; read from each thread's own
-//! clock, see `thread_clocks`), the session's thread runs
+//! (their CPU time, read from each thread's own clock (see `thread_clocks`), falls short of
+//! what the passes' chunks could keep busy, and below 1.5 cores' worth), the session's thread
+//! runs
 //! the next passes alone for a while (see the `degrade` module), so a 2-core run on a shared
 //! machine does not fall below the strategy's own 1-core speed. The results are the same
 //! bits.

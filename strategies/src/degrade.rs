@@ -14,7 +14,8 @@
 //! counts), and one CPU-second per second of the serial work between passes (the session's
 //! thread alone, the workers asleep), so the CPU time beyond the serial work, divided by the
 //! time in passes, falling short of p by more than [`SHORTFALL`] means the cores are
-//! shared. Once two windows in a row are short, the next passes run on the session's thread
+//! shared (p: the threads the passes' chunks keep busy, and the pool runs alone only below
+//! [`ALONE_BELOW`] cores' worth; both below). Once two windows in a row are short, the next passes run on the session's thread
 //! alone (the workers sleep and leave their cores to the competing work): [`FIRST_SOLO`]
 //! passes or [`FIRST_SOLO_TIME`], whichever ends first, both doubling while the shortfall
 //! persists, up to [`MAX_SOLO`] passes; then a window asks for help again, and a window
@@ -71,7 +72,8 @@ use std::time::{Duration, Instant};
 pub(crate) const WINDOW: Duration = Duration::from_millis(5);
 /// The least time inside passes a window must hold to be judged.
 pub(crate) const MIN_IN_PASSES: Duration = Duration::from_millis(2);
-/// How many cores' worth of CPU time may be missing before the pool runs alone.
+/// How many cores' worth of CPU time may be missing from what the passes' chunks could keep
+/// busy ([`parallelism`]) before a window is short (and then only below [`ALONE_BELOW`]).
 pub(crate) const SHORTFALL: f64 = 0.5;
 /// The pool runs alone only when its passes get less than this many cores' worth of CPU time,
 /// however many threads they had work for: alone, the session's thread gets one core's worth,
@@ -410,15 +412,16 @@ mod tests {
         assert_eq!(parallelism(0, 0), 1.0, "no threads or chunks count as one");
     }
 
-    /// Two windows of 10 passes of 1 ms each in `chunks` chunks on `threads` threads, whose
-    /// CPU clock runs at `busy` threads per second of pass; whether the pool then runs alone.
+    /// 21 passes of 0.5 ms, one every 0.6 ms (two judged windows), in `chunks` chunks on
+    /// `threads` threads whose CPU clock runs at `busy` threads per second of pass and at one
+    /// between passes (the serial work); whether the pool then runs alone.
     fn runs_alone_after(threads: usize, chunks: usize, busy: f64) -> bool {
         let (mut d, t0) = (Degrade::new(threads, threads), Instant::now());
         let mut cpu = 0.0;
         for k in 0..=20 {
             let t = f64::from(k) * 0.6;
             pass_of(&mut d, t0, t, 0.5, cpu, chunks);
-            cpu += 0.5 * busy;
+            cpu += 0.5 * busy + 0.1;
         }
         d.solo_pass_at(t0)
     }
@@ -442,12 +445,16 @@ mod tests {
     fn a_pass_is_judged_by_the_threads_its_chunks_keep_busy_not_by_the_pools_size() {
         // 16 chunks on 12 threads keep 8 busy: 8 threads' CPU is every core they could use.
         assert!(!runs_alone_after(12, 16, 8.0));
-        // 3 chunks on 2 threads keep 1.5 busy: 1.2 cores' worth is not short of that, though
-        // short of the two threads.
+        // 3 chunks on 2 threads keep 1.5 busy: 1.2 cores' worth is not short of that (1.0 is
+        // the threshold), though short of the two threads (1.5).
         assert!(!runs_alone_after(2, 3, 1.2));
         // One chunk has no help to give up, however little CPU its pass used; two do.
         assert!(!runs_alone_after(2, 1, 0.5));
         assert!(runs_alone_after(2, 2, 1.0));
+        // The second window reads what the clock says (the first a little more: its first
+        // pass is cold); below and above 1.5 on two.
+        assert!(runs_alone_after(2, 2, 1.4));
+        assert!(!runs_alone_after(2, 2, 1.6));
         assert!(
             !runs_alone_after(2, 3, 1.5),
             "3 chunks on 2 threads: 1.5 threads' work"
