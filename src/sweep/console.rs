@@ -191,8 +191,8 @@ pub fn contended_cells(rows: &[SummaryRow]) -> Option<String> {
     let mut text = format!(
         "warning: {} saw other work on the machine or ran passes on one thread because their \
          threads got less CPU time than their chunks had work for (contended=true in \
-         summary.csv; passes_alone in trials.csv); their times are not trustworthy and the report leaves them out of its \
-         findings:",
+         summary.csv; passes_alone in trials.csv); their times are not trustworthy and the \
+         report leaves them out of its findings:",
         plural(names.len(), "cell", "cells")
     );
     for name in names {

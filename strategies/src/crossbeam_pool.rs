@@ -36,10 +36,9 @@
 //! not a scheduling round-trip. And when the pool's threads do not get their cores at all
 //! (their CPU time, read from each thread's own clock (see `thread_clocks`), falls short of
 //! what the passes' chunks could keep busy, and below 1.5 cores' worth), the session's thread
-//! runs
-//! the next passes alone for a while (see the `degrade` module), so a 2-core run on a shared
-//! machine does not fall below the strategy's own 1-core speed. The results are the same
-//! bits.
+//! runs the next passes alone for a while (see the `degrade` module), so a 2-core run on a
+//! shared machine does not fall below the strategy's own 1-core speed. The results are the
+//! same bits.
 //!
 //! **Panics.** A kernel panic is caught per chunk; the first one is returned as
 //! [`KernelPanic`] once the pass has finished, and the workers keep serving later passes.
