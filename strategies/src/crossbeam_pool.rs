@@ -257,20 +257,31 @@ mod tests {
         assert!(!all.contains(&std::thread::current().id()));
     }
 
+    /// A pool executor of two threads on `board` and `clocks`, cutting each pass into `chunks`,
+    /// in the degradation state `degrade` (the tests serve the board themselves).
+    fn two_thread_executor<'a>(
+        board: &'a JobBoard,
+        clocks: &'a ThreadClocks,
+        chunks: usize,
+        degrade: Degrade,
+    ) -> PoolExecutor<'a> {
+        PoolExecutor {
+            board,
+            clocks,
+            threads: 2,
+            chunks,
+            degrade: RefCell::new(degrade),
+            not_sync: PhantomData,
+        }
+    }
+
     #[test]
     fn passes_run_alone_are_counted_and_leave_the_workers_idle() {
         // One worker serves the board: a pass that asked for help would give it chunks (each
         // takes a millisecond); a pass run alone gives it none. The degraded state lasts 3
         // passes.
         let (board, clocks) = (JobBoard::new(), ThreadClocks::new(2));
-        let executor = PoolExecutor {
-            board: &board,
-            clocks: &clocks,
-            threads: 2,
-            chunks: 4,
-            degrade: RefCell::new(Degrade::alone_for(3)),
-            not_sync: PhantomData,
-        };
+        let executor = two_thread_executor(&board, &clocks, 4, Degrade::alone_for(3));
         let caller = std::thread::current().id();
         let pass = || {
             let mut out = [None; 16];
@@ -305,14 +316,7 @@ mod tests {
         // sleeping kernel (next to no CPU time over many windows) is not taken for a machine
         // whose other work took the cores.
         let (board, clocks) = (JobBoard::new(), ThreadClocks::new(2));
-        let executor = PoolExecutor {
-            board: &board,
-            clocks: &clocks,
-            threads: 2,
-            chunks: 1,
-            degrade: RefCell::new(Degrade::new(2, 2)),
-            not_sync: PhantomData,
-        };
+        let executor = two_thread_executor(&board, &clocks, 1, Degrade::new(2, 2));
         clocks.register(0);
         std::thread::scope(|s| {
             let _stop = ShutDownOnDrop(&board);
