@@ -58,6 +58,11 @@ impl Stopwatch {
         }
     }
 
+    /// Wall seconds since `start`, without reading the other clocks.
+    pub fn peek_wall_s(&self) -> f64 {
+        self.wall.elapsed().as_secs_f64()
+    }
+
     /// The time since `start`.
     pub fn stop(&self) -> Elapsed {
         let wall_s = self.wall.elapsed().as_secs_f64();

@@ -20,6 +20,11 @@
 /// may take before a trial counts as contended: 5 %.
 pub const CONTENDED_SHARE: f64 = 0.05;
 
+/// The shortest window over which a sweep judges contention, wall seconds: a tick per CPU at
+/// each end of it is then at most a fifth of the [`CONTENDED_SHARE`] the threshold allows (see
+/// `crate::sweep::windows`).
+pub const WINDOW_S: f64 = 1.0;
+
 /// The cumulative CPU counters of `/proc/stat`'s `cpu` line, in ticks.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CpuTicks {

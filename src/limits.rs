@@ -9,8 +9,10 @@
 //! | `--steps` | 1 ..= [`MAX_STEPS`] | |
 //! | `--resolution` (`wcsph`) | 4 ..= 400 ([`crate::sph::wcsph::params::RESOLUTIONS`]) | below 4 the column has no interior; 400 is 320 000 fluid particles |
 //! | `--t-end` | 0 < t ≤ [`MAX_T_END_S`] s | far beyond the dam breaks (Martin & Moyce's data ends at 0.77 s; `wcsph`'s fluid splashes over the 2.5a walls after about 1.3 s, which ends the run with an error) |
-//! | `--trials` | 1 ..= [`MAX_TRIALS`] | |
+//! | `--trials` | 1 ..= [`MAX_TRIALS`] | the grid's rounds |
+//! | `--confirm-rounds` | 0 ..= [`MAX_TRIALS`] | |
 //! | `--warmup` | 0 ..= [`MAX_WARMUP`] | |
+//! | `--wait-quiet` | 0 ..= [`MAX_WAIT_QUIET_S`] s | an hour before each round is already a machine that will not calm down; the sweep then measures anyway and flags the cells |
 //! | a sweep's cells | at most [`MAX_CELLS`] | the product of its lists |
 //! | `--shard I/K` | 1 ≤ I ≤ K ≤ [`MAX_SHARDS`] (1024) | as many nodes as `--cores` allows threads; a shard also repeats its groups' `seq` cells, so far more shards than cells only wastes node time |
 
@@ -26,8 +28,10 @@ pub const MAX_STEPS: usize = 1_000_000_000;
 pub const MAX_T_END_S: f64 = 100.0;
 /// The most timed trials per cell of a sweep.
 pub const MAX_TRIALS: usize = 1000;
-/// The most untimed warm-up runs per cell of a sweep.
+/// The most untimed warm-up runs per cell (or group) of a sweep.
 pub const MAX_WARMUP: usize = 1000;
+/// The longest `sweep --wait-quiet` waits for a quiet machine before a round, s.
+pub const MAX_WAIT_QUIET_S: usize = 3600;
 /// The most cells one sweep may plan (the lists multiply: cores × chunks × N × …); far
 /// beyond any study that finishes, and small enough that the plan itself fits in memory.
 pub const MAX_CELLS: usize = 1_000_000;

@@ -241,6 +241,24 @@ fn trials(s: &str) -> Result<usize, String> {
     count(s, "trials", limits::MAX_TRIALS)
 }
 
+/// Confirmation rounds: 0 ..= [`limits::MAX_TRIALS`].
+fn confirm_rounds(s: &str) -> Result<usize, String> {
+    let v = s
+        .parse::<usize>()
+        .map_err(|_| format!("'{s}' is not a whole number of at least 0"))?;
+    limits::check("confirmation rounds", v, 0, limits::MAX_TRIALS).map_err(|e| e.to_string())
+}
+
+/// Seconds to wait for a quiet machine: 0 ..= [`limits::MAX_WAIT_QUIET_S`].
+fn wait_quiet(s: &str) -> Result<u64, String> {
+    let v = s
+        .parse::<usize>()
+        .map_err(|_| format!("'{s}' is not a whole number of seconds of at least 0"))?;
+    limits::check("--wait-quiet seconds", v, 0, limits::MAX_WAIT_QUIET_S)
+        .map(|v| v as u64)
+        .map_err(|e| e.to_string())
+}
+
 /// Warm-up runs per cell: 0 ..= [`limits::MAX_WARMUP`].
 fn warmup(s: &str) -> Result<usize, String> {
     let v = s

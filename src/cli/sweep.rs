@@ -11,6 +11,7 @@ use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
 use crate::sweep::params::SweepParams;
 use crate::sweep::range::{self, Axis};
+use crate::sweep::schedule::Schedule;
 use crate::sweep::{Request, Target};
 use crate::topology::Pin;
 
@@ -26,7 +27,7 @@ const QUICK_TRIALS: usize = 3;
 ///
 /// Not an `ArgGroup` that conflicts with `--resume`: clap's error for `--resume DIR --n 5`
 /// would then list every member of the group instead of naming `--n`.
-const NEW_SWEEP_ONLY: [&str; 17] = [
+const NEW_SWEEP_ONLY: [&str; 19] = [
     "cores",
     "chunks",
     "strategies",
@@ -36,6 +37,8 @@ const NEW_SWEEP_ONLY: [&str; 17] = [
     "steps",
     "trials",
     "warmup",
+    "schedule",
+    "confirm_rounds",
     "seed",
     "out",
     "force",
@@ -81,12 +84,31 @@ pub struct SweepArgs {
     /// Steps per run.
     #[arg(long, default_value_t = 1000, value_parser = super::steps)]
     pub steps: usize,
-    /// Timed runs per cell (1 ..= 1000).
+    /// Rounds (1 ..= 1000): in each, every cell of a group runs once, in a shuffled order.
+    /// Intervals need 3 or more.
     #[arg(long, default_value_t = 5, value_parser = super::trials)]
     pub trials: usize,
-    /// Untimed runs before each cell's trials (0 ..= 1000).
+    /// Untimed seq runs before each group's first round, at least one (0 ..= 1000); with
+    /// --schedule cells, untimed runs before each cell's trials.
     #[arg(long, default_value_t = 1, value_parser = super::warmup)]
     pub warmup: usize,
+    /// The order of the runs: rounds (shuffled, so the machine's drift hits every cell alike)
+    /// or cells (each cell's trials back to back, as the first versions did; for comparison).
+    #[arg(long, default_value = "rounds", value_parser = super::values::schedule())]
+    pub schedule: Schedule,
+    /// Rounds (0 ..= 1000) that measure each strategy's best cell per core count (and the
+    /// runner-up, for strategies with chunks) again after the grid: the findings rest on them
+    /// [default: --trials; 0 with --shard, which has none].
+    #[arg(long, value_name = "N", value_parser = super::confirm_rounds)]
+    pub confirm_rounds: Option<usize>,
+    /// Before each round, wait up to SECONDS (0 ..= 3600) for other work to leave the machine
+    /// quiet, saying so; then measure anyway. Also with --resume.
+    #[arg(long, value_name = "SECONDS", default_value_t = 0, value_parser = super::wait_quiet)]
+    pub wait_quiet: u64,
+    /// With --resume: measure again, from their first round, the groups that have a
+    /// contended cell.
+    #[arg(long, requires = "resume")]
+    pub remeasure_contended: bool,
     /// Seed of the initial jitter.
     #[arg(long, default_value_t = 2019)]
     pub seed: u64,
@@ -128,9 +150,9 @@ pub struct SweepArgs {
     /// machine's capacity as taken by other work, instead of the measured foreign CPU.
     #[arg(long, value_name = "LIST", hide = true)]
     pub fake_contention: Option<String>,
-    /// Test only: stop as if Ctrl-C was pressed once this many cells are written.
+    /// Test only: stop as if Ctrl-C was pressed once this many runs are written.
     #[arg(long, value_name = "K", hide = true)]
-    pub stop_after_cells: Option<usize>,
+    pub stop_after_runs: Option<usize>,
 }
 
 impl SweepArgs {
@@ -171,6 +193,17 @@ impl SweepArgs {
             chunks: list("chunks", chunks, Axis::Chunks)?,
             trials,
             warmup: self.warmup,
+            schedule: self.schedule,
+            confirm_rounds: match (self.confirm_rounds, self.shard) {
+                (Some(k), Some(shard)) if k > 0 => anyhow::bail!(
+                    "--confirm-rounds {k} with --shard {shard}: a shard holds only part of each \
+                     strategy's cells, so it cannot choose the best ones; confirm after the \
+                     merge with a sweep of the chosen cells, or leave --confirm-rounds out"
+                ),
+                (Some(k), _) => k,
+                (None, Some(_)) => 0,
+                (None, None) => trials,
+            },
             seed: self.seed,
             simd: Some(crate::simd::current()),
             fake_timings: self.fake_timings.clone(),
@@ -197,7 +230,9 @@ impl SweepArgs {
         };
         Ok(Request {
             target,
-            stop_after_cells: self.stop_after_cells,
+            remeasure_contended: self.remeasure_contended,
+            wait_quiet_s: self.wait_quiet,
+            stop_after_runs: self.stop_after_runs,
             command_line: std::env::args_os()
                 .map(|a| a.to_string_lossy().into_owned())
                 .collect(),

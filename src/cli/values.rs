@@ -10,6 +10,7 @@ use clap::{Arg, ValueEnum};
 use sph_strategies::StrategyName;
 
 use crate::render::scale::ColorBy;
+use crate::results::params::Schedule;
 use crate::simd::SimdPath;
 use crate::sph::neighbors::{NeighborMode, SumOrder};
 use crate::sph::params::Preset;
@@ -155,6 +156,29 @@ pub(super) fn order() -> impl TypedValueParser<Value = SumOrder> {
 /// Parses a [`Pin`] by its command-line name, listing the placements in `--help`.
 pub(super) fn pin() -> impl TypedValueParser<Value = Pin> {
     EnumValueParser::<PinArg>::new().map(Pin::from)
+}
+
+/// `sweep --schedule`'s values.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum ScheduleArg {
+    /// Shuffled rounds: in each, every cell of a group runs once (the default).
+    Rounds,
+    /// Each cell's trials back to back, cell after cell (the first versions' order).
+    Cells,
+}
+
+impl From<ScheduleArg> for Schedule {
+    fn from(arg: ScheduleArg) -> Schedule {
+        match arg {
+            ScheduleArg::Rounds => Schedule::Rounds,
+            ScheduleArg::Cells => Schedule::Cells,
+        }
+    }
+}
+
+/// Parses `sweep --schedule`.
+pub(super) fn schedule() -> impl TypedValueParser<Value = Schedule> {
+    EnumValueParser::<ScheduleArg>::new().map(Schedule::from)
 }
 
 /// Parses a [`ColorBy`] by its command-line name, listing the quantities in `--help`.

@@ -198,7 +198,11 @@ mod tests {
                     steal_s: None,
                     load1: None,
                     pin: r.pin,
-                    passes_alone: None,
+                    phase: r.phase,
+                    round: Some(t),
+                    position: Some(1),
+                    window_foreign_threads: None,
+                    contended: None,
                 })
             })
             .collect();

@@ -25,8 +25,8 @@ use super::files::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
 use super::key::Cell;
 use super::meta::Meta;
 use super::rows::{
-    EARLIER_SUMMARY_WIDTHS, EARLIER_TRIAL_WIDTHS, LEGACY_SUMMARY_COLUMNS, LEGACY_TRIAL_COLUMNS,
-    SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow,
+    Phase, SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow, is_older_summary_header,
+    is_older_trial_header,
 };
 use super::validate;
 
@@ -37,8 +37,15 @@ pub struct Sweep {
     pub dir: PathBuf,
     /// Its `meta.json`.
     pub meta: Meta,
-    /// Its `summary.csv` cells that passed the checks, in file order (the plan's order).
+    /// Its `summary.csv` cells of the grid phase that passed the checks, in file order (the
+    /// plan's order): every cell measured.
     pub rows: Vec<SummaryRow>,
+    /// Its cells of the confirmation phase that passed the checks: the chosen cells measured
+    /// again ([`crate::results::rows::Phase::Confirm`]); empty when the sweep had none.
+    pub confirmed: Vec<SummaryRow>,
+    /// The trial rows of the cells kept (both phases), cell by cell; empty without a
+    /// `trials.csv`.
+    pub trials: Vec<TrialRow>,
     /// Cells left out, each with why.
     pub dropped: Vec<String>,
 }
@@ -107,7 +114,10 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
     };
     let believed = believed(summary, trials);
     dropped.extend(believed.dropped);
-    let rows = believed.rows;
+    let (confirmed, rows): (Vec<SummaryRow>, Vec<SummaryRow>) = believed
+        .rows
+        .into_iter()
+        .partition(|r| r.phase == crate::results::rows::Phase::Confirm);
     if rows.is_empty() {
         bail!(
             "'{}' has no usable cells ({} dropped; the first: {})",
@@ -120,6 +130,8 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
         dir: dir.to_path_buf(),
         meta,
         rows,
+        confirmed,
+        trials: believed.trials,
         dropped,
     })
 }
@@ -140,18 +152,18 @@ pub struct Believed {
 /// possible on their own ([`validate::summary_alone`]).
 pub fn believed(summary: Vec<SummaryRow>, trials: Option<Vec<TrialRow>>) -> Believed {
     let have_trials = trials.is_some();
-    let mut by_cell: HashMap<Cell, Vec<TrialRow>> = HashMap::new();
+    let mut by_cell: HashMap<(Cell, Phase), Vec<TrialRow>> = HashMap::new();
     for t in trials.into_iter().flatten() {
-        by_cell.entry(t.key()).or_default().push(t);
+        by_cell.entry(t.phased_key()).or_default().push(t);
     }
     let mut seen = HashSet::new();
     let mut out = Believed::default();
     for row in summary {
         let mut of_cell = Vec::new();
-        let checked = if !seen.insert(row.key()) {
+        let checked = if !seen.insert(row.phased_key()) {
             Err("a second summary row of the same cell".to_owned())
         } else if have_trials {
-            of_cell = by_cell.remove(&row.key()).unwrap_or_default();
+            of_cell = by_cell.remove(&row.phased_key()).unwrap_or_default();
             of_cell.sort_by_key(|t| t.trial);
             validate::cell(&row, &of_cell)
         } else {
@@ -173,31 +185,21 @@ pub fn believed(summary: Vec<SummaryRow>, trials: Option<Vec<TrialRow>>) -> Beli
 /// Reads a `summary.csv` (this version's columns or the first release's): its rows, and a
 /// note for each line that is not one.
 pub fn read_summary(path: &Path) -> anyhow::Result<(Vec<SummaryRow>, Vec<String>)> {
-    let widths = [
-        LEGACY_SUMMARY_COLUMNS,
-        EARLIER_SUMMARY_WIDTHS[0],
-        EARLIER_SUMMARY_WIDTHS[1],
-    ];
-    read_csv(path, &SUMMARY_COLUMNS, &widths, "summary")
+    read_csv(path, &SUMMARY_COLUMNS, is_older_summary_header, "summary")
 }
 
 /// Reads a `trials.csv` (this version's columns or the first release's), as
 /// [`read_summary`].
 pub fn read_trials(path: &Path) -> anyhow::Result<(Vec<TrialRow>, Vec<String>)> {
-    let widths = [
-        LEGACY_TRIAL_COLUMNS,
-        EARLIER_TRIAL_WIDTHS[0],
-        EARLIER_TRIAL_WIDTHS[1],
-    ];
-    read_csv(path, &TRIAL_COLUMNS, &widths, "trial")
+    read_csv(path, &TRIAL_COLUMNS, is_older_trial_header, "trial")
 }
 
-/// The rows of a results CSV whose header is `columns` or the first `w` of them for a width `w`
-/// of `legacy` (an earlier version's file), and a note naming each line that is not a row.
+/// The rows of a results CSV whose header is `columns` or one that `older` accepts (an earlier
+/// version's file), and a note naming each line that is not a row.
 fn read_csv<R: serde::de::DeserializeOwned>(
     path: &Path,
     columns: &[&str],
-    legacy: &[usize],
+    older: fn(&[&str]) -> bool,
     what: &str,
 ) -> anyhow::Result<(Vec<R>, Vec<String>)> {
     let mut reader = csv::Reader::from_path(path)
@@ -207,7 +209,7 @@ fn read_csv<R: serde::de::DeserializeOwned>(
         .with_context(|| format!("cannot read '{}'", path.display()))?
         .clone();
     let found: Vec<&str> = header.iter().collect();
-    if found != columns && !legacy.iter().any(|&w| found == columns[..w]) {
+    if found != columns && !older(&found) {
         bail!(
             "'{}' is not a bench-sph {}: its header is not {}",
             path.display(),
@@ -252,7 +254,7 @@ mod tests {
     fn a_first_release_summary_reads_with_empty_new_columns() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("summary.csv");
-        let header = SUMMARY_COLUMNS[..LEGACY_SUMMARY_COLUMNS].join(",");
+        let header = SUMMARY_COLUMNS[..crate::results::rows::LEGACY_SUMMARY_COLUMNS].join(",");
         std::fs::write(
             &path,
             format!("{header}\nseq,all-pairs,seed,60,3,1,,,2,1.5,0.5,1.0,1.5,2.0,1.5,1.0,1.0,0,false,00000000000000aa,ok,\n"),
@@ -267,7 +269,7 @@ mod tests {
     fn a_row_naming_an_unknown_strategy_is_left_out_as_unreadable() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("summary.csv");
-        let header = SUMMARY_COLUMNS[..LEGACY_SUMMARY_COLUMNS].join(",");
+        let header = SUMMARY_COLUMNS[..crate::results::rows::LEGACY_SUMMARY_COLUMNS].join(",");
         let row = "all-pairs,seed,60,3,1,,,2,1.5,0.5,1.0,1.5,2.0,1.5,1.0,1.0,0,false,00000000000000aa,ok,";
         std::fs::write(&path, format!("{header}\nseq,{row}\nturbo,{row}\n")).unwrap();
         let (rows, bad) = read_summary(&path).unwrap();

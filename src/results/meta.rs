@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use super::params::SweepParams;
 use super::shard::Shard;
-use super::stats::{CONFIDENCE, RESAMPLES};
+use super::stats::CONFIDENCE;
 use crate::topology::Topology;
 
 /// The version of bench-sph that wrote the file.
@@ -146,33 +146,56 @@ pub struct Session {
     pub busy_threads_at_start: Option<f64>,
 }
 
-/// How the summary's intervals and `contended` flags were computed.
+/// How the runs were ordered and how the summary's intervals and `contended` flags were
+/// computed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Statistics {
-    /// Bootstrap resamples per interval.
-    pub bootstrap_resamples: usize,
+    /// How the intervals were computed: `student-t` ([`crate::results::intervals`]: the
+    /// mean's on the times, the speedup's on the logarithms of the per-round ratios); absent
+    /// in sweeps written before rounds, whose intervals came from the percentile bootstrap.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub intervals: Option<String>,
     /// The intervals' confidence level.
     pub confidence: f64,
-    /// The seed of the bootstrap's random streams (the sweep's `seed`).
-    pub bootstrap_seed: u64,
-    /// Share of the machine's capacity other work may take before a trial is contended.
+    /// The fewest rounds that give an interval.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_rounds: Option<usize>,
+    /// The seed of the rounds' shuffles (the sweep's `seed`; see
+    /// [`crate::sweep::schedule::round_seed`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shuffle_seed: Option<u64>,
+    /// Bootstrap resamples per interval (sweeps written before rounds).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bootstrap_resamples: Option<usize>,
+    /// The seed of the bootstrap's random streams (sweeps written before rounds).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bootstrap_seed: Option<u64>,
+    /// Share of the machine's capacity other work may take before a window is contended.
     pub contended_share: f64,
-    /// Whether a trial that ran passes alone (`passes_alone` > 0) is contended too (false in
-    /// sweeps written before that rule).
-    #[serde(default)]
-    pub contended_when_passes_alone: bool,
+    /// The shortest contention window, wall seconds ([`crate::sweep::windows`]); absent in
+    /// sweeps written before windows, which judged each trial alone.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contention_window_s: Option<f64>,
 }
 
 impl Statistics {
     /// This version's settings for a sweep with `seed`.
     pub fn current(seed: u64) -> Statistics {
         Statistics {
-            bootstrap_resamples: RESAMPLES,
+            intervals: Some("student-t".to_owned()),
             confidence: CONFIDENCE,
-            bootstrap_seed: seed,
+            min_rounds: Some(crate::results::intervals::MIN_ROUNDS),
+            shuffle_seed: Some(seed),
+            bootstrap_resamples: None,
+            bootstrap_seed: None,
             contended_share: crate::contention::CONTENDED_SHARE,
-            contended_when_passes_alone: true,
+            contention_window_s: Some(crate::contention::WINDOW_S),
         }
+    }
+
+    /// Whether the sweep ran before rounds: cells back to back, bootstrap intervals.
+    pub fn before_rounds(&self) -> bool {
+        self.intervals.is_none()
     }
 }
 

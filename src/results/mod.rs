@@ -1,21 +1,24 @@
 //! The results directory's schema, below both the sweep that writes it and the report that
 //! reads it: file names ([`files`]), the cell key ([`key`]), the rows and columns of
 //! `trials.csv` and `summary.csv` ([`rows`]), `meta.json` ([`meta`]) with the sweep's
-//! parameters ([`params`]) written by name ([`names`]), the statistics of a cell ([`stats`]),
-//! the checks a cell read back must pass ([`validate`]) and the lenient reading of whole
-//! directories ([`load`]).
+//! parameters ([`params`]) written by name ([`names`]), the statistics of a cell ([`stats`])
+//! and their intervals ([`intervals`]), a cell's summary row from its trial rows
+//! ([`summarize`]), the checks a cell read back must pass ([`validate`]) and the lenient
+//! reading of whole directories ([`load`]).
 //!
 //! A results directory holds:
-//! - `trials.csv`: one row per timed trial (columns [`rows::TRIAL_COLUMNS`]);
-//! - `summary.csv`: one row per cell (columns [`rows::SUMMARY_COLUMNS`]): mean, sample
-//!   stddev, min, median, max of the wall seconds, mean CPU seconds, speedup over the group's
-//!   `seq` mean, efficiency = speedup / cores, outliers (|t − median| > 3 MAD),
-//!   oversubscribed, the common checksum, status and reason;
+//! - `trials.csv`: one row per timed run (columns [`rows::TRIAL_COLUMNS`]), with its phase,
+//!   round and place in the round;
+//! - `summary.csv`: one row per cell and phase (columns [`rows::SUMMARY_COLUMNS`]): mean,
+//!   sample stddev, min, median, max of the wall seconds, mean CPU seconds, speedup over the
+//!   group's `seq` (paired by round), efficiency = speedup / cores, outliers
+//!   (|t − median| > 3 MAD), oversubscribed, the common checksum, status and reason;
 //! - `meta.json`: machine, build, times, command lines and every parameter;
 //! - in a merge of shards, `references.csv`: every shard's `seq` rows;
 //! - `sweep.lock` while a sweep runs, and the report drawn from it (`REPORT.md`, charts).
 
 pub mod files;
+pub mod intervals;
 pub mod key;
 pub mod load;
 pub mod meta;
@@ -24,6 +27,7 @@ pub mod params;
 pub mod rows;
 pub mod shard;
 pub mod stats;
+pub mod summarize;
 pub mod validate;
 
 pub use files::{

@@ -32,10 +32,20 @@ pub struct SweepParams {
     pub cores: Vec<usize>,
     /// Chunk counts, for strategies that use chunks.
     pub chunks: Vec<usize>,
-    /// Timed runs per cell.
+    /// Timed runs per cell: the rounds of the grid phase (`--trials`).
     pub trials: usize,
-    /// Untimed runs before a cell's trials.
+    /// Untimed runs: of the group's `seq` before its first round (`rounds`; one such run, the
+    /// reference run, happens even with 0), or before each cell's trials (`cells`).
     pub warmup: usize,
+    /// The order of the runs (`--schedule`); `cells` in directories written before rounds.
+    #[serde(default = "Schedule::before_rounds")]
+    pub schedule: Schedule,
+    /// Rounds of the confirmation phase (`--confirm-rounds`): each strategy's best cell (and
+    /// runner-up) per core count measured again; 0 for none (and in directories written
+    /// before the phase existed).
+    #[serde(default)]
+    pub confirm_rounds: usize,
+
     /// Seed of the initial jitter.
     pub seed: u64,
     /// SIMD path of the neighbour tests (`--simd`, else the widest the CPU ran); absent in
@@ -57,6 +67,31 @@ pub struct SweepParams {
     /// Test only: foreign-CPU shares replacing the measured ones (see [`crate::sweep::timing`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fake_contention: Option<String>,
+}
+
+/// The order of a sweep's runs (see [`crate::sweep::schedule`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Schedule {
+    /// Rounds in a shuffled order: in each round every cell of a group runs once.
+    Rounds,
+    /// Each cell's runs back to back, cell after cell in plan order (the first versions').
+    Cells,
+}
+
+impl Schedule {
+    /// What directories written before `schedule` was recorded ran.
+    fn before_rounds() -> Schedule {
+        Schedule::Cells
+    }
+
+    /// The name on the command line and in `meta.json`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Schedule::Rounds => "rounds",
+            Schedule::Cells => "cells",
+        }
+    }
 }
 
 /// `--pin`'s default, and what sweeps written before it ran: the operating system's placement.
@@ -86,8 +121,8 @@ impl SweepParams {
 #[cfg(test)]
 impl SweepParams {
     /// A small sweep for unit tests, which change what they test: rayon-chunks, the `seed`
-    /// preset, all-pairs, N = 60, 3 steps, cores 1 and 2, chunks 2 and 5, 2 trials, no warm-up,
-    /// seed 1, unpinned, the whole plan.
+    /// preset, all-pairs, N = 60, 3 steps, cores 1 and 2, chunks 2 and 5, 2 rounds, no warm-up
+    /// beyond the reference run, no confirmation, seed 1, unpinned, the whole plan.
     pub(crate) fn small() -> SweepParams {
         SweepParams {
             strategies: vec![StrategyName::RayonChunks],
@@ -99,6 +134,8 @@ impl SweepParams {
             chunks: vec![2, 5],
             trials: 2,
             warmup: 0,
+            schedule: Schedule::Rounds,
+            confirm_rounds: 0,
             seed: 1,
             simd: None,
             fake_timings: None,

@@ -9,15 +9,16 @@
 //!
 //! Columns added after the first release are appended at the end of each row (older readers
 //! keep working): per trial `foreign_cpu_s, steal_s, load1` ([`crate::contention`]); per cell
-//! the 95 % bootstrap intervals `mean_ci_low_s, mean_ci_high_s, speedup_ci_low,
-//! speedup_ci_high` ([`crate::sweep::bootstrap`]), `foreign_cpu_mean_s` and `contended` (some trial
-//! saw more foreign CPU than [`crate::contention::Threshold::allowed_s`] or ran passes alone),
-//! then
-//! `reference_shard`: in a shard of a sharded sweep (`sweep --shard I/K`) and in a merge of
-//! shards, the shard I whose `seq` cell is the row's speedup denominator, which is the shard
+//! the 95 % intervals `mean_ci_low_s, mean_ci_high_s, speedup_ci_low, speedup_ci_high`
+//! ([`crate::results::intervals`]), `foreign_cpu_mean_s` and `contended` (some run's
+//! contention window saw more foreign CPU than [`crate::contention::Threshold::allowed_s`]);
+//! then `reference_shard`: in a shard of a sharded sweep (`sweep --shard I/K`) and in a merge
+//! of shards, the shard I whose `seq` cell is the row's speedup denominator, which is the shard
 //! that measured the row; empty in an unsharded sweep; then `pin` (both files) and `smt`
-//! (summary) of `--pin`; then per trial `passes_alone`
-//! ([`Executor::passes_alone`](sph_strategies::Executor::passes_alone)).
+//! (summary) of `--pin`; then, since rounds, `phase` (both files) and per trial `round`,
+//! `position`, `window_foreign_threads` and `contended`. The versions before rounds wrote a
+//! last trial column `passes_alone` (crossbeam-pool's passes run alone, since removed), which
+//! is read and ignored.
 
 use serde::{Deserialize, Serialize};
 use sph_strategies::StrategyName;
@@ -28,7 +29,7 @@ use crate::sph::params::Preset;
 use crate::topology::Pin;
 
 /// The columns of `trials.csv`, in order.
-pub const TRIAL_COLUMNS: [&str; 19] = [
+pub const TRIAL_COLUMNS: [&str; 23] = [
     "strategy",
     "neighbors",
     "preset",
@@ -47,11 +48,15 @@ pub const TRIAL_COLUMNS: [&str; 19] = [
     "steal_s",
     "load1",
     "pin",
-    "passes_alone",
+    "phase",
+    "round",
+    "position",
+    "window_foreign_threads",
+    "contended",
 ];
 
 /// The columns of `summary.csv`, in order.
-pub const SUMMARY_COLUMNS: [&str; 31] = [
+pub const SUMMARY_COLUMNS: [&str; 32] = [
     "strategy",
     "neighbors",
     "preset",
@@ -83,6 +88,7 @@ pub const SUMMARY_COLUMNS: [&str; 31] = [
     "reference_shard",
     "pin",
     "smt",
+    "phase",
 ];
 
 /// How many leading columns of each file bench-sph 0.1.0 wrote before the contention and
@@ -90,13 +96,58 @@ pub const SUMMARY_COLUMNS: [&str; 31] = [
 pub const LEGACY_TRIAL_COLUMNS: usize = 14;
 /// See [`LEGACY_TRIAL_COLUMNS`].
 pub const LEGACY_SUMMARY_COLUMNS: usize = 22;
-/// The widths of `summary.csv` that earlier versions wrote after the first release: before
-/// `reference_shard` (28) and before `pin` and `smt` (29). Read as they are (the missing
-/// columns empty), and upgraded to every column by `--resume`.
-pub const EARLIER_SUMMARY_WIDTHS: [usize; 2] = [28, 29];
-/// The widths of `trials.csv` before `pin` (17) and before `passes_alone` (18): read as they
-/// are (the missing columns empty), upgraded by `--resume`.
-pub const EARLIER_TRIAL_WIDTHS: [usize; 2] = [17, 18];
+/// The widths of `summary.csv` that earlier versions wrote, each a prefix of
+/// [`SUMMARY_COLUMNS`]: the first release, then before `reference_shard`, before `pin` and
+/// `smt`, and before `phase` (the last version that ran cells back to back).
+const OLDER_SUMMARY_WIDTHS: [usize; 4] = [LEGACY_SUMMARY_COLUMNS, 28, 29, 31];
+/// The widths of `trials.csv` that earlier versions wrote as prefixes of [`TRIAL_COLUMNS`]:
+/// the first release, before `pin`, and before `passes_alone`.
+const OLDER_TRIAL_WIDTHS: [usize; 3] = [LEGACY_TRIAL_COLUMNS, 17, 18];
+/// The column the versions before rounds wrote last in `trials.csv` (crossbeam-pool's passes
+/// run alone, since removed): read and ignored.
+const RETIRED_TRIAL_COLUMN: &str = "passes_alone";
+
+/// Whether `header` is the header of a `summary.csv` an earlier version wrote (read as it is,
+/// the later columns empty).
+pub fn is_older_summary_header(header: &[&str]) -> bool {
+    OLDER_SUMMARY_WIDTHS
+        .iter()
+        .any(|&w| header == &SUMMARY_COLUMNS[..w])
+}
+
+/// Whether `header` is the header of a `trials.csv` an earlier version wrote (read as it is:
+/// the later columns empty, `passes_alone` ignored).
+pub fn is_older_trial_header(header: &[&str]) -> bool {
+    let before_rounds = [&TRIAL_COLUMNS[..18], &[RETIRED_TRIAL_COLUMN][..]].concat();
+    header == before_rounds.as_slice()
+        || OLDER_TRIAL_WIDTHS
+            .iter()
+            .any(|&w| header == &TRIAL_COLUMNS[..w])
+}
+
+/// Which rounds of a sweep a row belongs to.
+#[derive(
+    Debug, Clone, Copy, Default, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Phase {
+    /// The rounds over every cell of the plan: the charts' data, and where cells are chosen.
+    #[default]
+    Grid,
+    /// The rounds that measure again each strategy's best cells, chosen by the grid: the
+    /// findings' data (no winner's curse: these runs did not choose the cells).
+    Confirm,
+}
+
+impl Phase {
+    /// The name written in the CSVs.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Phase::Grid => "grid",
+            Phase::Confirm => "confirm",
+        }
+    }
+}
 
 /// Whether a cell's numbers can be used.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -155,11 +206,25 @@ pub struct TrialRow {
     /// files written before `--pin`, read as `none`).
     #[serde(default, deserialize_with = "pin_or_none")]
     pub pin: Pin,
-    /// Passes the strategy ran on one thread although it had more (`crossbeam-pool` on cores
-    /// it found shared: the trial's time is then not a time on its cores); 0 for every other
-    /// strategy, empty in files written before this column.
+    /// The phase the run belongs to (`grid`, or `confirm` for the rounds that re-measure the
+    /// chosen cells; `grid` in files written before phases).
     #[serde(default)]
-    pub passes_alone: Option<u64>,
+    pub phase: Phase,
+    /// The round of its phase the run ran in, from 1 (see [`crate::sweep::schedule`]); empty
+    /// in files written before rounds.
+    #[serde(default)]
+    pub round: Option<usize>,
+    /// The run's place in its round, from 1 (empty before rounds).
+    #[serde(default)]
+    pub position: Option<usize>,
+    /// Hardware threads' worth of CPU that other work used over the run's contention window
+    /// (foreign CPU seconds per wall second; see [`crate::sweep::windows`]); empty where
+    /// unknown.
+    #[serde(default)]
+    pub window_foreign_threads: Option<f64>,
+    /// Whether that window was contended for the run's cell; empty where unknown.
+    #[serde(default)]
+    pub contended: Option<bool>,
 }
 
 /// One row of `summary.csv`: one cell. Its first columns repeat [`TrialRow`]'s cell key on
@@ -199,7 +264,9 @@ pub struct SummaryRow {
     pub max_s: Option<f64>,
     /// Mean CPU seconds (user + system).
     pub cpu_mean_s: Option<f64>,
-    /// The group's `seq` mean divided by this cell's mean.
+    /// The speedup over the group's `seq`: the geometric mean of the per-round ratios of the
+    /// round's `seq` time to this cell's ([`crate::results::intervals::paired_ratio`]; in
+    /// files written before rounds, the ratio of the two means).
     pub speedup: Option<f64>,
     /// Speedup divided by cores.
     pub efficiency: Option<f64>,
@@ -213,23 +280,25 @@ pub struct SummaryRow {
     pub status: Status,
     /// Why the cell failed (empty when ok).
     pub reason: String,
-    /// Lower end of the 95 % bootstrap interval of the mean wall seconds.
+    /// Lower end of the 95 % Student-t interval of the mean wall seconds
+    /// ([`crate::results::intervals`]; a bootstrap interval in files written before rounds).
     #[serde(default)]
     pub mean_ci_low_s: Option<f64>,
     /// Upper end of that interval.
     #[serde(default)]
     pub mean_ci_high_s: Option<f64>,
-    /// Lower end of the 95 % bootstrap interval of the speedup.
+    /// Lower end of the 95 % interval of the speedup (the paired ratios' Student-t interval;
+    /// a bootstrap interval in files written before rounds).
     #[serde(default)]
     pub speedup_ci_low: Option<f64>,
     /// Upper end of that interval.
     #[serde(default)]
     pub speedup_ci_high: Option<f64>,
-    /// Mean foreign CPU seconds per trial.
+    /// Mean foreign CPU seconds per trial (each trial's own window).
     #[serde(default)]
     pub foreign_cpu_mean_s: Option<f64>,
-    /// Whether some trial saw more foreign CPU than the threshold or ran passes alone
-    /// ([`TrialRow::passes_alone`]); empty where neither is known.
+    /// Whether some run's contention window saw more foreign CPU than the threshold
+    /// ([`TrialRow::contended`]); empty where unknown.
     #[serde(default)]
     pub contended: Option<bool>,
     /// The shard (1-based) whose `seq` cell is this row's speedup denominator: the shard that
@@ -243,6 +312,11 @@ pub struct SummaryRow {
     /// than hardware threads (empty where the topology is unknown).
     #[serde(default)]
     pub smt: Option<bool>,
+    /// Which rounds the row summarises: `grid` (every cell of the plan) or `confirm` (the
+    /// cells the grid chose, measured again in rounds of their own); `grid` in files written
+    /// before phases.
+    #[serde(default)]
+    pub phase: Phase,
 }
 
 /// A `pin` field: a placement name, or empty (files written before `--pin`) for `none`.
@@ -283,6 +357,20 @@ macro_rules! keyed {
 }
 keyed!(TrialRow);
 keyed!(SummaryRow);
+
+impl TrialRow {
+    /// The row's cell and phase: a cell has one set of runs per phase.
+    pub fn phased_key(&self) -> (Cell, Phase) {
+        (self.key(), self.phase)
+    }
+}
+
+impl SummaryRow {
+    /// The row's cell and phase: a cell has one summary row per phase.
+    pub fn phased_key(&self) -> (Cell, Phase) {
+        (self.key(), self.phase)
+    }
+}
 
 impl TrialRow {
     /// Whether the row is a trial of its group's `seq` reference cell.
@@ -374,6 +462,7 @@ pub(crate) mod tests {
             reference_shard: None,
             pin: Pin::None,
             smt: Some(false),
+            phase: Phase::Grid,
         }
     }
 

@@ -8,11 +8,9 @@
 //! - outliers: trials with |t − median| > 3 · MAD ([`OUTLIER_MADS`]). When more than half the
 //!   trials are equal the MAD is 0, and every trial that differs from the median counts.
 //!
-//! And what the summary's intervals are: [`Interval`]s at [`CONFIDENCE`] from [`RESAMPLES`]
-//! bootstrap resamples (computed by [`crate::sweep::bootstrap`]).
+//! The summary's intervals are [`Interval`]s at [`CONFIDENCE`], computed by
+//! [`crate::results::intervals`].
 
-/// Resamples per interval.
-pub const RESAMPLES: usize = 10_000;
 /// The intervals' confidence level.
 pub const CONFIDENCE: f64 = 0.95;
 

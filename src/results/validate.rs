@@ -27,32 +27,7 @@ pub fn cell(summary: &SummaryRow, trials: &[TrialRow]) -> Result<(), String> {
         ));
     }
     for t in trials {
-        if !(t.wall_s.is_finite() && t.wall_s > 0.0) {
-            return Err(format!(
-                "trial {}: wall_s = {} is not a positive time",
-                t.trial, t.wall_s
-            ));
-        }
-        if !(t.cpu_s.is_finite() && t.cpu_s >= 0.0) {
-            return Err(format!(
-                "trial {}: cpu_s = {} is not a time",
-                t.trial, t.cpu_s
-            ));
-        }
-        for (name, value) in [
-            ("foreign_cpu_s", t.foreign_cpu_s),
-            ("steal_s", t.steal_s),
-            ("load1", t.load1),
-        ] {
-            if let Some(v) = value
-                && !(v.is_finite() && v >= 0.0)
-            {
-                return Err(format!(
-                    "trial {}: {name} = {v} is not a non-negative number",
-                    t.trial
-                ));
-            }
-        }
+        run(t)?;
         if summary.status == Status::Ok && t.checksum != summary.checksum {
             return Err(format!(
                 "trial {}: checksum {} differs from the cell's {}",
@@ -82,6 +57,39 @@ pub fn cell(summary: &SummaryRow, trials: &[TrialRow]) -> Result<(), String> {
                 "{name} = {} disagrees with its trial rows ({})",
                 show(found),
                 show(want)
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Why one trial row's own numbers cannot be believed, or `Ok`: times finite and positive,
+/// the machine's readings finite and non-negative.
+pub fn run(t: &TrialRow) -> Result<(), String> {
+    if !(t.wall_s.is_finite() && t.wall_s > 0.0) {
+        return Err(format!(
+            "trial {}: wall_s = {} is not a positive time",
+            t.trial, t.wall_s
+        ));
+    }
+    if !(t.cpu_s.is_finite() && t.cpu_s >= 0.0) {
+        return Err(format!(
+            "trial {}: cpu_s = {} is not a time",
+            t.trial, t.cpu_s
+        ));
+    }
+    for (name, value) in [
+        ("foreign_cpu_s", t.foreign_cpu_s),
+        ("steal_s", t.steal_s),
+        ("load1", t.load1),
+        ("window_foreign_threads", t.window_foreign_threads),
+    ] {
+        if let Some(v) = value
+            && !(v.is_finite() && v >= 0.0)
+        {
+            return Err(format!(
+                "trial {}: {name} = {v} is not a non-negative number",
+                t.trial
             ));
         }
     }
@@ -182,14 +190,14 @@ fn show(v: Option<f64>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::clock::Elapsed;
     use crate::results::key::Cell;
     use crate::results::key::test_group;
     use crate::sph::neighbors::NeighborMode;
-    use crate::sweep::rows::{Measured, summary_row, test_context, trial_rows};
     use sph_strategies::StrategyName;
 
     fn rows() -> (SummaryRow, Vec<TrialRow>) {
+        use crate::results::rows::Phase;
+        use crate::results::summarize::{CellContext, fixtures, summary_row};
         let cell = Cell {
             group: test_group(NeighborMode::AllPairs),
             strategy: StrategyName::RayonChunks,
@@ -197,24 +205,16 @@ mod tests {
             chunks: Some(4),
             pin: crate::topology::Pin::None,
         };
-        let measured: Vec<Measured> = [0.5, 0.6, 0.7]
-            .iter()
-            .map(|&w| Measured {
-                elapsed: Elapsed {
-                    passes_alone: 0,
-                    wall_s: w,
-                    cpu_s: 2.0 * w,
-                    foreign: None,
-                },
-                load1: None,
-                checksum: "00000000000000ff".to_owned(),
-            })
-            .collect();
-        let seq = [1.0, 1.1, 1.2];
-        let ctx = test_context(Some(&seq), 2);
+        let trials = fixtures::trials(&cell, &[0.5, 0.6, 0.7]);
+        let seq = fixtures::trials(&Cell::reference(cell.group), &[1.0, 1.1, 1.2]);
+        let ctx = CellContext {
+            hardware_threads: 2,
+            shard: None,
+            smt: None,
+        };
         (
-            summary_row(&cell, &measured, None, &ctx),
-            trial_rows(&cell, &measured, None),
+            summary_row(&cell, Phase::Grid, &trials, Some(&seq), None, &ctx),
+            trials,
         )
     }
 

@@ -2,12 +2,13 @@
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
+use std::time::Duration;
 
 use super::plan::{self, Cell, LabelStyle, Plan};
 use super::range::{Axis, compact};
 use crate::output::console::plural;
 use crate::results::params::SweepParams;
-use crate::results::rows::{Contended, Status, SummaryRow, fastest};
+use crate::results::rows::{Contended, Phase, Status, SummaryRow, fastest};
 use crate::scene::tank;
 use crate::sph::params::Preset;
 use crate::topology::Pin;
@@ -135,7 +136,37 @@ pub fn resolution_note(params: &SweepParams) -> Option<String> {
     })
 }
 
-/// One line for a finished cell: where it is in the plan, what it is, and its result.
+/// The lines of a finished phase: a heading naming the group and the phase, then one line
+/// per cell in plan order.
+pub fn phase_lines(
+    plan: &Plan,
+    group: &plan::Group,
+    phase: Phase,
+    rounds: usize,
+    rows: &[SummaryRow],
+) -> String {
+    let what = match phase {
+        Phase::Grid => "every cell",
+        Phase::Confirm => "the cells the grid chose, measured again",
+    };
+    let mut text = format!(
+        "{} — {} ({}, {}):",
+        group.label(LabelStyle::Sweep),
+        phase.as_str(),
+        what,
+        plural(rounds, "round", "rounds")
+    );
+    let total = plan.cells.len();
+    for (at, cell) in plan.cells.iter().enumerate() {
+        if let Some(row) = rows.iter().find(|r| r.key() == *cell) {
+            let _ = write!(text, "\n{}", cell_line(at + 1, total, cell, row));
+        }
+    }
+    text
+}
+
+/// One line for a finished cell: where it is in the plan, what it is, and its result; a
+/// contended cell ends with the word `contended`.
 pub fn cell_line(position: usize, total: usize, cell: &Cell, row: &SummaryRow) -> String {
     let width = total.to_string().len();
     let mut line = format!("[{position:>width$}/{total}] {:<36}", cell.label());
@@ -147,7 +178,10 @@ pub fn cell_line(position: usize, total: usize, cell: &Cell, row: &SummaryRow) -
                 let _ = write!(line, " ± {sd:.p$}");
             }
             if let Some(speedup) = row.speedup {
-                let _ = write!(line, "  speedup {speedup:.2}");
+                let _ = write!(line, "  speedup {speedup:.2}×");
+                if let (Some(lo), Some(hi)) = (row.speedup_ci_low, row.speedup_ci_high) {
+                    let _ = write!(line, " [{lo:.2}–{hi:.2}]");
+                }
             }
             if row.outliers.unwrap_or(0) > 0 {
                 let _ = write!(
@@ -162,10 +196,10 @@ pub fn cell_line(position: usize, total: usize, cell: &Cell, row: &SummaryRow) -
         }
     }
     if row.oversubscribed {
-        line.push_str("  (oversubscribed)");
+        line.push_str("  oversubscribed");
     }
     if row.contended == Some(true) {
-        line.push_str("  (CONTENDED: other work used the machine, or passes ran alone)");
+        line.push_str("  contended");
     }
     line
 }
@@ -174,26 +208,52 @@ pub fn cell_line(position: usize, total: usize, cell: &Cell, row: &SummaryRow) -
 pub fn busy_warning(busy_threads: f64, hardware_threads: usize) -> String {
     format!(
         "warning: {busy_threads:.1} of {hardware_threads} cores busy with other work: timings will \
-         not be trustworthy (cells that see it are marked contended=true in summary.csv)"
+         not be trustworthy (cells that see it are marked contended=true in summary.csv; \
+         --wait-quiet SECONDS waits for a quiet machine before each round)"
     )
 }
 
-/// The warning after a sweep naming its contended cells, if any.
-pub fn contended_cells(rows: &[SummaryRow]) -> Option<String> {
+/// Printed when `--wait-quiet` starts waiting before a round of `label`.
+pub fn waiting(label: &str, busy: Option<f64>, hardware_threads: usize, bound: Duration) {
+    crate::output::console::warn(&format!(
+        "{label}: {} of {hardware_threads} hardware threads busy with other work; waiting up \
+         to {} for a quiet machine (--wait-quiet)",
+        busy.map_or_else(|| "?".to_owned(), |b| format!("{b:.1}")),
+        duration(bound.as_secs_f64())
+    ));
+}
+
+/// Printed when the wait ends: quiet, or still busy and measuring anyway.
+pub fn waited(quiet: bool, after: Duration, busy: Option<f64>) {
+    let after = duration(after.as_secs_f64());
+    crate::output::console::warn(&if quiet {
+        format!("  quiet after {after}: measuring")
+    } else {
+        format!(
+            "  still busy after {after} ({} threads): measuring anyway; the cells will be \
+             marked contended",
+            busy.map_or_else(|| "?".to_owned(), |b| format!("{b:.1}"))
+        )
+    });
+}
+
+/// The warning after a sweep naming its contended cells, if any, and what to do.
+pub fn contended_cells(dir: &std::path::Path, rows: &[SummaryRow]) -> Option<String> {
     let names: Vec<String> = rows
         .iter()
         .filter(|r| r.contended == Some(true))
-        .map(|r| r.key().label_with_group())
+        .map(|r| format!("{} ({})", r.key().label_with_group(), r.phase.as_str()))
         .collect();
     if names.is_empty() {
         return None;
     }
     let mut text = format!(
-        "warning: {} saw other work on the machine or ran passes on one thread because their \
-         threads got less CPU time than their chunks had work for (contended=true in \
-         summary.csv; passes_alone in trials.csv); their times are not trustworthy and the \
-         report leaves them out of its findings:",
-        plural(names.len(), "cell", "cells")
+        "warning: {} saw other work on the machine (contended=true in summary.csv): their \
+         times are not trustworthy and the report leaves them out of its findings. To measure \
+         their groups again: bench-sph sweep --resume {} --remeasure-contended (add \
+         --wait-quiet 60 to wait for a quiet machine before each round). Contended:",
+        plural(names.len(), "cell", "cells"),
+        dir.display()
     );
     for name in names {
         let _ = write!(text, "\n  {name}");
@@ -203,14 +263,32 @@ pub fn contended_cells(rows: &[SummaryRow]) -> Option<String> {
 
 /// The fastest finished cell of each strategy in each group, as a table, groups in plan
 /// order and strategies in registry order. `rows` may hold any number of sessions' rows.
+/// Where a group has confirmation rows, only those compete: they did not choose the cells.
 pub fn best_cells(plan: &Plan, rows: &[SummaryRow]) -> String {
-    let by_key: HashMap<Cell, &SummaryRow> = rows.iter().map(|r| (r.key(), r)).collect();
     let mut text = String::new();
     for group in &plan.groups {
+        let confirmed = rows
+            .iter()
+            .any(|r| r.group() == *group && r.phase == Phase::Confirm);
+        let phase = if confirmed {
+            Phase::Confirm
+        } else {
+            Phase::Grid
+        };
+        let by_key: HashMap<Cell, &SummaryRow> = rows
+            .iter()
+            .filter(|r| r.phase == phase)
+            .map(|r| (r.key(), r))
+            .collect();
         let _ = writeln!(
             text,
-            "Fastest cell per strategy ({}):",
-            group.label(LabelStyle::Sweep)
+            "Fastest cell per strategy ({}; {}):",
+            group.label(LabelStyle::Sweep),
+            if confirmed {
+                "from the confirmation rounds, which did not choose the cells"
+            } else {
+                "from the grid rounds that chose them: biased fast"
+            }
         );
         // With several placements, one row per (strategy, pin), named `strategy (pin)`.
         let mut lines: Vec<(StrategyName, Pin)> = plan
@@ -225,8 +303,8 @@ pub fn best_cells(plan: &Plan, rows: &[SummaryRow]) -> String {
         let w = if pinned { 24 } else { 16 };
         let _ = writeln!(
             text,
-            "  {:<w$} {:>5} {:>6} {:>10} {:>10} {:>8} {:>10}",
-            "strategy", "cores", "chunks", "mean s", "stddev s", "speedup", "efficiency"
+            "  {:<w$} {:>5} {:>6} {:>10} {:>10} {:>19} {:>10}",
+            "strategy", "cores", "chunks", "mean s", "stddev s", "speedup [95 %]", "efficiency"
         );
         for (strategy, pin) in lines {
             let name = match pin {
@@ -245,15 +323,19 @@ pub fn best_cells(plan: &Plan, rows: &[SummaryRow]) -> String {
             };
             match best {
                 Some(r) => {
+                    let speedup = match (r.speedup, r.speedup_ci_low, r.speedup_ci_high) {
+                        (Some(s), Some(lo), Some(hi)) => format!("{s:.2} [{lo:.2}–{hi:.2}]"),
+                        (s, _, _) => num(s, 2),
+                    };
                     let _ = writeln!(
                         text,
-                        "  {:<w$} {:>5} {:>6} {:>10} {:>10} {:>8} {:>10}",
+                        "  {:<w$} {:>5} {:>6} {:>10} {:>10} {:>19} {:>10}",
                         name,
                         r.cores,
                         r.chunks.map_or_else(|| "-".to_owned(), |k| k.to_string()),
                         num(r.mean_s, places(r.mean_s.unwrap_or(0.0))),
                         num(r.stddev_s, places(r.mean_s.unwrap_or(0.0))),
-                        num(r.speedup, 2),
+                        speedup,
                         num(r.efficiency, 2),
                     );
                 }
@@ -269,10 +351,8 @@ pub fn best_cells(plan: &Plan, rows: &[SummaryRow]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::clock::Elapsed;
     use crate::sph::neighbors::NeighborMode;
     use crate::sweep::params::SweepParams;
-    use crate::sweep::rows::{Measured, summary_row};
 
     fn plan() -> Plan {
         Plan::new(&SweepParams {
@@ -317,26 +397,15 @@ mod tests {
     }
 
     fn row(cell: &Cell, walls: &[f64], failure: Option<&str>) -> SummaryRow {
-        let m: Vec<Measured> = walls
-            .iter()
-            .map(|&w| Measured {
-                elapsed: Elapsed {
-                    passes_alone: 0,
-                    wall_s: w,
-                    cpu_s: w,
-                    foreign: None,
-                },
-                load1: None,
-                checksum: "0000000000000001".to_owned(),
-            })
-            .collect();
-        let seq = [4.0, 4.0];
-        summary_row(
-            cell,
-            &m,
-            failure,
-            &crate::sweep::rows::test_context(Some(&seq), 2),
-        )
+        use crate::results::summarize::{CellContext, fixtures, summary_row};
+        let trials = fixtures::trials(cell, walls);
+        let seq = fixtures::trials(&Cell::reference(cell.group), &vec![4.0; walls.len()]);
+        let ctx = CellContext {
+            hardware_threads: 2,
+            shard: None,
+            smt: None,
+        };
+        summary_row(cell, Phase::Grid, &trials, Some(&seq), failure, &ctx)
     }
 
     #[test]
@@ -375,10 +444,17 @@ mod tests {
             ok.starts_with("[2/7] rayon-chunks, 1 core, 2 chunks"),
             "{ok}"
         );
+        // Paired with seq's 4 s: ratios 4 and 4/3, geometric mean √(16/3).
         assert!(
-            ok.contains("2.000 s ± 1.414") && ok.contains("speedup 2.00"),
+            ok.contains("2.000 s ± 1.414") && ok.contains("speedup 2.31×"),
             "{ok}"
         );
+        assert!(!ok.contains("× ["), "two rounds give no interval: {ok}");
+        let three = cell_line(2, 7, &cell, &row(&cell, &[2.0, 2.0, 2.0], None));
+        assert!(three.contains("speedup 2.00× [2.00–2.00]"), "{three}");
+        let mut contended = row(&cell, &[1.0, 3.0], None);
+        contended.contended = Some(true);
+        assert!(cell_line(2, 7, &cell, &contended).ends_with("  contended"));
         let bad = cell_line(2, 7, &cell, &row(&cell, &[1.0], Some("trial 1: boom")));
         assert!(bad.contains("FAILED: trial 1: boom"), "{bad}");
     }

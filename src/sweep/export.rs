@@ -1,9 +1,9 @@
-//! Writing `trials.csv` and `summary.csv` to any [`Write`], a cell at a time.
+//! Writing `trials.csv` and `summary.csv` to any [`Write`]: runs as their contention windows
+//! close, summary rows when their phase ends, each batch flushed at once.
 //!
-//! A cell's trial rows are written and flushed first, then its summary row: a sweep killed in
-//! between leaves trial rows without a summary row, which `--resume` recognises as an
-//! unfinished cell and drops (see [`super::resume`]). Nothing of a cell is written before the
-//! cell has finished, so an interrupted cell leaves no rows at all.
+//! A phase's runs are written before its summary rows: a sweep killed in between leaves runs
+//! without summary rows, which `--resume` keeps as the phase's finished runs and continues
+//! (see [`super::resume`]). A line cut off by a kill is dropped there.
 
 use std::io::Write;
 
@@ -36,13 +36,20 @@ impl<T: Write, S: Write> Exporter<T, S> {
         Ok(e)
     }
 
-    /// Writes one finished cell: its trial rows, flushed, then its summary row, flushed.
-    pub fn write_cell(&mut self, trials: &[TrialRow], summary: &SummaryRow) -> csv::Result<()> {
+    /// Writes runs' trial rows, flushed.
+    pub fn write_trials(&mut self, trials: &[TrialRow]) -> csv::Result<()> {
         for row in trials {
             self.trials.serialize(row)?;
         }
         self.trials.flush()?;
-        self.summary.serialize(summary)?;
+        Ok(())
+    }
+
+    /// Writes a phase's summary rows, flushed.
+    pub fn write_summaries(&mut self, rows: &[SummaryRow]) -> csv::Result<()> {
+        for row in rows {
+            self.summary.serialize(row)?;
+        }
         self.summary.flush()?;
         Ok(())
     }
@@ -63,12 +70,11 @@ pub fn to_csv<R: serde::Serialize>(columns: &[&str], rows: &[R]) -> csv::Result<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::clock::Elapsed;
-    use crate::contention::Foreign;
     use crate::results::key::test_group;
+    use crate::results::rows::Phase;
+    use crate::results::summarize::{CellContext, fixtures, summary_row};
     use crate::sph::neighbors::NeighborMode;
     use crate::sweep::plan::Cell;
-    use crate::sweep::rows::{Measured, summary_row, test_context, trial_rows};
     use sph_strategies::StrategyName;
 
     fn cell() -> Cell {
@@ -81,23 +87,16 @@ mod tests {
         }
     }
 
-    fn measured() -> Vec<Measured> {
-        [(0.5, 1.0), (0.25, 0.5)]
-            .iter()
-            .map(|&(wall_s, cpu_s)| Measured {
-                elapsed: Elapsed {
-                    passes_alone: 0,
-                    wall_s,
-                    cpu_s,
-                    foreign: Some(Foreign {
-                        cpu_s: 0.01,
-                        steal_s: Some(0.0),
-                    }),
-                },
-                load1: Some(0.5),
-                checksum: "0123456789abcdef".to_owned(),
-            })
-            .collect()
+    fn rows() -> (Vec<TrialRow>, SummaryRow) {
+        let trials = fixtures::trials(&cell(), &[0.5, 0.25, 0.375]);
+        let seq = fixtures::trials(&Cell::reference(cell().group), &[0.75, 0.5, 0.75]);
+        let ctx = CellContext {
+            hardware_threads: 2,
+            shard: None,
+            smt: None,
+        };
+        let summary = summary_row(&cell(), Phase::Grid, &trials, Some(&seq), None, &ctx);
+        (trials, summary)
     }
 
     /// The header a serde-derived writer would produce for `row`.
@@ -110,46 +109,41 @@ mod tests {
 
     #[test]
     fn the_column_lists_match_the_row_structs() {
-        let m = measured();
-        let trials = trial_rows(&cell(), &m, None);
-        let summary = summary_row(&cell(), &m, None, &test_context(Some(&[1.0]), 2));
+        let (trials, summary) = rows();
         assert_eq!(derived_header(&trials[0]), TRIAL_COLUMNS.join(","));
         assert_eq!(derived_header(&summary), SUMMARY_COLUMNS.join(","));
     }
 
     #[test]
-    fn a_cell_is_written_as_exact_csv_lines() {
-        let m = measured();
+    fn runs_and_summaries_are_written_as_exact_csv_lines() {
+        let (trials, summary) = rows();
         let (mut t, mut s) = (Vec::new(), Vec::new());
         let mut e = Exporter::new(&mut t, &mut s, true).unwrap();
-        e.write_cell(
-            &trial_rows(&cell(), &m, None),
-            &summary_row(&cell(), &m, None, &test_context(Some(&[0.75, 0.75]), 2)),
-        )
-        .unwrap();
+        e.write_trials(&trials[..2]).unwrap();
+        e.write_summaries(std::slice::from_ref(&summary)).unwrap();
         drop(e);
         assert_eq!(
             String::from_utf8(t).unwrap(),
             format!(
                 "{}\n\
-                 rayon-chunks,grid,seed,60,3,2,5,12,1,0.5,1.0,0123456789abcdef,ok,,0.01,0.0,0.5,none,0\n\
-                 rayon-chunks,grid,seed,60,3,2,5,12,2,0.25,0.5,0123456789abcdef,ok,,0.01,0.0,0.5,none,0\n",
+                 rayon-chunks,grid,seed,60,3,2,5,12,1,0.5,1.0,00000000000000aa,ok,,0.005,0.0,0.25,none,\
+                 grid,1,1,0.01,false\n\
+                 rayon-chunks,grid,seed,60,3,2,5,12,2,0.25,0.5,00000000000000aa,ok,,0.0025,0.0,0.25,none,\
+                 grid,2,1,0.01,false\n",
                 TRIAL_COLUMNS.join(",")
             )
         );
-        // mean 0.375, stddev √0.03125, median 0.375, speedup 2, efficiency 1; resampled
-        // means of two trials are 0.25, 0.375 or 0.5 (a quarter of them each at the ends),
-        // so the interval spans 0.25..0.5 and the speedup's 0.75/0.5..0.75/0.25.
-        assert_eq!(
-            String::from_utf8(s).unwrap(),
-            format!(
-                "{}\n\
-                 rayon-chunks,grid,seed,60,3,2,5,12,2,0.375,{},0.25,0.375,0.5,0.75,2.0,1.0,0,\
-                 false,0123456789abcdef,ok,,0.25,0.5,1.5,3.0,0.01,false,,none,\n",
-                SUMMARY_COLUMNS.join(","),
-                0.03125f64.sqrt()
-            )
+        let line = String::from_utf8(s).unwrap();
+        let line = line.lines().nth(1).unwrap();
+        // Paired ratios 1.5, 2, 2: the speedup is their geometric mean.
+        let speedup = (1.5f64 * 2.0 * 2.0).cbrt();
+        assert!(
+            line.starts_with(&format!(
+                "rayon-chunks,grid,seed,60,3,2,5,12,3,0.375,0.125,0.25,0.375,0.5,0.75,{speedup},"
+            )),
+            "{line}"
         );
+        assert!(line.ends_with(",false,,none,,grid"), "{line}");
     }
 
     #[test]
@@ -161,11 +155,10 @@ mod tests {
 
     #[test]
     fn to_csv_writes_the_header_then_the_rows() {
-        let m = measured();
-        let rows = trial_rows(&cell(), &m, None);
-        let bytes = to_csv(&TRIAL_COLUMNS, &rows).unwrap();
+        let (trials, _) = rows();
+        let bytes = to_csv(&TRIAL_COLUMNS, &trials).unwrap();
         let text = String::from_utf8(bytes).unwrap();
-        assert_eq!(text.lines().count(), 3);
+        assert_eq!(text.lines().count(), 4);
         assert!(text.starts_with("strategy,neighbors,"));
     }
 }

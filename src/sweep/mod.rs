@@ -2,19 +2,24 @@
 //!
 //! The pipeline, one module per step: the command line ([`crate::cli`]) becomes
 //! [`params::SweepParams`] (lists expanded by [`range`]); [`plan`] turns them into groups of
-//! cells; [`runner`] measures each cell (warm-ups, timed trials, the checksum guard, progress,
-//! Ctrl-C); [`rows`] turns measurements into rows (statistics from
-//! [`crate::results::stats`], intervals from [`bootstrap`]); [`export`] writes them to
-//! `trials.csv` and `summary.csv` after every cell, and `meta.json` records the sessions;
+//! cells; [`schedule`] orders each group's runs in shuffled rounds; [`runner`] measures them
+//! (the reference run, the checksum guard, [`windows`] of contention, the wait for a quiet
+//! machine, progress, Ctrl-C) and, after the grid, the cells [`confirm`] chooses; [`rows`]
+//! turns a run into its row and [`crate::results::summarize`] a phase's rows into summary
+//! rows (paired speedups, intervals from [`crate::results::intervals`]); [`export`] writes
+//! `trials.csv` and `summary.csv` as runs finish, and `meta.json` records the sessions;
 //! [`resume`] continues an interrupted sweep; [`console`] formats what is printed. The CLI
 //! then draws the report into the directory (`crate::cli::sweep::run`).
 //!
 //! What a results directory holds, and how it is read back, is [`crate::results`].
 
-pub mod bootstrap;
+pub mod confirm;
 pub mod console;
+#[cfg(test)]
+mod coverage;
 pub mod dir;
 pub mod export;
+pub mod input;
 pub mod lock;
 pub mod params;
 pub mod plan;
@@ -22,7 +27,9 @@ pub mod range;
 pub mod resume;
 pub mod rows;
 pub mod runner;
+pub mod schedule;
 pub mod timing;
+pub mod windows;
 
 use std::collections::{HashMap, HashSet};
 use std::fs::{File, OpenOptions};
@@ -34,14 +41,16 @@ use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::output::console::plural;
+use crate::results::key::{Cell, Group};
 use crate::results::meta::{Machine, Meta, Session, SweepStatus};
-use crate::results::rows::{Status, SummaryRow, TrialRow};
+use crate::results::rows::{Phase, Status, SummaryRow, TrialRow};
 use crate::results::shard::Shard;
 use lock::DirLock;
 use params::SweepParams;
-use plan::{Cell, Group, LabelStyle, Plan};
+use plan::{LabelStyle, Plan};
 use range::{Axis, compact};
-use runner::{Reference, Runner};
+use runner::{Kept, Runner};
+use schedule::Schedule;
 use timing::Timing;
 
 use crate::contention::Threshold;
@@ -72,8 +81,13 @@ pub enum Target {
 pub struct Request {
     /// New sweep or resume.
     pub target: Target,
-    /// Test only: stop as if Ctrl-C was pressed once this many cells are written.
-    pub stop_after_cells: Option<usize>,
+    /// With `--resume`: measure again every group that has a contended cell.
+    pub remeasure_contended: bool,
+    /// Longest wait for a quiet machine before each round, seconds (`--wait-quiet`; 0: do not
+    /// wait). A setting of the session, not of the plan: a resumed sweep may wait or not.
+    pub wait_quiet_s: u64,
+    /// Test only: stop as if Ctrl-C was pressed once this many runs are written.
+    pub stop_after_runs: Option<usize>,
     /// The command line, program name first (recorded in `meta.json`).
     pub command_line: Vec<String>,
 }
@@ -84,8 +98,8 @@ struct Opened {
     meta: Meta,
     /// Summary rows of cells finished by earlier sessions.
     finished: Vec<SummaryRow>,
-    /// Their trial rows.
-    finished_trials: Vec<TrialRow>,
+    /// Runs of unfinished phases that earlier sessions measured.
+    pending: Vec<TrialRow>,
     /// Whether the CSV files are new (and need their header lines).
     fresh: bool,
     /// The directory's lock, held until the sweep ends.
@@ -127,7 +141,7 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
             check_placements(params)?;
             start_new(params, out.as_deref(), *force, session)?
         }
-        Target::Resume { dir } => reopen(dir, session)?,
+        Target::Resume { dir } => reopen(dir, session, request.remeasure_contended)?,
     };
     let params = opened.meta.params.clone();
     if let Some(path) = params.simd {
@@ -151,15 +165,17 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
         hardware_threads,
         hz: crate::contention::ticks_per_second(),
     };
-    let done: HashSet<Cell> = opened.finished.iter().map(SummaryRow::key).collect();
-    let todo: Vec<usize> = (0..plan.cells.len())
-        .filter(|&i| !done.contains(&plan.cells[i]))
-        .collect();
-    let mut references = finished_references(&plan, &opened.finished, &opened.finished_trials);
+    let left = runs_left(&plan, &params, &opened.finished, &opened.pending);
 
     // Say what will happen before anything slow: the plan, the machine's load, then the
     // estimate (from short, bounded seq runs).
-    print_plan(&opened.dir, &params, &plan, &todo, hardware_threads);
+    print_plan(&opened.dir, &params, &plan, &left, hardware_threads);
+    if request.wait_quiet_s > 0 {
+        print(&format!(
+            "  before each round, waits up to {} for a quiet machine (--wait-quiet)",
+            console::duration(request.wait_quiet_s as f64)
+        ));
+    }
     let widest = plan.cells.iter().map(|c| c.cores).max().unwrap_or(1);
     let busy = busy_before(&timing, &threshold, widest);
     if let Some(session) = opened.meta.sessions.last_mut() {
@@ -169,7 +185,7 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
     if let Some(b) = busy.filter(|b| b.contended) {
         console_warn(&console::busy_warning(b.threads, hardware_threads));
     }
-    let run_ms = run_ms(&estimate(&plan, &todo, &params, hardware_threads)?);
+    let run_ms = run_ms(&estimate(&plan, &left, &params, hardware_threads)?);
 
     let exporter = export::Exporter::new(
         append(&opened.dir.join(TRIALS_FILE))?,
@@ -177,23 +193,86 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
         opened.fresh,
     )
     .context("cannot write the results")?;
-    let runner = Runner {
+    let total_ms = left
+        .runs
+        .iter()
+        .enumerate()
+        .map(|(i, &k)| run_ms[i].saturating_mul(k as u64))
+        .fold(0u64, u64::saturating_add);
+    let mut runner = Runner {
         plan: &plan,
-        warmup: params.warmup,
-        trials: params.trials,
-        seed: params.seed,
-        resamples: bootstrap::RESAMPLES,
+        params: &params,
         hardware_threads,
         threshold,
         timing,
-        stop_after_cells: request.stop_after_cells,
+        stop_after_runs: request.stop_after_runs,
+        wait_quiet: Duration::from_secs(request.wait_quiet_s),
         exporter,
-        progress: ProgressBar::hidden(),
+        progress: progress_bar(total_ms),
         run_ms,
-        shard: params.shard.map(|s| s.index),
+        runs_written: 0,
     };
-    let outcome = measure(runner, &todo, &mut references)?;
+    let kept = Kept {
+        finished: opened.finished.clone(),
+        pending: std::mem::take(&mut opened.pending),
+    };
+    let outcome = runner.run(&kept);
+    runner.progress.finish_and_clear();
+    let outcome = outcome?;
     conclude(opened, plan, outcome.rows, outcome.interrupted)
+}
+
+/// The runs a sweep has left: per plan position, the timed runs still to do (the grid's, plus
+/// the most the confirmation could ask for), and the phases already finished.
+#[derive(Debug, Clone, PartialEq)]
+struct Left {
+    /// Timed runs left per cell of the plan.
+    runs: Vec<usize>,
+    /// Cell phases finished by earlier sessions.
+    finished: usize,
+}
+
+/// What is left of the plan, given the finished summary rows and pending runs (the
+/// confirmation's cells counted at their most, [`confirm::most_chosen`], spread over the
+/// group's `seq` cell for the estimate).
+fn runs_left(
+    plan: &Plan,
+    params: &SweepParams,
+    finished: &[SummaryRow],
+    pending: &[TrialRow],
+) -> Left {
+    let mut runs = vec![0usize; plan.cells.len()];
+    for (i, cell) in plan.cells.iter().enumerate() {
+        let done = |phase: Phase| {
+            finished
+                .iter()
+                .any(|r| r.key() == *cell && r.phase == phase)
+        };
+        if !done(Phase::Grid) {
+            let measured = pending
+                .iter()
+                .filter(|t| t.key() == *cell && t.phase == Phase::Grid)
+                .count();
+            runs[i] += params.trials.saturating_sub(measured);
+        }
+    }
+    if params.confirm_rounds > 0 && params.shard.is_none() {
+        for group in &plan.groups {
+            let confirmed = finished
+                .iter()
+                .any(|r| r.group() == *group && r.phase == Phase::Confirm);
+            if confirmed {
+                continue;
+            }
+            if let Some(seq) = plan.cells.iter().position(|c| c.group == *group) {
+                runs[seq] += confirm::most_chosen(plan, group) * params.confirm_rounds;
+            }
+        }
+    }
+    Left {
+        runs,
+        finished: finished.len(),
+    }
 }
 
 /// Refuses, before anything runs, a placement of `params.pin` that the operating system
@@ -203,24 +282,6 @@ fn check_placements(params: &SweepParams) -> anyhow::Result<()> {
         crate::placement::placement(pin).context("cannot place the sweep's threads")?;
     }
     Ok(())
-}
-
-/// Runs the cells `todo` under a progress bar measured in estimated milliseconds (see
-/// [`progress_bar`]), cleared when the runner stops.
-fn measure<T: std::io::Write, S: std::io::Write>(
-    mut runner: Runner<'_, T, S>,
-    todo: &[usize],
-    references: &mut HashMap<Group, Reference>,
-) -> anyhow::Result<runner::SessionOutcome> {
-    let runs_per_cell = (runner.warmup + runner.trials) as u64;
-    let total_ms = todo
-        .iter()
-        .map(|&i| runner.run_ms[i].saturating_mul(runs_per_cell))
-        .fold(0u64, u64::saturating_add);
-    runner.progress = progress_bar(total_ms);
-    let outcome = runner.run(todo, references);
-    runner.progress.finish_and_clear();
-    outcome
 }
 
 /// Estimated milliseconds of one run of each cell (at least 1), from [`estimate`]'s seconds.
@@ -247,14 +308,15 @@ fn conclude(
     let cells_run = new_rows.len();
     let mut rows = std::mem::take(&mut opened.finished);
     rows.extend(new_rows);
-    let status = if interrupted || rows.len() < plan.cells.len() {
+    let grid_rows = rows.iter().filter(|r| r.phase == Phase::Grid).count();
+    let status = if interrupted || grid_rows < plan.cells.len() {
         SweepStatus::Interrupted
     } else {
         SweepStatus::Complete
     };
     opened.meta.finish(status, cells_run);
     opened.meta.write(&opened.dir.join(META_FILE))?;
-    if let Some(contended) = console::contended_cells(&rows) {
+    if let Some(contended) = console::contended_cells(&opened.dir, &rows) {
         console_warn(&contended);
     }
     Ok(Finished {
@@ -278,7 +340,7 @@ impl Finished {
         self.shard
     }
 
-    /// Whether every planned cell is finished (the report is drawn only then).
+    /// Whether every planned phase is finished (the report is drawn only then).
     pub fn is_complete(&self) -> bool {
         self.status == SweepStatus::Complete
     }
@@ -298,11 +360,10 @@ impl Finished {
     pub fn outcome(self) -> anyhow::Result<()> {
         let (dir, rows, planned) = (&self.dir, &self.rows, self.plan.cells.len());
         if self.status == SweepStatus::Interrupted {
+            let grid = rows.iter().filter(|r| r.phase == Phase::Grid).count();
             bail!(
-                "interrupted: {} of {} cells are finished and saved in '{}'; \
-                 continue with `bench-sph sweep --resume {}`",
-                rows.len(),
-                planned,
+                "interrupted: {grid} of {planned} cells are finished, and every run measured \
+                 is saved in '{}'; continue with `bench-sph sweep --resume {}`",
                 dir.display(),
                 dir.display()
             );
@@ -321,27 +382,6 @@ impl Finished {
         }
         Ok(())
     }
-}
-
-/// The references of groups whose `seq` cell an earlier session finished.
-fn finished_references(
-    plan: &Plan,
-    finished: &[SummaryRow],
-    trials: &[TrialRow],
-) -> HashMap<Group, Reference> {
-    finished
-        .iter()
-        .filter(|r| r.key().is_reference())
-        .filter_map(|r| {
-            let cell = plan.cells.iter().find(|&&c| c == r.key())?;
-            let walls = trials
-                .iter()
-                .filter(|t| t.key() == r.key())
-                .map(|t| t.wall_s)
-                .collect();
-            Some((cell.group, Reference::from_row(r, walls)))
-        })
-        .collect()
 }
 
 /// Refuses, before anything is allocated, a group too large for the machine's memory: a run
@@ -389,7 +429,7 @@ fn busy_before(timing: &Timing, threshold: &Threshold, cores: usize) -> Option<B
 /// has cells to run; printed as the plan's last line.
 fn estimate(
     plan: &Plan,
-    todo: &[usize],
+    left: &Left,
     params: &SweepParams,
     hardware_threads: usize,
 ) -> anyhow::Result<Vec<f64>> {
@@ -397,14 +437,14 @@ fn estimate(
         .groups
         .iter()
         .copied()
-        .filter(|g| todo.iter().any(|&i| plan.cells[i].group == *g))
+        .filter(|g| (0..plan.cells.len()).any(|i| left.runs[i] > 0 && plan.cells[i].group == *g))
         .collect();
     if !groups.is_empty() {
         let _ = crate::output::console::line("  estimating the time (a short seq run per group)…");
     }
     let seq_run_s: HashMap<Group, f64> = groups
         .iter()
-        .map(|&g| (g, runner::calibrate(g, params.seed)))
+        .map(|&g| (g, input::calibrate(g, params.seed)))
         .collect();
     let run_s: Vec<f64> = plan
         .cells
@@ -414,10 +454,19 @@ fn estimate(
             plan::estimate_run_s(c, seq, hardware_threads)
         })
         .collect();
-    let total: f64 = todo
-        .iter()
-        .map(|&i| run_s[i] * (params.warmup + params.trials) as f64)
-        .sum();
+    // The timed runs, plus the warm-ups: each phase's reference runs under rounds, each
+    // cell's under cells.
+    let warmups = match params.schedule {
+        Schedule::Rounds => 0.0,
+        Schedule::Cells => params.warmup as f64,
+    };
+    let reference_runs = groups.len() as f64 * (params.warmup.max(1) + 1) as f64;
+    let seq_mean = groups.iter().map(|g| seq_run_s[g]).sum::<f64>() / groups.len().max(1) as f64;
+    let total: f64 = (0..plan.cells.len())
+        .filter(|&i| left.runs[i] > 0)
+        .map(|i| run_s[i] * (left.runs[i] as f64 + warmups))
+        .sum::<f64>()
+        + reference_runs * seq_mean;
     let mut text = String::new();
     for g in &groups {
         text.push_str(&format!(
@@ -427,8 +476,8 @@ fn estimate(
         ));
     }
     text.push_str(&format!(
-        "  estimated time: about {} (assuming ideal speedup up to {} hardware threads; the \
-         progress bar's ETA corrects it)\n",
+        "  estimated time: at most about {} (assuming ideal speedup up to {} hardware threads \
+         and the largest confirmation; the progress bar's ETA corrects it)\n",
         console::duration(total),
         hardware_threads
     ));
@@ -468,16 +517,17 @@ fn start_new(
         dir,
         meta,
         finished: Vec::new(),
-        finished_trials: Vec::new(),
+        pending: Vec::new(),
         fresh: true,
         lock,
     })
 }
 
-/// Reads an earlier sweep's parameters (checked as the command line checks them) and
-/// finished cells (each re-checked), repairs its CSV files, and records this session in its
-/// `meta.json`.
-fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
+/// Reads an earlier sweep's parameters (checked as the command line checks them), finished
+/// cells and runs of unfinished rounds (each re-checked), repairs its CSV files (with
+/// `remeasure`, without the rows of every group that has a contended cell), and records this
+/// session in its `meta.json`.
+fn reopen(dir: &Path, session: Session, remeasure: bool) -> anyhow::Result<Opened> {
     let lock = dir::open_existing(dir)?;
     let meta_path = dir.join(META_FILE);
     let mut meta = Meta::read(&meta_path)?;
@@ -497,40 +547,78 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
     let plan = Plan::new(&meta.params);
     check_memory(&plan)?;
     let planned: HashSet<Cell> = plan.cells.iter().copied().collect();
-    let trials = meta.params.trials;
-    let check = |row: &SummaryRow| -> Result<(), String> {
-        if !planned.contains(&row.key()) {
+    let params = &meta.params;
+    let rounds = |phase: Phase| match phase {
+        Phase::Grid => params.trials,
+        Phase::Confirm if params.shard.is_none() => params.confirm_rounds,
+        Phase::Confirm => 0,
+    };
+    let check_cell = |row: &SummaryRow| -> Result<(), String> {
+        if !planned.contains(&row.key()) || rounds(row.phase) == 0 {
             return Err("not a cell of this sweep's plan".to_owned());
         }
-        // A failed cell is finished whatever number of trials it got to.
-        if row.status == Status::Ok && row.trials != trials {
+        // A failed cell is finished whatever number of rounds it got to.
+        let want = rounds(row.phase);
+        if row.status == Status::Ok && row.trials != want {
             return Err(format!(
-                "{} trials, but the sweep asks for {trials}",
-                row.trials
+                "{} rounds, but the sweep's {} phase has {want}",
+                row.trials,
+                row.phase.as_str()
             ));
         }
         Ok(())
     };
-    let repaired = resume::load_and_repair(dir, &check)?;
+    let check_run = |row: &TrialRow| -> Result<(), String> {
+        if !planned.contains(&row.key()) {
+            return Err("not a cell of this sweep's plan".to_owned());
+        }
+        match (row.round, row.position) {
+            (Some(r), Some(_)) if (1..=rounds(row.phase)).contains(&r) => Ok(()),
+            _ => Err(format!(
+                "not a round of the sweep's {} phase",
+                row.phase.as_str()
+            )),
+        }
+    };
+    let mut repaired = resume::load_and_repair(dir, &check_cell, &check_run)?;
     warn_if_changed(&meta, &session);
     for why in &repaired.rejected {
         console_warn(&format!("warning: dropped, will run again: {why}"));
     }
-    if repaired.upgraded {
+    if remeasure {
+        let contended: HashSet<Group> = repaired
+            .finished
+            .iter()
+            .filter(|r| r.contended == Some(true))
+            .map(SummaryRow::group)
+            .chain(
+                repaired
+                    .pending
+                    .iter()
+                    .filter(|t| t.contended == Some(true))
+                    .map(TrialRow::group),
+            )
+            .collect();
+        let removed = repaired.without_groups(&contended);
+        resume::write_back(dir, &repaired)?;
         print(&format!(
-            "Upgraded '{}': its CSV files were written by an earlier version; the columns it \
-             lacked (of reference_shard, pin, smt; passes_alone in trials.csv) are appended, \
-             empty (pin empty = none, passes_alone empty = unknown)",
-            dir.display()
+            "--remeasure-contended: {} with contended cells will be measured again from their \
+             first round ({removed} rows removed)",
+            plural(contended.len(), "group", "groups")
         ));
     }
     print(&format!(
-        "Resuming '{}': {} finished cells kept{}",
+        "Resuming '{}': {} and {} kept{}",
         dir.display(),
-        repaired.finished.len(),
+        plural(repaired.finished.len(), "finished cell", "finished cells"),
+        plural(
+            repaired.pending.len(),
+            "run of unfinished rounds",
+            "runs of unfinished rounds"
+        ),
         match repaired.dropped_trial_rows + repaired.dropped_summary_rows {
             0 => String::new(),
-            k => format!(" ({k} rows of unfinished or rejected cells dropped)"),
+            k => format!(" ({k} cut-off, repeated or rejected rows dropped)"),
         }
     ));
     meta.sessions.push(session);
@@ -541,7 +629,7 @@ fn reopen(dir: &Path, session: Session) -> anyhow::Result<Opened> {
         dir: dir.to_path_buf(),
         meta,
         finished: repaired.finished,
-        finished_trials: repaired.finished_trials,
+        pending: repaired.pending,
         fresh: false,
         lock,
     })
@@ -576,13 +664,7 @@ fn append(path: &Path) -> anyhow::Result<BufWriter<File>> {
 }
 
 /// The plan: groups, strategies, lists, cells and runs; warnings on standard error.
-fn print_plan(
-    dir: &Path,
-    params: &SweepParams,
-    plan: &Plan,
-    todo: &[usize],
-    hardware_threads: usize,
-) {
+fn print_plan(dir: &Path, params: &SweepParams, plan: &Plan, left: &Left, hardware_threads: usize) {
     let mut text = format!("bench-sph sweep → {}\n", dir.display());
     for group in &plan.groups {
         text.push_str(&format!("  group: {}\n", group.label(LabelStyle::Sweep)));
@@ -607,22 +689,13 @@ fn print_plan(
         compact(&params.chunks, Axis::Chunks),
         chunked_strategies(params)
     ));
-    text.push_str(&format!(
-        "  {} × ({} + {}) = {}\n",
-        plural(plan.cells.len(), "cell", "cells"),
-        plural(params.warmup, "warm-up", "warm-ups"),
-        plural(params.trials, "trial", "trials"),
-        plural(
-            plan.cells.len() * (params.warmup + params.trials),
-            "run",
-            "runs"
-        ),
-    ));
-    if todo.len() < plan.cells.len() {
+    text.push_str(&schedule_text(params, plan));
+    let to_run: usize = left.runs.iter().sum();
+    if left.finished > 0 || to_run < plan.cells.len() * params.trials {
         text.push_str(&format!(
-            "  {} already finished, {} to run\n",
-            plan.cells.len() - todo.len(),
-            todo.len()
+            "  {} finished by earlier sessions; at most {} to run\n",
+            plural(left.finished, "cell phase", "cell phases"),
+            plural(to_run, "timed run", "timed runs"),
         ));
     }
     print(&text);
@@ -641,6 +714,34 @@ fn print_plan(
              are not measurements",
         );
     }
+}
+
+/// How the runs are ordered, in two lines of the plan.
+fn schedule_text(params: &SweepParams, plan: &Plan) -> String {
+    let cells = plural(plan.cells.len(), "cell", "cells");
+    let mut text = match params.schedule {
+        Schedule::Rounds => format!(
+            "  {cells} × {}: in each round every cell of a group runs once, in an order \
+             shuffled from --seed {} ({} untimed seq {} first)\n",
+            plural(params.trials, "round", "rounds"),
+            params.seed,
+            params.warmup.max(1),
+            if params.warmup > 1 { "runs" } else { "run" },
+        ),
+        Schedule::Cells => format!(
+            "  {cells} × ({} + {}), each cell's runs back to back (--schedule cells)\n",
+            plural(params.warmup, "warm-up", "warm-ups"),
+            plural(params.trials, "trial", "trials"),
+        ),
+    };
+    if params.confirm_rounds > 0 && params.shard.is_none() {
+        text.push_str(&format!(
+            "  then, per group, each strategy's best cell per core count (and runner-up, with \
+             chunks) again in {} of their own: the findings rest on those\n",
+            plural(params.confirm_rounds, "round", "rounds")
+        ));
+    }
+    text
 }
 
 fn chunked_strategies(params: &SweepParams) -> String {

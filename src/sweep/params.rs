@@ -34,6 +34,8 @@ impl SweepParams {
         check("steps", self.steps, 1, limits::MAX_STEPS)?;
         check("trials", self.trials, 1, limits::MAX_TRIALS)?;
         check("warmup", self.warmup, 0, limits::MAX_WARMUP)?;
+        check("confirm-rounds", self.confirm_rounds, 0, limits::MAX_TRIALS)?;
+
         let lists = [
             self.presets.len(),
             self.neighbors.len(),

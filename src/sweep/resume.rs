@@ -1,17 +1,23 @@
-//! `--resume DIR`: what an earlier session finished, and the repairs that make each trial
+//! `--resume DIR`: what an earlier session finished, and the repairs that make each run
 //! appear exactly once.
 //!
-//! A cell counts as finished when `summary.csv` has its row and `trials.csv` has exactly
-//! `trials` rows for it (numbered 1, 2, …). Everything else of an unfinished cell — trial rows
-//! written just before a kill, a line cut off mid-write — is dropped, both files are written
-//! back without it, and the cell runs again. Failed cells are finished too: their failure is a
-//! result (delete their rows by hand to retry them).
+//! A cell's phase ([`Phase`]) counts as finished when `summary.csv` has its row and
+//! `trials.csv` has exactly `trials` rows for it (numbered 1, 2, …). The runs of a phase that
+//! has no summary row yet are **pending**: each (cell, phase, round) is kept once, and the
+//! runner skips those runs and continues the round it was in. Everything else — a line cut off
+//! mid-write, a repeated row, a run the caller's check refuses — is dropped, both files are
+//! written back without it, and the run happens again. Failed cells are finished too: their
+//! failure is a result (delete their rows by hand to retry them).
 //!
 //! A finished cell is believed only if it passes [`crate::results::validate::cell`] (finite
-//! positive
-//! times, statistics that are those of its trials) and the caller's own check (`--resume`:
-//! the cell is in the plan and has the sweep's number of trials); otherwise it is dropped,
-//! listed in [`Repaired::rejected`], and runs again.
+//! positive times, statistics that are those of its trials) and the caller's own check
+//! (`--resume`: the cell is in the plan and has the phase's number of rounds); a pending run
+//! only if its times are possible and the caller's check of runs accepts it (its cell and round
+//! are in the plan). Otherwise it is dropped, listed in [`Repaired::rejected`], and runs again.
+//!
+//! Directories written before rounds (their files lack `round` and the other columns after
+//! `pin`) cannot be continued: their cells ran back to back, and a paired speedup needs the
+//! rounds they do not have. Resuming one is refused with a message saying so.
 
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -20,98 +26,124 @@ use anyhow::Context;
 
 use super::export::to_csv;
 use super::plan::Cell;
+use crate::results::key::Group;
 use crate::results::rows::{
-    EARLIER_SUMMARY_WIDTHS, EARLIER_TRIAL_WIDTHS, SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS,
-    TrialRow,
+    Phase, SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow, is_older_summary_header,
+    is_older_trial_header,
 };
 
-/// A results file whose header is not this version's.
+/// Why a directory's files cannot be resumed.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error(
-    "{file} has the columns '{found}', not those bench-sph {} writes",
-    crate::results::meta::VERSION
-)]
-pub struct UnexpectedColumns {
-    /// The file's name.
-    pub file: &'static str,
-    /// Its header line.
-    pub found: String,
+pub enum NotResumable {
+    /// A header that is not a results file's.
+    #[error(
+        "{file} has the columns '{found}', not those bench-sph {} writes",
+        crate::results::meta::VERSION
+    )]
+    UnexpectedColumns {
+        /// The file's name.
+        file: &'static str,
+        /// Its header line.
+        found: String,
+    },
+    /// A file an earlier version wrote, before rounds.
+    #[error(
+        "{file} was written by an earlier bench-sph, which ran each cell's trials back to back: \
+         its cells have no rounds to pair and continue. Report it as it is (`bench-sph report \
+         DIR`), or measure again in a new sweep"
+    )]
+    BeforeRounds {
+        /// The file's name.
+        file: &'static str,
+    },
 }
 
-/// The finished cells of a results directory, and its files with everything else removed.
+/// A caller's check of a finished cell's summary row.
+pub type CheckCell<'a> = &'a dyn Fn(&SummaryRow) -> Result<(), String>;
+/// A caller's check of a pending run.
+pub type CheckRun<'a> = &'a dyn Fn(&TrialRow) -> Result<(), String>;
+
+/// The finished cells and pending runs of a results directory, and its files with everything
+/// else removed.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Repaired {
-    /// The summary rows of the finished cells, in file order.
+    /// The summary rows of the finished cell phases, in file order.
     pub finished: Vec<SummaryRow>,
-    /// The trial rows of the finished cells.
+    /// The trial rows of the finished cell phases.
     pub finished_trials: Vec<TrialRow>,
-    /// Finished-looking cells that were dropped: the cell and why.
+    /// The runs of unfinished cell phases, each (cell, phase, round) once, in file order.
+    pub pending: Vec<TrialRow>,
+    /// Rows that were dropped although they were whole: the cell (or run) and why.
     pub rejected: Vec<String>,
-    /// `trials.csv` as it should be: header plus the finished cells' trial rows.
+    /// `trials.csv` as it should be: header, the finished cells' trial rows, the pending runs.
     pub trials_csv: Vec<u8>,
     /// `summary.csv` as it should be: header plus the finished cells' rows.
     pub summary_csv: Vec<u8>,
-    /// Trial rows kept.
-    pub kept_trial_rows: usize,
     /// Trial rows (or broken lines) dropped from `trials.csv`.
     pub dropped_trial_rows: usize,
     /// Summary rows (or broken lines) dropped from `summary.csv`.
     pub dropped_summary_rows: usize,
-    /// Whether a file had the columns of an earlier version (`reference_shard`, `pin` or `smt`
-    /// of `summary.csv`, `pin` or `passes_alone` of `trials.csv` missing): its repaired contents
-    /// have every column, those empty (the upgrade).
-    pub upgraded: bool,
 }
 
 /// Repairs the contents of `trials.csv` and `summary.csv` (either may be empty: no file);
-/// `check` is the caller's own test of a finished cell (see the module docs).
-// Over ~60 lines on purpose: the repair is one pass over the rows whose steps (first row per cell,
-// trials once per number, finished = complete and believed) are the module docs' list in order.
+/// `check_cell` and `check_run` are the caller's own tests (see the module docs).
+// Over ~60 lines on purpose: the repair is one pass over the rows whose steps (first row per
+// cell, trials once per number, finished = complete and believed, the rest pending) are the
+// module docs' list in order.
 pub fn repair(
     trials: &[u8],
     summary: &[u8],
-    check: &dyn Fn(&SummaryRow) -> Result<(), String>,
-) -> Result<Repaired, UnexpectedColumns> {
-    let (summary_rows, mut dropped_summary_rows, older_summary) = read_rows::<SummaryRow>(
+    check_cell: CheckCell<'_>,
+    check_run: CheckRun<'_>,
+) -> Result<Repaired, NotResumable> {
+    let (summary_rows, mut dropped_summary_rows) = read_rows::<SummaryRow>(
         summary,
         "summary.csv",
         &SUMMARY_COLUMNS,
-        &EARLIER_SUMMARY_WIDTHS,
+        is_older_summary_header,
     )?;
-    let (trial_rows, mut dropped_trial_rows, older_trials) =
-        read_rows::<TrialRow>(trials, "trials.csv", &TRIAL_COLUMNS, &EARLIER_TRIAL_WIDTHS)?;
+    let (trial_rows, mut dropped_trial_rows) =
+        read_rows::<TrialRow>(trials, "trials.csv", &TRIAL_COLUMNS, is_older_trial_header)?;
 
-    // The first summary row of each cell; the trial rows of each cell, once per number.
+    // The first summary row of each cell phase; the trial rows of each, once per number.
     let mut seen = HashSet::new();
     let mut candidates = Vec::new();
     for row in summary_rows {
-        if seen.insert(row.key()) {
+        if seen.insert(row.phased_key()) {
             candidates.push(row);
         } else {
             dropped_summary_rows += 1;
         }
     }
-    let mut by_cell: HashMap<Cell, Vec<TrialRow>> = HashMap::new();
-    for row in trial_rows {
-        let rows = by_cell.entry(row.key()).or_default();
-        if rows.iter().any(|r| r.trial == row.trial) {
+    // Each row with its place in the file, so that what is kept keeps its order.
+    let mut by_cell: HashMap<(Cell, Phase), Vec<(usize, TrialRow)>> = HashMap::new();
+    for (at, row) in trial_rows.into_iter().enumerate() {
+        let rows = by_cell.entry(row.phased_key()).or_default();
+        let repeated = rows
+            .iter()
+            .any(|(_, r)| r.trial == row.trial || (r.round.is_some() && r.round == row.round));
+        if repeated {
             dropped_trial_rows += 1;
         } else {
-            rows.push(row);
+            rows.push((at, row));
         }
     }
 
     // Finished = a summary row and trials numbered exactly 1..=trials.
     let mut finished = Vec::new();
-    let mut kept = Vec::new();
+    let mut kept: Vec<(usize, TrialRow)> = Vec::new();
     let mut rejected = Vec::new();
     for row in candidates {
-        let mut trials = by_cell.remove(&row.key()).unwrap_or_default();
-        trials.sort_by_key(|t| t.trial);
-        let complete =
-            trials.len() == row.trials && trials.iter().enumerate().all(|(i, t)| t.trial == i + 1);
+        let mut trials = by_cell.remove(&row.phased_key()).unwrap_or_default();
+        trials.sort_by_key(|(_, t)| t.trial);
+        let complete = trials.len() == row.trials
+            && trials
+                .iter()
+                .enumerate()
+                .all(|(i, (_, t))| t.trial == i + 1);
         let believed = if complete {
-            crate::results::validate::cell(&row, &trials).and_then(|()| check(&row))
+            let rows: Vec<TrialRow> = trials.iter().map(|(_, t)| t.clone()).collect();
+            crate::results::validate::cell(&row, &rows).and_then(|()| check_cell(&row))
         } else {
             Ok(())
         };
@@ -121,67 +153,115 @@ pub fn repair(
         if complete && believed.is_ok() {
             kept.extend(trials);
             finished.push(row);
-        } else {
+        } else if complete {
             dropped_trial_rows += trials.len();
+            dropped_summary_rows += 1;
+        } else {
+            // A summary row written before its phase's last runs (or whose runs were cut):
+            // the runs stay, as runs of an unfinished phase.
+            by_cell.insert(row.phased_key(), trials);
             dropped_summary_rows += 1;
         }
     }
-    dropped_trial_rows += by_cell.values().map(Vec::len).sum::<usize>();
+
+    // The rest are the runs of unfinished phases.
+    let mut rest: Vec<(usize, TrialRow)> = by_cell.into_values().flatten().collect();
+    rest.sort_by_key(|(at, _)| *at);
+    let mut pending = Vec::new();
+    for (at, run) in rest {
+        match crate::results::validate::run(&run).and_then(|()| check_run(&run)) {
+            Ok(()) => pending.push((at, run)),
+            Err(why) => {
+                rejected.push(format!(
+                    "{}, round {}: {why}",
+                    run.key().label_with_group(),
+                    run.round.unwrap_or(run.trial)
+                ));
+                dropped_trial_rows += 1;
+            }
+        }
+    }
+    kept.sort_by_key(|(at, _)| *at);
+    let kept: Vec<TrialRow> = kept.into_iter().map(|(_, t)| t).collect();
+    let pending: Vec<TrialRow> = pending.into_iter().map(|(_, t)| t).collect();
 
     let csv_bytes = |result: csv::Result<Vec<u8>>| result.expect("CSV into memory cannot fail");
+    let all_trials: Vec<&TrialRow> = kept.iter().chain(&pending).collect();
     Ok(Repaired {
-        trials_csv: csv_bytes(to_csv(&TRIAL_COLUMNS, &kept)),
+        trials_csv: csv_bytes(to_csv(&TRIAL_COLUMNS, &all_trials)),
         summary_csv: csv_bytes(to_csv(&SUMMARY_COLUMNS, &finished)),
-        kept_trial_rows: kept.len(),
         finished,
         finished_trials: kept,
+        pending,
         rejected,
         dropped_trial_rows,
         dropped_summary_rows,
-        upgraded: older_summary || older_trials,
     })
 }
 
-/// The complete rows of a CSV file, the number of lines that were not (a last line without
-/// its newline, cut off by a kill, or a row that does not parse), and whether its header was
-/// the first `w` of `columns` for a width `w` of `older` (an earlier version's file, whose
-/// missing columns are empty).
+impl Repaired {
+    /// The same directory without any row of `groups` (`--remeasure-contended`): those groups
+    /// run again from their first round. Returns the rows removed.
+    pub fn without_groups(&mut self, groups: &HashSet<Group>) -> usize {
+        let before = self.finished.len() + self.finished_trials.len() + self.pending.len();
+        self.finished.retain(|r| !groups.contains(&r.group()));
+        self.finished_trials
+            .retain(|r| !groups.contains(&r.group()));
+        self.pending.retain(|r| !groups.contains(&r.group()));
+        let after = self.finished.len() + self.finished_trials.len() + self.pending.len();
+        let csv_bytes = |result: csv::Result<Vec<u8>>| result.expect("CSV into memory cannot fail");
+        let all_trials: Vec<&TrialRow> = self.finished_trials.iter().chain(&self.pending).collect();
+        self.trials_csv = csv_bytes(to_csv(&TRIAL_COLUMNS, &all_trials));
+        self.summary_csv = csv_bytes(to_csv(&SUMMARY_COLUMNS, &self.finished));
+        before - after
+    }
+}
+
+/// The complete rows of a CSV file and the number of lines that were not (a last line without
+/// its newline, cut off by a kill, or a row that does not parse). A header that `older`
+/// accepts is an earlier version's file, which cannot be resumed.
 fn read_rows<R: serde::de::DeserializeOwned>(
     bytes: &[u8],
     file: &'static str,
     columns: &[&str],
-    older: &[usize],
-) -> Result<(Vec<R>, usize, bool), UnexpectedColumns> {
+    older: fn(&[&str]) -> bool,
+) -> Result<(Vec<R>, usize), NotResumable> {
     let complete = match bytes.iter().rposition(|&b| b == b'\n') {
         Some(last) => &bytes[..=last],
         None => &[][..],
     };
     let mut dropped = usize::from(complete.len() < bytes.len());
     if complete.is_empty() {
-        return Ok((Vec::new(), dropped, false));
+        return Ok((Vec::new(), dropped));
     }
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(true)
         .from_reader(complete);
-    let header = reader
-        .headers()
-        .map(|h| h.iter().collect::<Vec<_>>().join(","));
-    let is_older = |h: &str| older.iter().any(|&w| h == columns[..w].join(","));
-    let upgraded = match header {
-        Ok(h) if h == columns.join(",") => false,
-        Ok(h) if is_older(&h) => true,
-        Ok(h) => return Err(UnexpectedColumns { file, found: h }),
+    let first_line = || {
+        String::from_utf8_lossy(complete.split(|&b| b == b'\n').next().unwrap_or_default())
+            .into_owned()
+    };
+    match reader.headers() {
+        Ok(h) => {
+            let found: Vec<&str> = h.iter().collect();
+            if older(&found) {
+                return Err(NotResumable::BeforeRounds { file });
+            }
+            if found != columns {
+                return Err(NotResumable::UnexpectedColumns {
+                    file,
+                    found: found.join(","),
+                });
+            }
+        }
         Err(_) => {
-            return Err(UnexpectedColumns {
+            return Err(NotResumable::UnexpectedColumns {
                 file,
-                found: String::from_utf8_lossy(
-                    complete.split(|&b| b == b'\n').next().unwrap_or_default(),
-                )
-                .into_owned(),
+                found: first_line(),
             });
         }
-    };
+    }
     let mut rows = Vec::new();
     for record in reader.deserialize::<R>() {
         match record {
@@ -189,7 +269,7 @@ fn read_rows<R: serde::de::DeserializeOwned>(
             Err(_) => dropped += 1,
         }
     }
-    Ok((rows, dropped, upgraded))
+    Ok((rows, dropped))
 }
 
 /// Reads `dir`'s CSV files (a missing one counts as empty), repairs them with `check`, and
@@ -197,7 +277,8 @@ fn read_rows<R: serde::de::DeserializeOwned>(
 /// original).
 pub fn load_and_repair(
     dir: &Path,
-    check: &dyn Fn(&SummaryRow) -> Result<(), String>,
+    check_cell: CheckCell<'_>,
+    check_run: CheckRun<'_>,
 ) -> anyhow::Result<Repaired> {
     let read = |name: &str| -> anyhow::Result<Vec<u8>> {
         let path = dir.join(name);
@@ -207,26 +288,38 @@ pub fn load_and_repair(
             Err(e) => Err(e).with_context(|| format!("cannot read '{}'", path.display())),
         }
     };
-    let repaired = repair(&read("trials.csv")?, &read("summary.csv")?, check)
-        .with_context(|| format!("cannot resume '{}'", dir.display()))?;
+    let repaired = repair(
+        &read("trials.csv")?,
+        &read("summary.csv")?,
+        check_cell,
+        check_run,
+    )
+    .with_context(|| format!("cannot resume '{}'", dir.display()))?;
+    write_back(dir, &repaired)?;
+    Ok(repaired)
+}
+
+/// Writes `repaired`'s files into `dir` (each through a temporary file renamed over the
+/// original).
+pub fn write_back(dir: &Path, repaired: &Repaired) -> anyhow::Result<()> {
     for (name, bytes) in [
         ("trials.csv", &repaired.trials_csv),
         ("summary.csv", &repaired.summary_csv),
     ] {
         crate::output::atomic::write(&dir.join(name), bytes)?;
     }
-    Ok(repaired)
+    Ok(())
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::clock::Elapsed;
     use crate::results::key::test_group;
+    use crate::results::rows::Status;
+    use crate::results::summarize::{CellContext, fixtures, summary_row};
     use crate::sph::neighbors::NeighborMode;
     use crate::sweep::export::Exporter;
     use crate::sweep::plan::Cell;
-    use crate::sweep::rows::{Measured, summary_row, test_context, trial_rows};
     use sph_strategies::StrategyName;
 
     fn cell(cores: usize) -> Cell {
@@ -239,166 +332,186 @@ mod tests {
         }
     }
 
-    fn measured(k: usize) -> Vec<Measured> {
-        (1..=k)
-            .map(|i| Measured {
-                elapsed: Elapsed {
-                    passes_alone: 0,
-                    wall_s: i as f64,
-                    cpu_s: i as f64,
-                    foreign: None,
-                },
-                load1: None,
-                checksum: "00000000000000ff".to_owned(),
-            })
-            .collect()
+    fn summary(cell: &Cell, trials: &[TrialRow]) -> SummaryRow {
+        let ctx = CellContext {
+            hardware_threads: 2,
+            shard: None,
+            smt: None,
+        };
+        summary_row(cell, Phase::Grid, trials, None, None, &ctx)
     }
 
-    /// Two finished cells, as an uninterrupted session writes them.
-    fn two_cells() -> (Vec<u8>, Vec<u8>) {
+    fn accept_cell(_: &SummaryRow) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn accept_run(_: &TrialRow) -> Result<(), String> {
+        Ok(())
+    }
+
+    /// A finished phase of two cells (3 rounds each), as an uninterrupted session writes it.
+    fn finished_phase() -> (Vec<u8>, Vec<u8>) {
         let (mut t, mut s) = (Vec::new(), Vec::new());
         let mut e = Exporter::new(&mut t, &mut s, true).unwrap();
-        for cores in [1, 2] {
-            let m = measured(3);
-            e.write_cell(
-                &trial_rows(&cell(cores), &m, None),
-                &summary_row(&cell(cores), &m, None, &test_context(Some(&[1.0]), 2)),
-            )
-            .unwrap();
+        let runs: Vec<Vec<TrialRow>> = [1, 2]
+            .iter()
+            .map(|&c| fixtures::trials(&cell(c), &[1.0, 2.0, 3.0]))
+            .collect();
+        for round in 0..3 {
+            e.write_trials(&[runs[0][round].clone(), runs[1][round].clone()])
+                .unwrap();
         }
+        e.write_summaries(&[summary(&cell(1), &runs[0]), summary(&cell(2), &runs[1])])
+            .unwrap();
         drop(e);
         (t, s)
     }
 
+    fn repair_all(t: &[u8], s: &[u8]) -> Repaired {
+        repair(t, s, &accept_cell, &accept_run).unwrap()
+    }
+
     #[test]
     fn intact_files_come_back_unchanged() {
-        let (t, s) = two_cells();
-        let r = repair(&t, &s, &|_| Ok(())).unwrap();
+        let (t, s) = finished_phase();
+        let r = repair_all(&t, &s);
+        assert_eq!(r.rejected, Vec::<String>::new());
+        assert_eq!(r.dropped_summary_rows, 0);
         assert_eq!(r.finished.len(), 2);
-        assert_eq!(
-            (
-                r.kept_trial_rows,
-                r.dropped_trial_rows,
-                r.dropped_summary_rows
-            ),
-            (6, 0, 0)
-        );
+        assert_eq!((r.finished_trials.len(), r.pending.len()), (6, 0));
+        assert_eq!((r.dropped_trial_rows, r.dropped_summary_rows), (0, 0));
         assert_eq!(r.trials_csv, t);
         assert_eq!(r.summary_csv, s);
     }
 
     #[test]
-    fn trial_rows_of_a_cell_without_a_summary_row_are_dropped() {
-        let (mut t, s) = two_cells();
-        let mut e = Exporter::new(&mut t, Vec::new(), false).unwrap();
-        e.write_cell(
-            &trial_rows(&cell(3), &measured(2), None),
-            &summary_row(&cell(3), &measured(2), None, &test_context(None, 2)),
-        )
-        .unwrap();
-        drop(e);
-        let r = repair(&t, &s, &|_| Ok(())).unwrap();
-        assert_eq!(r.finished.len(), 2);
-        assert_eq!(r.dropped_trial_rows, 2);
-        assert_eq!(r.trials_csv, two_cells().0);
+    fn runs_of_a_phase_without_summary_rows_are_kept_as_pending() {
+        let (t, _) = finished_phase();
+        let empty = to_csv(&SUMMARY_COLUMNS, &Vec::<SummaryRow>::new()).unwrap();
+        let r = repair_all(&t, &empty);
+        assert!(r.finished.is_empty());
+        assert_eq!(r.pending.len(), 6);
+        assert_eq!(r.trials_csv, t, "every run kept, once");
+        let rounds: Vec<Option<usize>> = r.pending.iter().map(|t| t.round).collect();
+        assert_eq!(
+            rounds,
+            [Some(1), Some(1), Some(2), Some(2), Some(3), Some(3)]
+        );
     }
 
     #[test]
-    fn a_line_cut_off_mid_write_is_dropped() {
-        let (t, mut s) = two_cells();
-        let mut t_cut = t.clone();
-        t_cut.extend_from_slice(b"rayon-iter,all-pairs,seed,60,3,4,,,1,0.5");
-        s.extend_from_slice(
-            b"rayon-iter,all-pairs,seed,60,3,4,,,3,1.0,1.0,1.0,1.0,1.0,1.0,1.0,1.0,0,fa",
-        );
-        let r = repair(&t_cut, &s, &|_| Ok(())).unwrap();
+    fn a_line_cut_off_mid_write_and_a_repeated_run_are_dropped() {
+        let (t, s) = finished_phase();
+        let text = String::from_utf8(t.clone()).unwrap();
+        let repeated = text.lines().nth(3).unwrap();
+        let mut t2 = format!("{text}{repeated}\n").into_bytes();
+        t2.extend_from_slice(b"rayon-iter,all-pairs,seed,60,3,4,,,1,0.5");
+        let r = repair_all(&t2, &s);
         assert_eq!(r.finished.len(), 2);
-        assert_eq!((r.dropped_trial_rows, r.dropped_summary_rows), (1, 1));
+        assert_eq!(r.dropped_trial_rows, 2);
         assert_eq!(r.trials_csv, t);
     }
 
     #[test]
-    fn a_summary_row_whose_trials_are_incomplete_makes_the_cell_run_again() {
-        let (t, s) = two_cells();
+    fn a_summary_row_whose_runs_are_incomplete_leaves_its_runs_pending() {
+        let (t, s) = finished_phase();
         let text = String::from_utf8(t).unwrap();
-        // Remove the last trial row of the second cell.
+        // Remove the last run of the second cell.
         let mut lines: Vec<&str> = text.lines().collect();
         lines.pop();
         let t = format!("{}\n", lines.join("\n"));
-        let r = repair(t.as_bytes(), &s, &|_| Ok(())).unwrap();
+        let r = repair_all(t.as_bytes(), &s);
         assert_eq!(r.finished.len(), 1);
         assert_eq!(r.finished[0].cores, 1);
-        assert_eq!(
-            (
-                r.kept_trial_rows,
-                r.dropped_trial_rows,
-                r.dropped_summary_rows
-            ),
-            (3, 2, 1)
-        );
+        assert_eq!((r.pending.len(), r.dropped_summary_rows), (2, 1));
     }
 
     #[test]
-    fn repeated_rows_are_kept_once() {
-        let (t, s) = two_cells();
-        let text = String::from_utf8(t.clone()).unwrap();
-        let last = text.lines().last().unwrap();
-        let t2 = format!("{text}{last}\n");
-        let stext = String::from_utf8(s.clone()).unwrap();
-        let s2 = format!("{stext}{}\n", stext.lines().last().unwrap());
-        let r = repair(t2.as_bytes(), s2.as_bytes(), &|_| Ok(())).unwrap();
-        assert_eq!(r.finished.len(), 2);
-        assert_eq!(r.trials_csv, t);
-        assert_eq!(r.summary_csv, s);
+    fn a_run_the_caller_refuses_or_with_impossible_times_runs_again() {
+        let (t, _) = finished_phase();
+        let empty = to_csv(&SUMMARY_COLUMNS, &Vec::<SummaryRow>::new()).unwrap();
+        let not_round_3 = |r: &TrialRow| match r.round {
+            Some(3) => Err("not a round of the plan".to_owned()),
+            _ => Ok(()),
+        };
+        let r = repair(&t, &empty, &accept_cell, &not_round_3).unwrap();
+        assert_eq!((r.pending.len(), r.dropped_trial_rows), (4, 2));
+        assert!(
+            r.rejected[0].contains("round 3: not a round of the plan"),
+            "{:?}",
+            r.rejected
+        );
+        let text = String::from_utf8(t)
+            .unwrap()
+            .replacen(",1.0,2.0,", ",-1.0,2.0,", 1);
+        let r = repair_all(text.as_bytes(), &empty);
+        assert_eq!(r.pending.len(), 5);
+        assert!(r.rejected[0].contains("wall_s = -1"), "{:?}", r.rejected);
+    }
+
+    #[test]
+    fn a_failed_run_stays_pending_with_its_reason() {
+        let mut runs = fixtures::trials(&cell(1), &[1.0, 2.0]);
+        runs[1].status = Status::Failed;
+        runs[1].reason = "round 2: checksum differs".to_owned();
+        let t = to_csv(&TRIAL_COLUMNS, &runs).unwrap();
+        let r = repair_all(&t, b"");
+        assert_eq!(r.pending[1].status, Status::Failed);
+    }
+
+    #[test]
+    fn removing_groups_drops_all_their_rows() {
+        let (t, s) = finished_phase();
+        let mut r = repair_all(&t, &s);
+        let groups: HashSet<Group> = [cell(1).group].into();
+        assert_eq!(r.without_groups(&groups), 8);
+        assert!(r.finished.is_empty() && r.finished_trials.is_empty());
+        assert_eq!(String::from_utf8(r.trials_csv).unwrap().lines().count(), 1);
     }
 
     #[test]
     fn missing_files_mean_nothing_is_finished() {
-        let r = repair(b"", b"", &|_| Ok(())).unwrap();
+        let r = repair_all(b"", b"");
         assert!(r.finished.is_empty());
         assert!(r.trials_csv.starts_with(b"strategy,"));
     }
 
     #[test]
-    fn files_of_earlier_versions_are_read_and_upgraded_to_every_column() {
-        let (t, s) = two_cells();
-        // A file as an earlier version wrote it: its last `fewer` columns missing.
-        let cut = |bytes: &[u8], fewer: usize| -> String {
-            String::from_utf8(bytes.to_vec())
-                .unwrap()
-                .lines()
-                .map(|l| {
-                    let keep: Vec<&str> = l.split(',').collect();
-                    format!("{}\n", keep[..keep.len() - fewer].join(","))
-                })
-                .collect()
-        };
-        // The upgrade writes every column: a missing `pin` as `none` (what these trials
-        // have), a missing `passes_alone` empty (unknown), where these trials have 0.
-        let upgraded_trials: String = String::from_utf8(t.clone())
+    fn files_written_before_rounds_are_refused_as_such() {
+        let (t, s) = finished_phase();
+        let before: String = String::from_utf8(t)
             .unwrap()
             .lines()
-            .map(|l| match l.strip_suffix(",0") {
-                Some(row) => format!("{row},\n"),
-                None => format!("{l}\n"), // the header
+            .map(|l| {
+                let keep: Vec<&str> = l.split(',').collect();
+                let last = if keep[0] == "strategy" {
+                    "passes_alone"
+                } else {
+                    "0"
+                };
+                format!("{},{last}\n", keep[..18].join(","))
             })
             .collect();
-        for (summary_fewer, trial_fewer) in [(2, 1), (3, 2)] {
-            let older = cut(&s, summary_fewer);
-            let older_trials = cut(&t, trial_fewer);
-            let r = repair(older_trials.as_bytes(), older.as_bytes(), &|_| Ok(())).unwrap();
-            assert!(r.upgraded, "{summary_fewer} {trial_fewer}");
-            assert_eq!(r.finished.len(), 2);
-            assert_eq!(r.summary_csv, s);
-            assert_eq!(String::from_utf8(r.trials_csv).unwrap(), upgraded_trials);
-        }
-        assert!(!repair(&t, &s, &|_| Ok(())).unwrap().upgraded);
+        let err = repair(before.as_bytes(), &s, &accept_cell, &accept_run).unwrap_err();
+        assert_eq!(err, NotResumable::BeforeRounds { file: "trials.csv" });
+        assert!(err.to_string().contains("back to back"), "{err}");
+        let summary_before: String = String::from_utf8(s)
+            .unwrap()
+            .lines()
+            .map(|l| l.rsplit_once(',').unwrap().0.to_owned() + "\n")
+            .collect();
+        let err = repair(b"", summary_before.as_bytes(), &accept_cell, &accept_run).unwrap_err();
+        assert_eq!(
+            err,
+            NotResumable::BeforeRounds {
+                file: "summary.csv"
+            }
+        );
     }
 
     #[test]
     fn a_foreign_header_is_an_error() {
-        let err = repair(b"a,b\n1,2\n", b"", &|_| Ok(())).unwrap_err();
-        assert_eq!(err.file, "trials.csv");
+        let err = repair(b"a,b\n1,2\n", b"", &accept_cell, &accept_run).unwrap_err();
         assert!(err.to_string().contains("'a,b'"), "{err}");
     }
 }

@@ -1,34 +1,43 @@
-//! Running cells: warm-ups, timed trials, the checksum guard, progress and Ctrl-C.
+//! Running a group's phases: the reference run, the rounds ([`super::schedule`]), the
+//! checksum guard, contention windows ([`super::windows`]), the wait for a quiet machine,
+//! progress and Ctrl-C.
 //!
-//! Each run simulates the whole dam break from the group's initial state on a fresh
-//! [`Simulation`](crate::solver::Simulation), through [`run_timed`] (the timed region is the step loop only). Every run —
-//! warm-up or trial — must end with the group's reference checksum, the one the group's
-//! `seq` cell produced first; the first run that does not, or that fails, ends the cell as
-//! failed with the reason, and the sweep goes on. A group whose `seq` cell failed has no
-//! reference: its other cells are written as failed without running.
+//! A group runs its grid phase (every cell of the plan, `--trials` rounds), then, unless the
+//! sweep is a shard or `--confirm-rounds 0`, its confirmation phase (the cells
+//! [`super::confirm::choose`] picks from the grid's rows, `--confirm-rounds` rounds). Each
+//! phase starts with the **reference run**: an untimed `seq` run whose checksum every later
+//! run must reproduce (under `rounds` it is the group's warm-up too: `--warmup W` makes W such
+//! runs, at least one). The first run that does not reproduce it, or that fails, ends its cell
+//! as failed with the reason, and the phase goes on without it; when the `seq` cell itself
+//! fails, the phase stops and its other cells are written as failed.
 //!
-//! Ctrl-C sets a flag that is checked before every run: the cell in progress is discarded
-//! (nothing of it has been written), finished cells stay, and the sweep stops with an error
-//! naming `--resume`. A second Ctrl-C exits at once.
+//! A run's trial row is written (and flushed) when its contention window closes, about every
+//! second; a phase's summary rows are written together once its last round is done. Ctrl-C
+//! sets a flag that is checked before every run: the runs already measured are written, the
+//! run in progress is discarded, and the sweep stops with an error naming `--resume`, which
+//! continues the round it was in. A second Ctrl-C exits at once.
 
-use std::collections::HashMap;
-use std::fmt;
+use std::collections::{HashMap, HashSet};
 use std::io::Write;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use indicatif::ProgressBar;
 
+use super::confirm;
 use super::console;
 use super::export::Exporter;
+use super::input::GroupInput;
 use super::plan::{Cell, Group, Plan};
-use super::rows::{CellContext, Measured, summary_row, trial_rows};
-use super::timing::{Timing, Trial};
-use crate::checksum::checksum_hex;
+use super::rows::{Measured, trial_row};
+use super::schedule::{self, Run, Schedule};
+use super::timing::{Timing, Trial, fake_index};
+use super::windows::{Verdict, Windows};
 use crate::contention::Threshold;
-use crate::results::rows::{Status, SummaryRow};
-use crate::run::run_timed;
-use crate::scene::Scene;
+use crate::results::params::SweepParams;
+use crate::results::rows::{Phase, Status, SummaryRow, TrialRow};
+use crate::results::summarize::{CellContext, summary_row};
 
 /// Set by Ctrl-C; checked before every run and every cell.
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
@@ -54,224 +63,39 @@ pub fn install_ctrlc_handler() {
     });
 }
 
-/// Which run of a cell.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum RunKind {
-    /// Untimed warm-up number k (from 1).
-    Warmup(usize),
-    /// Timed trial number k (from 1).
-    Trial(usize),
-}
-
-impl fmt::Display for RunKind {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            RunKind::Warmup(k) => write!(f, "warm-up {k}"),
-            RunKind::Trial(k) => write!(f, "trial {k}"),
-        }
-    }
-}
-
-/// How a cell's runs ended.
-#[derive(Debug, Clone, PartialEq)]
-pub enum CellOutcome {
-    /// All runs done, or stopped at the first failure (`failure` says which and why).
-    Finished {
-        /// The timed trials that completed.
-        measured: Vec<Measured>,
-        /// Why the cell failed, if it did.
-        failure: Option<String>,
-    },
-    /// Stopped by Ctrl-C between runs: nothing of the cell is kept.
-    Interrupted,
-}
-
-/// Runs a cell's `warmup` warm-ups, then its `trials` trials, with `run`, checking each
-/// run's checksum against `reference` (`None` for a `seq` reference cell: its first run sets
-/// it). `stop` is asked before every run.
-pub fn measure_cell(
-    warmup: usize,
-    trials: usize,
-    reference: Option<&str>,
-    stop: &dyn Fn() -> bool,
-    mut run: impl FnMut(RunKind) -> Result<Measured, String>,
-) -> CellOutcome {
-    let mut expected = reference.map(str::to_owned);
-    let mut measured = Vec::with_capacity(trials);
-    let kinds = (1..=warmup)
-        .map(RunKind::Warmup)
-        .chain((1..=trials).map(RunKind::Trial));
-    for kind in kinds {
-        if stop() {
-            return CellOutcome::Interrupted;
-        }
-        let m = match run(kind) {
-            Ok(m) => m,
-            Err(e) => {
-                return CellOutcome::Finished {
-                    measured,
-                    failure: Some(format!("{kind}: {e}")),
-                };
-            }
-        };
-        let mismatch = match &expected {
-            None => {
-                expected = Some(m.checksum.clone());
-                None
-            }
-            Some(want) if *want != m.checksum => Some(format!(
-                "{kind}: checksum {} differs from the reference {want} of seq at 1 core",
-                m.checksum
-            )),
-            Some(_) => None,
-        };
-        if let RunKind::Trial(_) = kind {
-            measured.push(m);
-        }
-        if mismatch.is_some() {
-            return CellOutcome::Finished {
-                measured,
-                failure: mismatch,
-            };
-        }
-    }
-    CellOutcome::Finished {
-        measured,
-        failure: None,
-    }
-}
-
-/// What a group's other cells are measured against.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Reference {
-    /// The `seq` cell succeeded: its checksum and trial wall seconds.
-    Ok {
-        /// The checksum every run must reproduce.
-        checksum: String,
-        /// The wall seconds of its trials (their mean is the denominator of speedup).
-        walls: Vec<f64>,
-    },
-    /// The `seq` cell failed for this reason.
-    Failed(String),
-}
-
-impl Reference {
-    /// The reference a finished `seq` cell gives: its summary row and its trial wall seconds.
-    pub fn from_row(row: &SummaryRow, walls: Vec<f64>) -> Reference {
-        match (row.status, row.mean_s) {
-            (Status::Ok, Some(_)) if !walls.is_empty() => Reference::Ok {
-                checksum: row.checksum.clone(),
-                walls,
-            },
-            (Status::Ok, _) => Reference::Failed("its trials are missing".to_owned()),
-            _ => Reference::Failed(row.reason.clone()),
-        }
-    }
-}
-
-/// The initial state of a group, built once and cloned for every run.
-struct GroupInput {
-    group: Group,
-    scene: Scene,
-}
-
-impl GroupInput {
-    fn new(group: Group, seed: u64) -> GroupInput {
-        let scene = Scene::dam_break(group.preset, group.n, seed)
-            .unwrap_or_else(|e| panic!("no memory for {} particles: {e}", group.n));
-        GroupInput { group, scene }
-    }
-
-    /// One whole run of `cell` from the initial state: its times and final checksum.
-    fn run(&self, cell: &Cell) -> Result<Measured, String> {
-        self.run_steps(cell, self.group.steps)
-    }
-
-    /// `steps` steps of `cell` from the initial state.
-    fn run_steps(&self, cell: &Cell, steps: usize) -> Result<Measured, String> {
-        let mut sim = self.scene.clone().simulate(self.group.neighbors);
-        let load1 = crate::contention::load1();
-        let placement =
-            crate::placement::placement(cell.pin).map_err(|e| one_line(&format!("{e:#}")))?;
-        let config = cell.config().placed(placement);
-        let elapsed = run_timed(&mut sim, cell.strategy, &config, steps)
-            .map_err(|e| one_line(&format!("{:#}", anyhow::Error::new(e))))?;
-        Ok(Measured {
-            elapsed,
-            load1,
-            checksum: checksum_hex(&sim.state),
-        })
-    }
-}
-
-/// A message on one line (CSV fields and resume's line-based repair rely on it).
-fn one_line(s: &str) -> String {
-    s.split_whitespace().collect::<Vec<_>>().join(" ")
-}
-
-/// The most particles the estimate simulates, per neighbour search: it must take well under
-/// a second whatever N the sweep asks for.
-const CALIBRATION_N_ALL_PAIRS: usize = 4000;
-/// See [`CALIBRATION_N_ALL_PAIRS`].
-const CALIBRATION_N_GRID: usize = 200_000;
-
-/// Seconds one `seq` run of `group` takes, estimated from a short timed run of at most
-/// 4000 (all-pairs, `CALIBRATION_N_ALL_PAIRS`) or 200 000 (grid, `CALIBRATION_N_GRID`) particles,
-/// scaled by (N / sample)² or N / sample: one step, then doubling the steps until a run
-/// takes 50 ms or covers all steps. NaN when the run fails (the sweep will then report the
-/// failure properly).
-pub fn calibrate(group: Group, seed: u64) -> f64 {
-    let (cap, exponent) = match group.neighbors {
-        crate::sph::neighbors::NeighborMode::AllPairs => (CALIBRATION_N_ALL_PAIRS, 2),
-        crate::sph::neighbors::NeighborMode::Grid => (CALIBRATION_N_GRID, 1),
-    };
-    let sample = Group {
-        n: group.n.min(cap),
-        ..group
-    };
-    let scale = (group.n as f64 / sample.n as f64).powi(exponent);
-    let input = GroupInput::new(sample, seed);
-    let seq = Cell::reference(sample);
-    let mut steps = 1;
-    loop {
-        let Ok(m) = input.run_steps(&seq, steps) else {
-            return f64::NAN;
-        };
-        if m.elapsed.wall_s >= 0.05 || steps >= group.steps {
-            return m.elapsed.wall_s / steps as f64 * group.steps as f64 * scale;
-        }
-        steps = (steps * 2).min(group.steps);
-    }
+/// What earlier sessions left of the sweep (from `--resume`'s repair).
+#[derive(Debug, Clone, Default)]
+pub struct Kept {
+    /// Summary rows of finished cell phases.
+    pub finished: Vec<SummaryRow>,
+    /// Trial rows of phases not finished yet: runs not to repeat.
+    pub pending: Vec<TrialRow>,
 }
 
 /// Everything a session needs to run cells.
 pub struct Runner<'a, T: Write, S: Write> {
     /// The plan (cells are named by their position in it).
     pub plan: &'a Plan,
-    /// Warm-ups per cell.
-    pub warmup: usize,
-    /// Trials per cell.
-    pub trials: usize,
-    /// Seed of the initial states and of the bootstrap.
-    pub seed: u64,
-    /// Bootstrap resamples per interval.
-    pub resamples: usize,
+    /// The sweep's parameters: rounds, warm-ups, schedule, seed, wait.
+    pub params: &'a SweepParams,
     /// The machine's hardware threads (for `oversubscribed` and contention).
     pub hardware_threads: usize,
-    /// When foreign CPU makes a trial contended.
+    /// When foreign CPU makes a window contended.
     pub threshold: Threshold,
-    /// Where trial numbers come from.
+    /// Where run numbers come from.
     pub timing: Timing,
-    /// Test only: behave as if Ctrl-C was pressed after this many cells.
-    pub stop_after_cells: Option<usize>,
+    /// Test only: behave as if Ctrl-C was pressed once this many runs are written.
+    pub stop_after_runs: Option<usize>,
+    /// Longest wait for a quiet machine before each round (zero: do not wait).
+    pub wait_quiet: Duration,
     /// The CSV writers.
     pub exporter: Exporter<T, S>,
     /// The progress bar, in estimated milliseconds.
     pub progress: ProgressBar,
     /// Estimated milliseconds of one run of each cell of the plan.
     pub run_ms: Vec<u64>,
-    /// The shard of the plan this sweep runs (`reference_shard` of its rows), if it is one.
-    pub shard: Option<usize>,
+    /// Timed runs written by this session.
+    pub runs_written: usize,
 }
 
 /// What a session did.
@@ -279,304 +103,493 @@ pub struct Runner<'a, T: Write, S: Write> {
 pub struct SessionOutcome {
     /// The summary rows written, in order.
     pub rows: Vec<SummaryRow>,
-    /// Whether it stopped early (Ctrl-C or `--stop-after-cells`).
+    /// Whether it stopped early (Ctrl-C or `--stop-after-runs`).
     pub interrupted: bool,
 }
 
-/// What `cell` is measured against: the checksum its runs must reproduce and the group's
-/// `seq` walls (both `None` for the reference cell itself), or why it cannot run.
-type Against = (Option<String>, Option<String>, Option<Vec<f64>>);
+/// One phase of one group.
+struct PhaseWork<'k> {
+    group: Group,
+    phase: Phase,
+    /// Plan positions, the group's `seq` first.
+    cells: Vec<usize>,
+    rounds: usize,
+    /// Summary rows of this phase finished by earlier sessions, by plan position.
+    finished: HashMap<usize, &'k SummaryRow>,
+    /// Runs of this phase earlier sessions measured.
+    pending: Vec<&'k TrialRow>,
+}
 
-/// The group's reference as `cell` needs it (see [`Against`]): `(checksum, failure, walls)`.
-fn against(cell: &Cell, references: &HashMap<Group, Reference>) -> Against {
-    if cell.is_reference() {
-        return (None, None, None);
-    }
-    match references.get(&cell.group) {
-        Some(Reference::Ok { checksum, walls }) => {
-            (Some(checksum.clone()), None, Some(walls.clone()))
-        }
-        Some(Reference::Failed(why)) => (
-            None,
-            Some(format!("not run: the group's seq reference failed ({why})")),
-            None,
-        ),
-        None => (
-            None,
-            Some("not run: the group has no seq reference".to_owned()),
-            None,
-        ),
+/// The state of a phase while it runs.
+struct Progress {
+    /// Each cell's trial rows so far (kept and new), by plan position.
+    rows_of: HashMap<usize, Vec<TrialRow>>,
+    /// Cells that failed, with why.
+    failed: HashMap<usize, String>,
+    /// Runs measured, waiting for their contention window to close: plan position and row.
+    buffered: Vec<(usize, TrialRow)>,
+    /// The checksum every run must reproduce.
+    reference: Option<String>,
+}
+
+impl Progress {
+    fn trial_number(&self, cell: usize) -> usize {
+        let written = self.rows_of.get(&cell).map_or(0, Vec::len);
+        let waiting = self.buffered.iter().filter(|(c, _)| *c == cell).count();
+        written + waiting + 1
     }
 }
 
 impl<T: Write, S: Write> Runner<'_, T, S> {
-    /// Runs the cells at positions `todo` of the plan (ascending), measuring each against its
-    /// group's entry in `references` (filled in as `seq` cells finish), and writes each
-    /// finished cell at once.
-    pub fn run(
-        &mut self,
-        todo: &[usize],
-        references: &mut HashMap<Group, Reference>,
-    ) -> anyhow::Result<SessionOutcome> {
+    /// Runs every group's phases that `kept` does not hold finished, group after group, and
+    /// writes their rows.
+    pub fn run(&mut self, kept: &Kept) -> anyhow::Result<SessionOutcome> {
         let mut outcome = SessionOutcome::default();
-        let mut input: Option<GroupInput> = None;
-        let mut shown_group: Option<Group> = None;
-        for &index in todo {
-            let stop_now = self.stop_after_cells == Some(outcome.rows.len());
-            if interrupted() || stop_now {
+        for &group in &self.plan.groups {
+            let cells: Vec<usize> = (0..self.plan.cells.len())
+                .filter(|&i| self.plan.cells[i].group == group)
+                .collect();
+            let grid = self.work(group, Phase::Grid, cells, self.params.trials, kept);
+            let Some(grid_rows) = self.phase(&grid, &mut outcome)? else {
+                outcome.interrupted = true;
+                break;
+            };
+            if self.params.confirm_rounds == 0 || self.params.shard.is_some() {
+                continue;
+            }
+            let chosen: Vec<usize> = confirm::choose(self.plan, &group, &grid_rows)
+                .into_iter()
+                .map(|(at, _)| at)
+                .collect();
+            if chosen.len() < 2 {
+                continue;
+            }
+            let confirm = self.work(
+                group,
+                Phase::Confirm,
+                chosen,
+                self.params.confirm_rounds,
+                kept,
+            );
+            if self.phase(&confirm, &mut outcome)?.is_none() {
                 outcome.interrupted = true;
                 break;
             }
-            let cell = self.plan.cells[index];
-            let (measured, failure, seq_walls) = against(&cell, references);
-            let (measured, failure) = if let Some(failure) = failure {
-                self.progress
-                    .inc(self.run_ms[index].saturating_mul((self.warmup + self.trials) as u64));
-                (Vec::new(), Some(failure))
-            } else {
-                if input.as_ref().is_none_or(|i| i.group != cell.group) {
-                    input = Some(GroupInput::new(cell.group, self.seed));
-                }
-                let group_input = input.as_ref().expect("built above");
-                self.progress.set_message(cell.label());
-                match self.measure(index, &cell, group_input, measured.as_deref()) {
-                    CellOutcome::Interrupted => {
-                        outcome.interrupted = true;
-                        break;
-                    }
-                    CellOutcome::Finished { measured, failure } => (measured, failure),
-                }
-            };
-
-            let summary = self.record(index, &measured, failure, seq_walls, references)?;
-            let mut text = String::new();
-            if self.plan.groups.len() > 1 && shown_group != Some(cell.group) {
-                text = format!("{}:\n", cell.group.label(super::plan::LabelStyle::Sweep));
-                shown_group = Some(cell.group);
-            }
-            text.push_str(&console::cell_line(
-                index + 1,
-                self.plan.cells.len(),
-                &cell,
-                &summary,
-            ));
-            // A closed standard output ends the sweep like Ctrl-C (checked before the next
-            // cell); this cell is written already.
-            self.progress.suspend(|| {
-                let _ = crate::output::console::line(&text);
-            });
-            outcome.rows.push(summary);
         }
         Ok(outcome)
     }
 
-    /// Writes the cell at `index` of the plan (its trial rows and summary row, against the
-    /// group's `seq` walls), and records a reference cell in `references`.
-    fn record(
-        &mut self,
-        index: usize,
-        measured: &[Measured],
-        failure: Option<String>,
-        seq_walls: Option<Vec<f64>>,
-        references: &mut HashMap<Group, Reference>,
-    ) -> anyhow::Result<SummaryRow> {
-        let cell = self.plan.cells[index];
-        let seq_walls = if cell.is_reference() {
-            failure.is_none().then(|| walls(measured))
-        } else {
-            seq_walls
-        };
-        let ctx = CellContext {
-            seq_walls: seq_walls.as_deref(),
-            hardware_threads: self.hardware_threads,
-            threshold: self.threshold,
-            seed: self.seed,
-            resamples: self.resamples,
-            shard: self.shard,
-            smt: crate::placement::machine_topology().is_smt(cell.cores),
-        };
-        let summary = summary_row(&cell, measured, failure.as_deref(), &ctx);
-        let trials = trial_rows(&cell, measured, failure.as_deref());
-        self.exporter
-            .write_cell(&trials, &summary)
-            .context("cannot write the results")?;
-        if cell.is_reference() {
-            references.insert(cell.group, Reference::from_row(&summary, walls(measured)));
-        }
-        Ok(summary)
-    }
-
-    /// The runs of one cell, with the progress bar advanced after each.
-    fn measure(
+    /// The work of `group`'s `phase` over `cells`, with what `kept` holds of it.
+    fn work<'k>(
         &self,
-        index: usize,
-        cell: &Cell,
-        input: &GroupInput,
-        reference: Option<&str>,
-    ) -> CellOutcome {
-        let run_ms = self.run_ms[index];
-        measure_cell(self.warmup, self.trials, reference, &interrupted, |kind| {
-            let result = input.run(cell);
-            self.progress.inc(run_ms);
-            let mut m = result?;
-            if let RunKind::Trial(k) = kind {
-                let measured = Trial {
-                    elapsed: m.elapsed,
-                    load1: m.load1,
-                };
-                let t =
-                    self.timing
-                        .trial(measured, index, self.trials, k - 1, self.hardware_threads);
-                (m.elapsed, m.load1) = (t.elapsed, t.load1);
-            }
-            Ok(m)
-        })
-    }
-}
-
-fn walls(measured: &[Measured]) -> Vec<f64> {
-    measured.iter().map(|m| m.elapsed.wall_s).collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::clock::Elapsed;
-    use sph_strategies::StrategyName;
-    use std::cell::Cell as Counter;
-
-    fn ok(checksum: &str) -> Result<Measured, String> {
-        Ok(Measured {
-            elapsed: Elapsed {
-                passes_alone: 0,
-                wall_s: 1.0,
-                cpu_s: 1.0,
-                foreign: None,
-            },
-            load1: None,
-            checksum: checksum.to_owned(),
-        })
-    }
-
-    fn never() -> bool {
-        false
-    }
-
-    #[test]
-    fn a_cell_runs_its_warmups_then_its_trials_and_keeps_only_the_trials() {
-        let mut kinds = Vec::new();
-        let out = measure_cell(2, 3, Some("a"), &never, |k| {
-            kinds.push(k);
-            ok("a")
-        });
-        use RunKind::*;
-        assert_eq!(kinds, [Warmup(1), Warmup(2), Trial(1), Trial(2), Trial(3)]);
-        let CellOutcome::Finished { measured, failure } = out else {
-            panic!("interrupted")
-        };
-        assert_eq!((measured.len(), failure), (3, None));
-    }
-
-    #[test]
-    fn a_checksum_that_differs_from_the_reference_fails_the_cell() {
-        let calls = Counter::new(0);
-        let out = measure_cell(1, 3, Some("a"), &never, |_| {
-            calls.set(calls.get() + 1);
-            if calls.get() == 3 { ok("b") } else { ok("a") }
-        });
-        let CellOutcome::Finished { measured, failure } = out else {
-            panic!("interrupted")
-        };
-        assert_eq!(measured.len(), 2, "the mismatching trial is kept as a row");
-        let failure = failure.unwrap();
-        assert!(
-            failure.starts_with("trial 2: checksum b differs from the reference a"),
-            "{failure}"
-        );
-        assert_eq!(calls.get(), 3, "the cell stops at its first failure");
-    }
-
-    #[test]
-    fn a_mismatch_in_a_warmup_also_fails_the_cell() {
-        let out = measure_cell(1, 2, Some("a"), &never, |_| ok("b"));
-        let CellOutcome::Finished { measured, failure } = out else {
-            panic!("interrupted")
-        };
-        assert!(measured.is_empty());
-        assert!(failure.unwrap().starts_with("warm-up 1: checksum b"));
-    }
-
-    #[test]
-    fn the_reference_cell_sets_the_checksum_with_its_first_run_and_must_repeat_it() {
-        let calls = Counter::new(0);
-        let out = measure_cell(1, 2, None, &never, |_| {
-            calls.set(calls.get() + 1);
-            ok(if calls.get() == 1 { "a" } else { "c" })
-        });
-        let CellOutcome::Finished { failure, .. } = out else {
-            panic!("interrupted")
-        };
-        assert!(
-            failure
-                .unwrap()
-                .contains("checksum c differs from the reference a")
-        );
-    }
-
-    #[test]
-    fn a_run_error_fails_the_cell_with_its_reason() {
-        let out = measure_cell(0, 2, Some("a"), &never, |k| match k {
-            RunKind::Trial(2) => Err("the simulation diverged at step 3".to_owned()),
-            _ => ok("a"),
-        });
-        let CellOutcome::Finished { measured, failure } = out else {
-            panic!("interrupted")
-        };
-        assert_eq!(measured.len(), 1);
-        assert_eq!(
-            failure.unwrap(),
-            "trial 2: the simulation diverged at step 3"
-        );
-    }
-
-    #[test]
-    fn a_stop_request_between_runs_discards_the_cell() {
-        let calls = Counter::new(0);
-        let stop = || calls.get() >= 2;
-        let out = measure_cell(1, 3, Some("a"), &stop, |_| {
-            calls.set(calls.get() + 1);
-            ok("a")
-        });
-        assert_eq!(out, CellOutcome::Interrupted);
-        assert_eq!(calls.get(), 2);
-    }
-
-    #[test]
-    fn a_real_run_reproduces_the_sequential_checksum_on_every_strategy() {
-        let group = Group {
-            preset: crate::sph::params::Preset::Seed,
-            neighbors: crate::sph::neighbors::NeighborMode::Grid,
-            n: 50,
-            steps: 4,
-        };
-        let input = GroupInput::new(group, 3);
-        let checksums: Vec<String> = StrategyName::ALL
+        group: Group,
+        phase: Phase,
+        cells: Vec<usize>,
+        rounds: usize,
+        kept: &'k Kept,
+    ) -> PhaseWork<'k> {
+        let position = |cell: Cell| self.plan.cells.iter().position(|c| *c == cell);
+        let finished = kept
+            .finished
             .iter()
-            .map(|&strategy| {
-                let cell = Cell {
-                    group,
-                    strategy,
-                    cores: 2,
-                    chunks: Some(3),
-                    pin: crate::topology::Pin::None,
-                };
-                input.run(&cell).unwrap().checksum
-            })
+            .filter(|r| r.phase == phase)
+            .filter_map(|r| Some((position(r.key())?, r)))
+            .filter(|(at, _)| cells.contains(at))
             .collect();
-        assert!(
-            checksums.iter().all(|c| *c == checksums[0]),
-            "{checksums:?}"
+        let pending = kept
+            .pending
+            .iter()
+            .filter(|r| r.phase == phase && position(r.key()).is_some_and(|at| cells.contains(&at)))
+            .collect();
+        PhaseWork {
+            group,
+            phase,
+            cells,
+            rounds,
+            finished,
+            pending,
+        }
+    }
+
+    /// Runs a phase; returns all its summary rows (kept and new), or `None` when the sweep
+    /// was interrupted in it.
+    fn phase(
+        &mut self,
+        work: &PhaseWork<'_>,
+        outcome: &mut SessionOutcome,
+    ) -> anyhow::Result<Option<Vec<SummaryRow>>> {
+        let mut rows: Vec<SummaryRow> = work.finished.values().map(|r| (*r).clone()).collect();
+        if work.cells.iter().all(|c| work.finished.contains_key(c)) {
+            return Ok(Some(rows));
+        }
+        let seq = work.cells[0];
+        let mut state = Progress {
+            rows_of: HashMap::new(),
+            failed: HashMap::new(),
+            buffered: Vec::new(),
+            reference: None,
+        };
+        let mut done: HashSet<(usize, usize)> = HashSet::new();
+        for &row in &work.pending {
+            let at = self.position(row);
+            done.insert((at, row.round.unwrap_or(row.trial)));
+            if row.status == Status::Failed {
+                state.failed.insert(at, row.reason.clone());
+            }
+            state.rows_of.entry(at).or_default().push(row.clone());
+        }
+        let runs = schedule::order(
+            self.params.schedule,
+            &work.cells,
+            work.rounds,
+            self.params.seed,
+            &work.group,
+            work.phase,
         );
-        assert!(calibrate(group, 3) > 0.0);
+        let todo: Vec<Run> = runs
+            .into_iter()
+            .filter(|r| !work.finished.contains_key(&r.cell) && !done.contains(&(r.cell, r.round)))
+            .collect();
+        let input = GroupInput::new(work.group, self.params.seed);
+        let mut windows = Windows::new(self.threshold, self.timing.fakes_contention());
+        let interrupted = self.measure(work, &todo, &input, &mut state, &mut windows)?;
+        self.write_verdicts(&mut state, windows.close())?;
+        if interrupted {
+            return Ok(None);
+        }
+        let new_rows = self.summaries(work, seq, &mut state);
+        self.exporter
+            .write_summaries(&new_rows)
+            .context("cannot write the results")?;
+        self.print_phase(work, &new_rows);
+        rows.extend(new_rows.iter().cloned());
+        outcome.rows.extend(new_rows);
+        Ok(Some(rows))
+    }
+
+    /// The plan position of a row's cell (the caller made sure it is in the plan).
+    fn position(&self, row: &TrialRow) -> usize {
+        self.plan
+            .cells
+            .iter()
+            .position(|c| *c == row.key())
+            .expect("kept rows are of the plan's cells")
+    }
+
+    /// Runs `todo` in order (the reference run first); returns whether the sweep was
+    /// interrupted.
+    fn measure(
+        &mut self,
+        work: &PhaseWork<'_>,
+        todo: &[Run],
+        input: &GroupInput,
+        state: &mut Progress,
+        windows: &mut Windows<usize>,
+    ) -> anyhow::Result<bool> {
+        if todo.is_empty() {
+            return Ok(false);
+        }
+        let seq = work.cells[0];
+        let widest = work
+            .cells
+            .iter()
+            .map(|&c| self.plan.cells[c].cores)
+            .max()
+            .unwrap_or(1);
+        self.wait_quiet(work, widest, windows, state)?;
+        let reference_runs = match self.params.schedule {
+            Schedule::Rounds => self.params.warmup.max(1),
+            Schedule::Cells => 1,
+        };
+        self.untimed(input, seq, reference_runs, state);
+        let mut round = todo[0].round;
+        let mut warmed: HashSet<usize> = HashSet::new();
+        for run in todo {
+            if state.failed.contains_key(&seq) {
+                break;
+            }
+            if state.failed.contains_key(&run.cell) {
+                continue;
+            }
+            if run.round != round && self.params.schedule == Schedule::Rounds {
+                round = run.round;
+                if self.wait_quiet(work, widest, windows, state)? {
+                    self.untimed(input, seq, 1, state);
+                }
+            }
+            if self.params.schedule == Schedule::Cells && warmed.insert(run.cell) {
+                self.untimed(input, run.cell, self.params.warmup, state);
+                if state.failed.contains_key(&run.cell) {
+                    continue;
+                }
+            }
+            if self.stop() {
+                return Ok(true);
+            }
+            self.timed(work, run, input, state, windows)?;
+        }
+        Ok(false)
+    }
+
+    /// `count` untimed runs of the cell at `at`; the first run of a phase sets the reference
+    /// checksum (and must agree with the runs kept from earlier sessions).
+    fn untimed(&mut self, input: &GroupInput, at: usize, count: usize, state: &mut Progress) {
+        let cell = self.plan.cells[at];
+        for k in 1..=count {
+            if self.stop() {
+                return;
+            }
+            let result = input.run(&cell);
+            self.progress.inc(self.run_ms[at]);
+            let failure = match result {
+                Err(e) => Some(format!("warm-up {k}: {e}")),
+                Ok(m) => self.check(
+                    &mut state.reference,
+                    &m.checksum,
+                    &format!("warm-up {k}"),
+                    state.rows_of.values().flatten(),
+                ),
+            };
+            if let Some(why) = failure {
+                state.failed.insert(at, why);
+                return;
+            }
+        }
+    }
+
+    /// The failure, if any, of a run named `what` that ended with `checksum`, against the
+    /// phase's reference (set by the first run checked, which must agree with `kept`'s ok
+    /// runs).
+    fn check<'r>(
+        &self,
+        reference: &mut Option<String>,
+        checksum: &str,
+        what: &str,
+        kept: impl IntoIterator<Item = &'r TrialRow>,
+    ) -> Option<String> {
+        match reference {
+            Some(want) if want != checksum => Some(format!(
+                "{what}: checksum {checksum} differs from the reference {want} of seq at 1 core"
+            )),
+            Some(_) => None,
+            None => {
+                let earlier = kept
+                    .into_iter()
+                    .find(|r| r.status == Status::Ok && r.checksum != checksum);
+                *reference = Some(checksum.to_owned());
+                earlier.map(|r| {
+                    format!(
+                        "{what}: the reference checksum {checksum} differs from {} of the runs \
+                         kept from an earlier session: this build computes other bits; resume \
+                         with the build that started the sweep, or start a new one",
+                        r.checksum
+                    )
+                })
+            }
+        }
+    }
+
+    /// One timed run: measured, checked, buffered until its window closes.
+    fn timed(
+        &mut self,
+        work: &PhaseWork<'_>,
+        run: &Run,
+        input: &GroupInput,
+        state: &mut Progress,
+        windows: &mut Windows<usize>,
+    ) -> anyhow::Result<()> {
+        let cell = self.plan.cells[run.cell];
+        self.progress
+            .set_message(format!("round {} · {}", run.round, cell.label()));
+        windows.before_run();
+        let result = input.run(&cell);
+        self.progress.inc(self.run_ms[run.cell]);
+        let what = format!("round {}", run.round);
+        let m = match result {
+            Ok(m) => self.faked(work.phase, run, m),
+            Err(e) => {
+                state.failed.insert(run.cell, format!("{what}: {e}"));
+                return Ok(());
+            }
+        };
+        let failure = self.check(&mut state.reference, &m.checksum, &what, std::iter::empty());
+        let unknown = Verdict {
+            foreign_threads: None,
+            contended: None,
+        };
+        let trial = state.trial_number(run.cell);
+        let row = trial_row(
+            &cell,
+            work.phase,
+            run,
+            trial,
+            &m,
+            failure.as_deref(),
+            unknown,
+        );
+        if let Some(why) = failure {
+            state.failed.insert(run.cell, why);
+        }
+        let key = state.buffered.len();
+        state.buffered.push((run.cell, row));
+        let fake = self
+            .timing
+            .fakes_contention()
+            .then(|| (m.elapsed.foreign.map_or(0.0, |f| f.cpu_s), m.elapsed.wall_s));
+        let verdicts = windows.after_run(key, cell.cores, fake);
+        self.write_verdicts(state, verdicts)
+    }
+
+    /// `m` with the fake numbers of `--fake-timings` / `--fake-contention` where given.
+    fn faked(&self, phase: Phase, run: &Run, mut m: Measured) -> Measured {
+        let index = fake_index(
+            phase,
+            run.cell,
+            run.round,
+            self.plan.cells.len(),
+            self.params.trials,
+            self.params.confirm_rounds,
+        );
+        let t = self.timing.trial(
+            Trial {
+                elapsed: m.elapsed,
+                load1: m.load1,
+            },
+            index,
+            self.hardware_threads,
+        );
+        (m.elapsed, m.load1) = (t.elapsed, t.load1);
+        m
+    }
+
+    /// Writes the buffered rows whose window closed, with its verdicts.
+    fn write_verdicts(
+        &mut self,
+        state: &mut Progress,
+        verdicts: Vec<(usize, Verdict)>,
+    ) -> anyhow::Result<()> {
+        if verdicts.is_empty() {
+            return Ok(());
+        }
+        let mut rows = std::mem::take(&mut state.buffered);
+        for (key, verdict) in verdicts {
+            let row = &mut rows[key].1;
+            row.window_foreign_threads = verdict.foreign_threads;
+            row.contended = verdict.contended;
+        }
+        let trial_rows: Vec<TrialRow> = rows.iter().map(|(_, r)| r.clone()).collect();
+        self.exporter
+            .write_trials(&trial_rows)
+            .context("cannot write the results")?;
+        self.runs_written += rows.len();
+        for (at, row) in rows {
+            state.rows_of.entry(at).or_default().push(row);
+        }
+        Ok(())
+    }
+
+    /// Whether to stop before the next run.
+    fn stop(&self) -> bool {
+        interrupted() || self.stop_after_runs.is_some_and(|k| self.runs_written >= k)
+    }
+
+    /// With `--wait-quiet`, waits (bounded, and saying so) until other work leaves the
+    /// machine quiet enough for a cell of `widest` cores. Returns whether it waited (the
+    /// caller then warms up again: an idle core slows down).
+    fn wait_quiet(
+        &mut self,
+        work: &PhaseWork<'_>,
+        widest: usize,
+        windows: &mut Windows<usize>,
+        state: &mut Progress,
+    ) -> anyhow::Result<bool> {
+        if self.wait_quiet.is_zero() {
+            return Ok(false);
+        }
+        // The wait belongs to no run's window.
+        self.write_verdicts(state, windows.close())?;
+        let bound = self.wait_quiet;
+        let start = Instant::now();
+        let mut busy = self.busy_threads(Duration::from_millis(300));
+        if !self.too_busy(busy, widest) {
+            return Ok(false);
+        }
+        let label = format!(
+            "{} ({})",
+            work.group.label(super::plan::LabelStyle::Sweep),
+            work.phase.as_str()
+        );
+        self.progress.suspend(|| {
+            console::waiting(&label, busy, self.hardware_threads, bound);
+        });
+        while self.too_busy(busy, widest) && start.elapsed() < bound && !self.stop() {
+            busy = self
+                .busy_threads(Duration::from_secs(1).min(bound.saturating_sub(start.elapsed())));
+        }
+        let quiet = !self.too_busy(busy, widest);
+        self.progress.suspend(|| {
+            console::waited(quiet, start.elapsed(), busy);
+        });
+        Ok(true)
+    }
+
+    /// Hardware threads' worth of CPU other work used over `window` (fake with
+    /// `--fake-contention`); `None` where the machine cannot say.
+    fn busy_threads(&self, window: Duration) -> Option<f64> {
+        if let Some(threads) = self.timing.fake_busy_threads(self.hardware_threads) {
+            std::thread::sleep(window.min(Duration::from_millis(50)));
+            return Some(threads);
+        }
+        let (foreign_s, wall_s) = crate::clock::sample_now(window)?;
+        Some(foreign_s / wall_s)
+    }
+
+    fn too_busy(&self, busy: Option<f64>, cores: usize) -> bool {
+        busy.is_some_and(|b| self.threshold.exceeded(b, 1.0, cores))
+    }
+
+    /// The summary rows of the phase's cells that earlier sessions did not finish.
+    fn summaries(&self, work: &PhaseWork<'_>, seq: usize, state: &mut Progress) -> Vec<SummaryRow> {
+        let seq_failed = state.failed.get(&seq).cloned();
+        let mut seq_rows = state.rows_of.get(&seq).cloned().unwrap_or_default();
+        seq_rows.sort_by_key(|t| t.trial);
+        work.cells
+            .iter()
+            .filter(|at| !work.finished.contains_key(at))
+            .map(|&at| {
+                let cell = self.plan.cells[at];
+                let mut trials = state.rows_of.remove(&at).unwrap_or_default();
+                trials.sort_by_key(|t| t.trial);
+                let failure = state.failed.get(&at).cloned().or_else(|| {
+                    let why = seq_failed.as_ref().filter(|_| at != seq)?;
+                    Some(format!(
+                        "not measured further: the group's seq reference failed ({why})"
+                    ))
+                });
+                let ctx = CellContext {
+                    hardware_threads: self.hardware_threads,
+                    shard: self.params.shard.map(|s| s.index),
+                    smt: crate::placement::machine_topology().is_smt(cell.cores),
+                };
+                let reference = seq_failed.is_none().then_some(seq_rows.as_slice());
+                summary_row(
+                    &cell,
+                    work.phase,
+                    &trials,
+                    reference,
+                    failure.as_deref(),
+                    &ctx,
+                )
+            })
+            .collect()
+    }
+
+    /// Prints the phase's new summary rows, one line per cell.
+    fn print_phase(&self, work: &PhaseWork<'_>, rows: &[SummaryRow]) {
+        let text = console::phase_lines(self.plan, &work.group, work.phase, work.rounds, rows);
+        // A closed standard output ends the sweep like Ctrl-C (checked before the next run).
+        self.progress.suspend(|| {
+            let _ = crate::output::console::line(&text);
+        });
     }
 }

@@ -15,8 +15,10 @@
 //! was doing.
 //!
 //! The simulation still runs and its checksums are still checked; only the numbers written
-//! are replaced. Trial `t` (from 0) of the cell at position `c` of the plan gets item
-//! `(c · trials + t) mod len` of each list, so a resumed sweep gets the same numbers as an
+//! are replaced. Each timed run has a fixed number ([`fake_index`]): round r (from 1) of the
+//! cell at position c of a plan of P cells is `c · K + r − 1` in the grid's K rounds and
+//! `P · K + c · C + r − 1` in the confirmation's C rounds; it gets item `index mod len` of each
+//! list, whatever order the rounds ran in, so a resumed sweep gets the same numbers as an
 //! uninterrupted one. A sweep with fake numbers records the lists in `meta.json` and says so
 //! in its output and report: such numbers never pass for measurements.
 
@@ -77,17 +79,10 @@ impl Timing {
         Ok(Timing { times, shares })
     }
 
-    /// The numbers to record for trial `trial` (from 0) of the cell at `cell_index` in the
-    /// plan, given what was measured.
-    pub fn trial(
-        &self,
-        measured: Trial,
-        cell_index: usize,
-        trials: usize,
-        trial: usize,
-        hardware_threads: usize,
-    ) -> Trial {
-        let pick = |len: usize| (cell_index * trials + trial) % len;
+    /// The numbers to record for the run numbered `index` ([`fake_index`]), given what was
+    /// measured.
+    pub fn trial(&self, measured: Trial, index: usize, hardware_threads: usize) -> Trial {
+        let pick = |len: usize| index % len;
         let mut out = measured;
         if let Some(list) = &self.times {
             let (wall_s, cpu_s) = list[pick(list.len())];
@@ -108,12 +103,36 @@ impl Timing {
         out
     }
 
+    /// Whether foreign CPU readings are fake (`--fake-contention`, or implied by
+    /// `--fake-timings`).
+    pub fn fakes_contention(&self) -> bool {
+        self.shares.is_some()
+    }
+
     /// Test only: the busy hardware threads the check before the plan should see (`None`:
     /// measure them).
     pub fn fake_busy_threads(&self, hardware_threads: usize) -> Option<f64> {
         self.shares
             .as_ref()
             .map(|list| list[0] * hardware_threads as f64)
+    }
+}
+
+/// The fixed number of round `round` (from 1) of the cell at plan position `cell` in `phase`,
+/// for a plan of `cells` cells with `trials` grid rounds and `confirm_rounds` confirmation
+/// rounds (see the module docs).
+pub fn fake_index(
+    phase: crate::results::rows::Phase,
+    cell: usize,
+    round: usize,
+    cells: usize,
+    trials: usize,
+    confirm_rounds: usize,
+) -> usize {
+    use crate::results::rows::Phase;
+    match phase {
+        Phase::Grid => cell * trials + round - 1,
+        Phase::Confirm => cells * trials + cell * confirm_rounds + round - 1,
     }
 }
 
@@ -154,14 +173,15 @@ mod tests {
     #[test]
     fn real_timing_keeps_the_measurement() {
         let t = Timing::new(None, None).unwrap();
-        assert_eq!(t.trial(MEASURED, 3, 5, 2, 2), MEASURED);
+        assert_eq!(t.trial(MEASURED, 17, 2), MEASURED);
+        assert!(!t.fakes_contention());
         assert_eq!(t.fake_busy_threads(2), None);
     }
 
     #[test]
     fn fake_timings_are_taken_in_turn_by_plan_position() {
         let t = Timing::new(Some("1,2:0.5,3"), None).unwrap();
-        let at = |cell, trial| t.trial(MEASURED, cell, 2, trial, 2).elapsed;
+        let at = |cell: usize, trial: usize| t.trial(MEASURED, cell * 2 + trial, 2).elapsed;
         assert_eq!((at(0, 0).wall_s, at(0, 0).cpu_s), (1.0, 1.0));
         assert_eq!((at(0, 1).wall_s, at(0, 1).cpu_s), (2.0, 0.5));
         assert_eq!(at(1, 0).wall_s, 3.0);
@@ -171,13 +191,30 @@ mod tests {
     #[test]
     fn fake_contention_gives_foreign_time_in_proportion_to_the_wall_time() {
         let t = Timing::new(Some("2"), Some("0,0.5")).unwrap();
-        let quiet = t.trial(MEASURED, 0, 2, 0, 4);
+        let quiet = t.trial(MEASURED, 0, 4);
         assert_eq!(quiet.elapsed.foreign.unwrap().cpu_s, 0.0);
-        let busy = t.trial(MEASURED, 0, 2, 1, 4);
+        let busy = t.trial(MEASURED, 1, 4);
         // Half of 4 threads for 2 s.
         assert_eq!(busy.elapsed.foreign.unwrap().cpu_s, 4.0);
         assert_eq!(busy.load1, Some(2.0));
         assert_eq!(t.fake_busy_threads(4), Some(0.0));
+    }
+
+    #[test]
+    fn every_run_of_a_sweep_has_its_own_fake_index() {
+        use crate::results::rows::Phase;
+        let (cells, trials, confirm) = (4, 3, 2);
+        let mut seen = std::collections::HashSet::new();
+        for c in 0..cells {
+            for r in 1..=trials {
+                assert!(seen.insert(fake_index(Phase::Grid, c, r, cells, trials, confirm)));
+            }
+            for r in 1..=confirm {
+                assert!(seen.insert(fake_index(Phase::Confirm, c, r, cells, trials, confirm)));
+            }
+        }
+        assert_eq!(seen.len(), cells * (trials + confirm));
+        assert_eq!(seen.iter().max(), Some(&(cells * (trials + confirm) - 1)));
     }
 
     #[test]

@@ -160,6 +160,8 @@ pub(crate) mod tests {
             dir: dir.into(),
             meta,
             rows,
+            confirmed: Vec::new(),
+            trials: Vec::new(),
             dropped: Vec::new(),
         }
     }
