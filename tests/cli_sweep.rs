@@ -15,13 +15,15 @@ use common::{
 };
 
 const TRIAL_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
-    trial,wall_s,cpu_s,checksum,status,reason,foreign_cpu_s,steal_s,load1,pin,passes_alone";
+    trial,wall_s,cpu_s,checksum,status,reason,foreign_cpu_s,steal_s,load1,pin,phase,round,\
+    position,window_foreign_threads,contended";
 const SUMMARY_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
     trials,mean_s,stddev_s,min_s,median_s,max_s,cpu_mean_s,speedup,efficiency,outliers,\
     oversubscribed,checksum,status,reason,mean_ci_low_s,mean_ci_high_s,speedup_ci_low,\
-    speedup_ci_high,foreign_cpu_mean_s,contended,reference_shard,pin,smt";
+    speedup_ci_high,foreign_cpu_mean_s,contended,reference_shard,pin,smt,phase";
 
-/// A tiny sweep: 1 seq cell + 3 strategies × 2 cores + 2 strategies × 2 cores × 2 chunks = 15.
+/// A tiny sweep: 1 seq cell + 3 strategies × 2 cores + 2 strategies × 2 cores × 2 chunks = 15
+/// cells, 2 rounds, no confirmation (tests that want one ask for it).
 const TINY: &[&str] = &[
     "sweep",
     "--n",
@@ -36,15 +38,32 @@ const TINY: &[&str] = &[
     "1..2",
     "--chunks",
     "2,5",
+    "--confirm-rounds",
+    "0",
     "--no-plots",
 ];
 const TINY_CELLS: usize = 15;
 
-/// Runs the tiny sweep (plus `extra`) into `dir` and expects success.
-fn tiny_sweep(dir: &Path, extra: &[&str]) -> Output {
+/// The tiny sweep's arguments with `extra`: an option the tiny sweep already gives takes the
+/// value `extra` gives it; the rest is added.
+fn tiny_args<'a>(extra: &[&'a str]) -> Vec<&'a str> {
     let mut args = TINY.to_vec();
+    let mut rest = extra.iter();
+    while let Some(&item) = rest.next() {
+        match args.iter().position(|a| *a == item) {
+            Some(at) if item.starts_with("--") && at + 1 < args.len() => {
+                args[at + 1] = rest.next().expect("a value");
+            }
+            _ => args.push(item),
+        }
+    }
+    args
+}
+
+/// Runs the tiny sweep (with `extra`, see [`tiny_args`]) into `dir` and expects success.
+fn tiny_sweep(dir: &Path, extra: &[&str]) -> Output {
+    let mut args = tiny_args(extra);
     args.extend(["--out", dir.to_str().unwrap()]);
-    args.extend(extra);
     let o = run(&args);
     assert!(
         o.status.success(),
@@ -64,7 +83,7 @@ fn header(path: &Path) -> String {
         .to_owned()
 }
 
-/// The columns that name a cell.
+/// The columns that name a cell and its phase.
 fn cell_key(row: &Row) -> String {
     [
         "strategy",
@@ -74,9 +93,15 @@ fn cell_key(row: &Row) -> String {
         "steps",
         "cores",
         "chunks",
+        "phase",
     ]
     .map(|c| row[c].as_str())
     .join("|")
+}
+
+/// The rows of `phase`.
+fn of_phase<'a>(rows: &'a [Row], phase: &str) -> Vec<&'a Row> {
+    rows.iter().filter(|r| r["phase"] == phase).collect()
 }
 
 /// Every cell's trial rows, by cell key.
@@ -88,10 +113,12 @@ fn trials_by_cell(trials: &[Row]) -> BTreeMap<String, Vec<&Row>> {
     by_cell
 }
 
-/// Asserts one row per trial, numbered 1..=trials, for every summary row, and no other rows.
+/// Asserts one row per round, numbered 1..=rounds (trial and round alike), for every grid
+/// summary row, and no other rows (the sweep ran without confirmation).
 fn assert_one_row_per_trial(dir: &Path, trials_per_cell: usize, cells: usize) {
     let summary = rows(&dir.join("summary.csv"));
     let trials = rows(&dir.join("trials.csv"));
+    assert!(summary.iter().chain(&trials).all(|r| r["phase"] == "grid"));
     assert_eq!(summary.len(), cells, "summary rows");
     let by_cell = trials_by_cell(&trials);
     assert_eq!(by_cell.len(), cells, "cells in trials.csv");
@@ -100,8 +127,13 @@ fn assert_one_row_per_trial(dir: &Path, trials_per_cell: usize, cells: usize) {
     keys.dedup();
     assert_eq!(keys.len(), cells, "duplicate summary rows");
     for (key, rows) in &by_cell {
-        let numbers: Vec<&str> = rows.iter().map(|r| r["trial"].as_str()).collect();
+        let mut numbers: Vec<(&str, &str)> = rows
+            .iter()
+            .map(|r| (r["trial"].as_str(), r["round"].as_str()))
+            .collect();
+        numbers.sort_by_key(|&(t, _)| t.parse::<usize>().unwrap());
         let want: Vec<String> = (1..=trials_per_cell).map(|k| k.to_string()).collect();
+        let want: Vec<(&str, &str)> = want.iter().map(|k| (k.as_str(), k.as_str())).collect();
         assert_eq!(numbers, want, "trials of {key}");
     }
 }
@@ -205,6 +237,11 @@ fn a_tiny_sweep_writes_trials_summary_and_meta_with_the_documented_columns() {
     assert_eq!(meta["params"]["chunks"], serde_json::json!([2, 5]));
     assert_eq!(meta["params"]["trials"], 2);
     assert_eq!(meta["params"]["warmup"], 1);
+    assert_eq!(meta["params"]["schedule"], "rounds");
+    assert_eq!(meta["params"]["confirm_rounds"], 0);
+    assert_eq!(meta["statistics"]["intervals"], "student-t");
+    assert_eq!(meta["statistics"]["shuffle_seed"], 2019);
+    assert_eq!(meta["statistics"]["contention_window_s"], 1.0);
     assert_eq!(meta["params"]["strategies"].as_array().unwrap().len(), 6);
     assert!(
         meta["command_line"]
@@ -218,8 +255,8 @@ fn a_tiny_sweep_writes_trials_summary_and_meta_with_the_documented_columns() {
         "stdout",
         &stdout(&o),
         &[
-            "15 cells",
-            "1 warm-up + 2 trials",
+            "15 cells × 2 rounds",
+            "shuffled from --seed 2019",
             "estimated time",
             "Fastest cell per strategy",
             "trials.csv",
@@ -229,10 +266,25 @@ fn a_tiny_sweep_writes_trials_summary_and_meta_with_the_documented_columns() {
     );
 }
 
+/// The geometric mean of `xs` and its Student-t interval for three values (t = 4.3027 at two
+/// degrees of freedom), computed here independently of the crate.
+fn geometric_three(xs: &[f64]) -> (f64, f64, f64) {
+    assert_eq!(xs.len(), 3);
+    let logs: Vec<f64> = xs.iter().map(|x| x.ln()).collect();
+    let m = mean(&logs);
+    let sd = (logs.iter().map(|l| (l - m) * (l - m)).sum::<f64>() / 2.0).sqrt();
+    let half = 4.302_652_729_749_464 * sd / 3f64.sqrt();
+    (m.exp(), (m - half).exp(), (m + half).exp())
+}
+
+fn close(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-12 * a.abs().max(b.abs())
+}
+
 #[test]
 fn summary_statistics_agree_exactly_with_the_trial_rows_under_fake_timings() {
     let (_tmp, dir) = scratch("r");
-    // Seven items for three trials a cell: each cell gets a different slice of the list.
+    // Seven items for three rounds a cell: each cell gets a different slice of the list.
     let fake = "1:0.5,2:1,3:1.5,2:2,2:2,9:3,4:4";
     let mut args: Vec<&str> = TINY.to_vec();
     let at = args.iter().position(|a| *a == "--trials").unwrap();
@@ -247,7 +299,7 @@ fn summary_statistics_agree_exactly_with_the_trial_rows_under_fake_timings() {
     let by_cell = trials_by_cell(&trials);
     assert_eq!(summary.len(), TINY_CELLS);
 
-    // The seq cell got 1, 2, 3 (CPU 0.5, 1, 1.5); the next cell 2, 2, 9.
+    // The seq cell got 1, 2, 3 (CPU 0.5, 1, 1.5) in rounds 1, 2, 3; the next cell 2, 2, 9.
     let seq = &summary[0];
     assert_eq!(seq["strategy"], "seq");
     for (column, want) in [
@@ -260,6 +312,8 @@ fn summary_statistics_agree_exactly_with_the_trial_rows_under_fake_timings() {
         ("speedup", 1.0),
         ("efficiency", 1.0),
         ("outliers", 0.0),
+        ("speedup_ci_low", 1.0),
+        ("speedup_ci_high", 1.0),
     ] {
         assert_eq!(num(seq, column), want, "seq {column}");
     }
@@ -267,8 +321,14 @@ fn summary_statistics_agree_exactly_with_the_trial_rows_under_fake_timings() {
     assert_eq!(num(second, "mean_s"), 13.0 / 3.0);
     assert_eq!(num(second, "median_s"), 2.0);
     assert_eq!(num(second, "outliers"), 1.0, "9 is beyond 3 MAD (MAD = 0)");
-    assert_eq!(num(second, "speedup"), 2.0 / (13.0 / 3.0));
+    // Paired by round: 1/2, 2/2, 3/9.
+    let (g, _, _) = geometric_three(&[0.5, 1.0, 3.0 / 9.0]);
+    assert!(close(num(second, "speedup"), g), "{second:?}");
 
+    let seq_by_round: BTreeMap<String, f64> = by_cell[&cell_key(seq)]
+        .iter()
+        .map(|r| (r["round"].clone(), num(r, "wall_s")))
+        .collect();
     for s in &summary {
         let rows = &by_cell[&cell_key(s)];
         let walls: Vec<f64> = rows.iter().map(|r| num(r, "wall_s")).collect();
@@ -282,7 +342,12 @@ fn summary_statistics_agree_exactly_with_the_trial_rows_under_fake_timings() {
             .iter()
             .filter(|w| (*w - med).abs() > 3.0 * mad)
             .count();
-        let speedup = 2.0 / m;
+        let ratios: Vec<f64> = rows
+            .iter()
+            .map(|r| seq_by_round[&r["round"]] / num(r, "wall_s"))
+            .collect();
+        let (speedup, low, high) = geometric_three(&ratios);
+        let (_, mean_low, mean_high) = geometric_three(&walls);
         let cores = num(s, "cores");
         assert_eq!(num(s, "trials"), 3.0);
         assert_eq!(num(s, "mean_s"), m, "{s:?}");
@@ -298,58 +363,150 @@ fn summary_statistics_agree_exactly_with_the_trial_rows_under_fake_timings() {
         assert_eq!(num(s, "median_s"), med, "{s:?}");
         assert_eq!(num(s, "cpu_mean_s"), mean(&cpus), "{s:?}");
         assert_eq!(num(s, "outliers"), outliers as f64, "{s:?}");
-        assert_eq!(num(s, "speedup"), speedup, "{s:?}");
-        assert_eq!(num(s, "efficiency"), speedup / cores, "{s:?}");
+        for (column, want) in [
+            ("speedup", speedup),
+            ("speedup_ci_low", low),
+            ("speedup_ci_high", high),
+            ("mean_ci_low_s", mean_low),
+            ("mean_ci_high_s", mean_high),
+            ("efficiency", speedup / cores),
+        ] {
+            assert!(close(num(s, column), want), "{column} {want} in {s:?}");
+        }
     }
     let meta = std::fs::read_to_string(dir.join("meta.json")).unwrap();
     assert!(meta.contains(fake), "fake timings are recorded: {meta}");
 }
 
+/// The runs of `trials` in file order, grouped by round: each round's cell keys in the order
+/// they ran.
+fn rounds_in_order(trials: &[Row]) -> Vec<Vec<String>> {
+    let mut rounds: Vec<Vec<String>> = Vec::new();
+    let mut last = String::new();
+    for t in trials {
+        if t["round"] != last {
+            last = t["round"].clone();
+            rounds.push(Vec::new());
+        }
+        let position: usize = t["position"].parse().unwrap();
+        let round = rounds.last_mut().unwrap();
+        assert_eq!(
+            position,
+            round.len() + 1,
+            "positions count up within a round"
+        );
+        round.push(cell_key(t));
+    }
+    rounds
+}
+
 #[test]
-fn a_sweep_stopped_midway_and_resumed_ends_with_exactly_one_row_per_trial() {
+fn rounds_run_every_cell_once_in_an_order_shuffled_from_the_seed() {
     let tmp = tempfile::tempdir().unwrap();
-    let fake = ["--fake-timings", "1,2,3,4,5"];
+    let sweep = |name: &str, extra: &[&str]| {
+        let dir = tmp.path().join(name);
+        let mut args = vec!["--trials", "4", "--fake-timings", "1,2,3"];
+        args.extend(extra);
+        tiny_sweep(&dir, &args);
+        rows(&dir.join("trials.csv"))
+    };
+    let trials = sweep("a", &[]);
+    let rounds = rounds_in_order(&trials);
+    assert_eq!(rounds.len(), 4, "rounds one after the other");
+    let mut first_round = rounds[0].clone();
+    first_round.sort();
+    for (i, round) in rounds.iter().enumerate() {
+        let mut cells = round.clone();
+        cells.sort();
+        assert_eq!(cells, first_round, "round {} runs every cell once", i + 1);
+    }
+    assert_eq!(first_round.len(), TINY_CELLS);
+    assert!(
+        rounds.windows(2).any(|w| w[0] != w[1]),
+        "each round its own order"
+    );
+    assert!(
+        rounds.iter().any(|r| !r[0].starts_with("seq|")),
+        "seq is not always first"
+    );
+    // The same seed, the same order; another seed, another.
+    assert_eq!(rounds_in_order(&sweep("b", &[])), rounds);
+    assert_ne!(rounds_in_order(&sweep("c", &["--seed", "7"])), rounds);
+    // --schedule cells: each cell's runs back to back, seq first, in plan order.
+    let cells = sweep("d", &["--schedule", "cells"]);
+    let keys: Vec<String> = cells.iter().map(cell_key).collect();
+    assert!(keys[..4].iter().all(|k| k.starts_with("seq|")));
+    assert!(keys.chunks(4).all(|c| c.iter().all(|k| *k == c[0])));
+}
+
+#[test]
+fn the_confirmation_rounds_measure_each_strategys_best_cells_again() {
+    let (_tmp, dir) = scratch("r");
+    // Rounds 2 and 3 of 2 rounds take the times in turn: every grid cell of rayon-chunks and
+    // crossbeam-pool gets its own mean, so each has a best and a runner-up per cores.
+    tiny_sweep(
+        &dir,
+        &["--confirm-rounds", "3", "--fake-timings", "5,4,3,2,1,6,7"],
+    );
+    let summary = rows(&dir.join("summary.csv"));
+    let trials = rows(&dir.join("trials.csv"));
+    let grid = of_phase(&summary, "grid");
+    let confirmed = of_phase(&summary, "confirm");
+    assert_eq!(grid.len(), TINY_CELLS);
+    // seq, rayon-iter, rayon-spawn, std-static at 1 and 2 cores (6 cells), and best and
+    // runner-up of rayon-chunks and crossbeam-pool at 1 and 2 cores (8).
+    assert_eq!(confirmed.len(), 1 + 6 + 8, "{confirmed:?}");
+    assert_eq!(confirmed[0]["strategy"], "seq");
+    for c in &confirmed {
+        assert_eq!(c["trials"], "3", "{c:?}");
+        let runs: Vec<&Row> = of_phase(&trials, "confirm")
+            .into_iter()
+            .filter(|t| cell_key(t) == cell_key(c))
+            .collect();
+        assert_eq!(runs.len(), 3, "{c:?}");
+    }
+    // The confirmation's runs come after every grid run.
+    let last_grid = trials.iter().rposition(|t| t["phase"] == "grid").unwrap();
+    let first_confirm = trials.iter().position(|t| t["phase"] == "confirm").unwrap();
+    assert!(last_grid < first_confirm);
+}
+
+#[test]
+fn a_sweep_stopped_midway_and_resumed_ends_with_exactly_one_row_per_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let fake = ["--fake-timings", "1,2,3,4,5", "--trials", "3"];
     // The same sweep without interruption, to compare with.
     let whole = tmp.path().join("whole");
     tiny_sweep(&whole, &fake);
 
     let dir = tmp.path().join("r");
     let d = dir.to_str().unwrap();
-    let mut args = TINY.to_vec();
-    args.extend(["--out", d, "--stop-after-cells", "4"]);
-    args.extend(fake);
-    fails_with(
-        &args,
-        &["Error:", "interrupted", "4 of 15 cells", "--resume"],
-    );
-    assert_one_row_per_trial(&dir, 2, 4);
+    let mut args = tiny_args(&fake);
+    // 20 runs: round 1 (15 runs) and a third of round 2.
+    args.extend(["--out", d, "--stop-after-runs", "20"]);
+    fails_with(&args, &["Error:", "interrupted", "--resume"]);
+    let kept = rows(&dir.join("trials.csv"));
+    assert_eq!(kept.len(), 20);
+    assert!(rows(&dir.join("summary.csv")).is_empty());
     let meta = std::fs::read_to_string(dir.join("meta.json")).unwrap();
     assert!(meta.contains("\"status\": \"interrupted\""), "{meta}");
 
-    // A kill in the middle of writing the fifth cell (rayon-spawn at 2 cores): its first
-    // trial row, then its second cut off mid-line.
+    // A kill in the middle of writing the next run: a line cut off.
     let trials_path = dir.join("trials.csv");
     let mut text = std::fs::read_to_string(&trials_path).unwrap();
-    let last = text.lines().last().unwrap().to_owned();
-    assert!(
-        last.starts_with("rayon-spawn,all-pairs,seed,60,3,1,,,2,"),
-        "{last}"
-    );
-    let partial = last.replacen(",60,3,1,,,2,", ",60,3,2,,,1,", 1);
-    text.push_str(&format!(
-        "{partial}\nrayon-spawn,all-pairs,seed,60,3,2,,,2,0.0"
-    ));
+    text.push_str("rayon-spawn,all-pairs,seed,60,3,2,,,2,0.0");
     std::fs::write(&trials_path, text).unwrap();
 
     let o = run(&["sweep", "--resume", d, "--no-plots"]);
     assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
     assert!(
-        stdout(&o).contains("4 finished cells kept"),
+        stdout(&o).contains("20 runs of unfinished rounds kept"),
         "{}",
         stdout(&o)
     );
-    assert_one_row_per_trial(&dir, 2, TINY_CELLS);
-    // Same parameters, same fake times: the same files as the uninterrupted sweep.
+    assert_one_row_per_trial(&dir, 3, TINY_CELLS);
+    // Same parameters, same fake times, the same order: the same files as the uninterrupted
+    // sweep.
     for file in ["trials.csv", "summary.csv"] {
         assert_eq!(
             std::fs::read_to_string(dir.join(file)).unwrap(),
@@ -361,15 +518,127 @@ fn a_sweep_stopped_midway_and_resumed_ends_with_exactly_one_row_per_trial() {
         serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap();
     assert_eq!(meta["status"], "complete");
     assert_eq!(meta["sessions"].as_array().unwrap().len(), 2);
-    assert_eq!(meta["sessions"][1]["cells_run"], 11);
+    assert_eq!(meta["sessions"][1]["cells_run"], TINY_CELLS);
 
     // Resuming a finished sweep runs nothing and succeeds.
     let o = run(&["sweep", "--resume", d, "--no-plots"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert_one_row_per_trial(&dir, 2, TINY_CELLS);
+    assert_one_row_per_trial(&dir, 3, TINY_CELLS);
 }
 
-/// A sweep that runs for a second or two: 1 + 3 × 2 + 2 × 2 × 17 = 75 cells of 2 trials.
+#[test]
+fn every_cell_is_flagged_beside_a_busy_machine_and_none_on_a_quiet_one() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (share, contended) in [("0.5", "true"), ("0", "false")] {
+        let dir = tmp.path().join(share);
+        // Short runs (5 ms): judged over windows, not alone.
+        let o = tiny_sweep(
+            &dir,
+            &["--fake-timings", "0.005", "--fake-contention", share],
+        );
+        let summary = rows(&dir.join("summary.csv"));
+        assert!(
+            summary.iter().all(|r| r["contended"] == contended),
+            "share {share}: {summary:?}"
+        );
+        let trials = rows(&dir.join("trials.csv"));
+        assert!(trials.iter().all(|t| t["contended"] == contended));
+        let lines = stdout(&o)
+            .lines()
+            .filter(|l| l.starts_with('[') && l.ends_with("  contended"))
+            .count();
+        assert_eq!(lines, if contended == "true" { TINY_CELLS } else { 0 });
+        let warned = stderr(&o).contains("--remeasure-contended");
+        assert_eq!(warned, contended == "true", "{}", stderr(&o));
+    }
+}
+
+#[test]
+fn a_busy_machine_can_be_waited_for_and_its_contended_groups_measured_again() {
+    let (_tmp, dir) = scratch("r");
+    let d = dir.to_str().unwrap();
+    let o = tiny_sweep(
+        &dir,
+        &[
+            "--strategies",
+            "rayon-iter",
+            "--fake-timings",
+            "0.01",
+            "--fake-contention",
+            "0.9",
+            "--wait-quiet",
+            "1",
+        ],
+    );
+    assert_holds_all(
+        "stderr",
+        &stderr(&o),
+        &[
+            "waiting up to 1.0 s for a quiet machine",
+            "still busy after",
+        ],
+    );
+    let first: Vec<String> = rows(&dir.join("trials.csv"))
+        .iter()
+        .map(|t| t["contended"].clone())
+        .collect();
+    assert!(first.iter().all(|c| c == "true"));
+    let o = run(&[
+        "sweep",
+        "--resume",
+        d,
+        "--remeasure-contended",
+        "--no-plots",
+    ]);
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    assert!(
+        stdout(&o).contains("1 group with contended cells will be measured again"),
+        "{}",
+        stdout(&o)
+    );
+    assert_one_row_per_trial(&dir, 2, 3);
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap();
+    assert_eq!(meta["sessions"][1]["cells_run"], 3);
+    // --remeasure-contended belongs to --resume.
+    fails_with(
+        &["sweep", "--remeasure-contended", "--out", d],
+        &["--resume"],
+    );
+}
+
+#[test]
+fn a_shard_runs_its_own_rounds_with_its_own_seq_and_no_confirmation() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut seen = Vec::new();
+    for i in 1..=2 {
+        let dir = tmp.path().join(format!("s{i}"));
+        let shard = format!("{i}/2");
+        tiny_sweep(&dir, &["--shard", &shard, "--fake-timings", "1,2"]);
+        let trials = rows(&dir.join("trials.csv"));
+        let rounds = rounds_in_order(&trials);
+        assert_eq!(rounds.len(), 2);
+        assert!(
+            rounds
+                .iter()
+                .all(|r| r.iter().filter(|k| k.starts_with("seq|")).count() == 1)
+        );
+        assert!(trials.iter().all(|t| t["phase"] == "grid"));
+        seen.extend(rounds[0].iter().filter(|k| !k.starts_with("seq|")).cloned());
+    }
+    seen.sort();
+    seen.dedup();
+    assert_eq!(seen.len(), TINY_CELLS - 1, "the shards share the cells out");
+    let (_t, dir) = scratch("never");
+    let mut args = TINY.to_vec();
+    let at = args.iter().position(|a| *a == "--confirm-rounds").unwrap();
+    args[at + 1] = "2";
+    args.extend(["--shard", "1/2", "--out", dir.to_str().unwrap()]);
+    fails_with(&args, &["Error:", "--confirm-rounds 2 with --shard 1/2"]);
+}
+
+/// A sweep that runs for a second or two: 1 + 3 × 2 + 2 × 2 × 17 = 75 cells of 2 rounds, no
+/// confirmation.
 const SLOW: &[&str] = &[
     "sweep",
     "--n",
@@ -384,24 +653,26 @@ const SLOW: &[&str] = &[
     "1..2",
     "--chunks",
     "paper",
+    "--confirm-rounds",
+    "0",
     "--no-plots",
 ];
 const SLOW_CELLS: usize = 75;
 
-/// Starts a sweep big enough to still be running when the first cells are written, and
-/// returns it once `summary.csv` holds `cells` rows (or it has ended).
-fn spawn_until_cells(dir: &Path, cells: usize) -> std::process::Child {
+/// Starts a sweep big enough to still be running when the first runs are written, and
+/// returns it once `trials.csv` holds `runs` rows (or it has ended).
+fn spawn_until_runs(dir: &Path, runs: usize) -> std::process::Child {
     let mut child = start(
         bench_sph()
             .args(SLOW)
             .args(["--out", dir.to_str().unwrap()]),
         Stdio::null(),
     );
-    let summary = dir.join("summary.csv");
+    let trials = dir.join("trials.csv");
     poll_until(Duration::from_secs(120), Duration::from_millis(5), || {
         let written =
-            std::fs::read_to_string(&summary).map_or(0, |t| t.lines().count().saturating_sub(1));
-        written >= cells || child.try_wait().unwrap().is_some()
+            std::fs::read_to_string(&trials).map_or(0, |t| t.lines().count().saturating_sub(1));
+        written >= runs || child.try_wait().unwrap().is_some()
     });
     child
 }
@@ -409,17 +680,17 @@ fn spawn_until_cells(dir: &Path, cells: usize) -> std::process::Child {
 #[test]
 fn a_sweep_killed_outright_resumes_without_duplicating_rows() {
     let (_tmp, dir) = scratch("r");
-    let mut child = spawn_until_cells(&dir, 2);
+    let mut child = spawn_until_runs(&dir, 2);
     let was_running = child.try_wait().unwrap().is_none();
     let _ = child.kill(); // SIGKILL: no chance to tidy up
     child.wait().unwrap();
     if was_running {
-        let kept = rows(&dir.join("summary.csv")).len();
+        let kept = rows(&dir.join("trials.csv")).len();
         assert!(
-            (2..SLOW_CELLS).contains(&kept),
-            "{kept} cells before the kill"
+            (2..2 * SLOW_CELLS).contains(&kept),
+            "{kept} runs before the kill"
         );
-        eprintln!("killed after {kept} cells");
+        eprintln!("killed after {kept} runs");
     }
     let d = dir.to_str().unwrap();
     let o = run(&["sweep", "--resume", d, "--no-plots"]);
@@ -428,9 +699,9 @@ fn a_sweep_killed_outright_resumes_without_duplicating_rows() {
 }
 
 #[test]
-fn ctrl_c_keeps_the_finished_cells_and_exits_with_an_error_naming_resume() {
+fn ctrl_c_keeps_the_runs_measured_and_exits_with_an_error_naming_resume() {
     let (_tmp, dir) = scratch("r");
-    let mut child = spawn_until_cells(&dir, 1);
+    let mut child = spawn_until_runs(&dir, 1);
     let still_running = child.try_wait().unwrap().is_none();
     let sent = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
@@ -441,8 +712,14 @@ fn ctrl_c_keeps_the_finished_cells_and_exits_with_an_error_naming_resume() {
         assert!(!out.status.success());
         common::assert_interrupted(&dir, &common::text(&out.stderr));
     }
-    let cells = rows(&dir.join("summary.csv")).len();
-    assert_one_row_per_trial(&dir, 2, cells);
+    // Every run written once, in whole rounds and the start of the next.
+    let trials = rows(&dir.join("trials.csv"));
+    let by_cell = trials_by_cell(&trials);
+    assert!(by_cell.values().all(|runs| runs.len() <= 2));
+    let d = dir.to_str().unwrap();
+    let o = run(&["sweep", "--resume", d, "--no-plots"]);
+    assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    assert_one_row_per_trial(&dir, 2, SLOW_CELLS);
 }
 
 #[test]
@@ -536,7 +813,7 @@ fn cells_with_more_cores_than_hardware_threads_are_marked_and_warned_about() {
     );
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stderr(&o).contains("oversubscribed"), "{}", stderr(&o));
-    assert!(stdout(&o).contains("(oversubscribed)"), "{}", stdout(&o));
+    assert!(stdout(&o).contains("  oversubscribed"), "{}", stdout(&o));
     for r in rows(&dir.join("summary.csv")) {
         let over = num(&r, "cores") as usize > hw;
         assert_eq!(r["oversubscribed"], over.to_string(), "{r:?}");
@@ -555,7 +832,7 @@ fn a_resumed_sweep_runs_its_recorded_simd_path_and_refuses_another() {
     args.extend([
         "--out",
         d,
-        "--stop-after-cells",
+        "--stop-after-runs",
         "2",
         "--fake-timings",
         "1,2",
