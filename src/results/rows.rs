@@ -17,7 +17,8 @@
 //! shards, the shard I whose `seq` cell is the row's speedup denominator, which is the shard
 //! that measured the row; empty in an unsharded sweep; then `pin` (both files) and `smt`
 //! (summary) of `--pin`; then per trial `passes_alone`
-//! ([`Executor::passes_alone`](sph_strategies::Executor::passes_alone)).
+//! (passes `crossbeam-pool` once ran on one thread; it no longer does, so new trials leave it
+//! empty).
 
 use serde::{Deserialize, Serialize};
 use sph_strategies::StrategyName;

@@ -201,7 +201,6 @@ mod tests {
             .iter()
             .map(|&w| Measured {
                 elapsed: Elapsed {
-                    passes_alone: 0,
                     wall_s: w,
                     cpu_s: 2.0 * w,
                     foreign: None,

@@ -321,7 +321,6 @@ mod tests {
             .iter()
             .map(|&w| Measured {
                 elapsed: Elapsed {
-                    passes_alone: 0,
                     wall_s: w,
                     cpu_s: w,
                     foreign: None,

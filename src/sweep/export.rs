@@ -86,7 +86,6 @@ mod tests {
             .iter()
             .map(|&(wall_s, cpu_s)| Measured {
                 elapsed: Elapsed {
-                    passes_alone: 0,
                     wall_s,
                     cpu_s,
                     foreign: Some(Foreign {

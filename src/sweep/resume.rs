@@ -243,7 +243,6 @@ mod tests {
         (1..=k)
             .map(|i| Measured {
                 elapsed: Elapsed {
-                    passes_alone: 0,
                     wall_s: i as f64,
                     cpu_s: i as f64,
                     foreign: None,

@@ -46,7 +46,7 @@ pub fn trial_rows(cell: &Cell, measured: &[Measured], failure: Option<&str>) -> 
             steal_s: m.elapsed.foreign.and_then(|f| f.steal_s),
             load1: m.load1,
             pin: cell.pin,
-            passes_alone: Some(m.elapsed.passes_alone),
+            passes_alone: None,
         })
         .collect()
 }
@@ -103,8 +103,6 @@ pub fn summary_row(
         .map(|m| m.elapsed.foreign.map(|f| f.cpu_s))
         .collect();
     let foreign = foreign.filter(|f| !f.is_empty());
-    // A strategy that ran passes alone found its threads short of cores itself.
-    let ran_alone = measured.iter().any(|m| m.elapsed.passes_alone > 0);
     SummaryRow {
         strategy: cell.strategy,
         neighbors: cell.group.neighbors,
@@ -136,15 +134,11 @@ pub fn summary_row(
         speedup_ci_low: speedup_ci.map(|i| i.low),
         speedup_ci_high: speedup_ci.map(|i| i.high),
         foreign_cpu_mean_s: foreign.as_deref().map(mean),
-        contended: match foreign {
-            _ if ran_alone => Some(true),
-            Some(f) => Some(
-                f.iter()
-                    .zip(&walls)
-                    .any(|(&foreign, &wall)| ctx.threshold.exceeded(foreign, wall, cell.cores)),
-            ),
-            None => None,
-        },
+        contended: foreign.map(|f| {
+            f.iter()
+                .zip(&walls)
+                .any(|(&foreign, &wall)| ctx.threshold.exceeded(foreign, wall, cell.cores))
+        }),
         reference_shard: ctx.shard,
         pin: cell.pin,
         smt: ctx.smt,
@@ -199,7 +193,6 @@ mod tests {
             .iter()
             .map(|&w| Measured {
                 elapsed: Elapsed {
-                    passes_alone: 0,
                     wall_s: w,
                     cpu_s: 2.0 * w,
                     foreign: Some(Foreign {
@@ -270,34 +263,6 @@ mod tests {
             summary_row(&c, &m, None, &test_context(None, 2)).contended,
             Some(false)
         );
-    }
-
-    #[test]
-    fn a_trial_whose_strategy_ran_passes_alone_makes_the_cell_contended_and_says_how_many() {
-        let c = cell(StrategyName::CrossbeamPool, 2, Some(7));
-        let mut m = measured(&[1.0, 1.0, 1.0]);
-        assert_eq!(
-            summary_row(&c, &m, None, &test_context(None, 2)).contended,
-            Some(false)
-        );
-        m[2].elapsed.passes_alone = 64;
-        assert_eq!(
-            summary_row(&c, &m, None, &test_context(None, 2)).contended,
-            Some(true)
-        );
-        // Known from the run itself, without the machine's counters.
-        for t in &mut m {
-            t.elapsed.foreign = None;
-        }
-        assert_eq!(
-            summary_row(&c, &m, None, &test_context(None, 2)).contended,
-            Some(true)
-        );
-        let alone: Vec<_> = trial_rows(&c, &m, None)
-            .iter()
-            .map(|t| t.passes_alone)
-            .collect();
-        assert_eq!(alone, [Some(0), Some(0), Some(64)]);
     }
 
     #[test]

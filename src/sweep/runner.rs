@@ -448,7 +448,6 @@ mod tests {
     fn ok(checksum: &str) -> Result<Measured, String> {
         Ok(Measured {
             elapsed: Elapsed {
-                passes_alone: 0,
                 wall_s: 1.0,
                 cpu_s: 1.0,
                 foreign: None,

@@ -93,8 +93,6 @@ impl Timing {
             let (wall_s, cpu_s) = list[pick(list.len())];
             out.elapsed.wall_s = wall_s;
             out.elapsed.cpu_s = cpu_s;
-            // Whether a pass ran alone is the machine's doing too.
-            out.elapsed.passes_alone = 0;
         }
         if let Some(list) = &self.shares {
             let share = list[pick(list.len())];
@@ -143,7 +141,6 @@ mod tests {
 
     const MEASURED: Trial = Trial {
         elapsed: Elapsed {
-            passes_alone: 0,
             wall_s: 9.0,
             cpu_s: 9.0,
             foreign: None,
