@@ -4,8 +4,8 @@
 # (`sh -c 'while :; do :; done'`) competes for the cores, and prints per cell the median wall
 # time, its spread, the median CPU time and the ratio to the strategy's own 1-core median.
 # On a 2-core machine a 2-core run then has three runnable threads for two cores: a strategy
-# that degrades gracefully stays near its 1-core time (ratio <= 1), one that collapses does
-# not.
+# whose waiting leaves a shared core to whoever can use it stays near or below its 1-core
+# time (ratio <= 1), one that collapses does not.
 #
 # Usage: scripts/contention-bench.sh [--quiet-machine]
 #   --quiet-machine   no busy process: the same table for comparison (also: NO_BUSY=1)

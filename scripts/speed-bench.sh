@@ -24,9 +24,7 @@
 # (n * steps / wall_s), the parallel efficiency (seq median / (cores * median)) and, at
 # N = 10^6, the peak resident memory per particle; for the paired runs the efficiency of each
 # run (min, median, max) and of its median step. It checks that the plain loop ends in the
-# same state as `bench-sph simulate --strategy seq` (all-pairs): same checksum. It names every
-# configuration with runs whose strategy ran passes alone (`passes_alone` in the JSON:
-# crossbeam-pool on cores it found short), whose times are then not times on their cores.
+# same state as `bench-sph simulate --strategy seq` (all-pairs): same checksum.
 # Without a C++ compiler the plain loop and the ratio columns are skipped.
 # Run it on an otherwise quiet machine: it warns when the 1-minute load exceeds half the
 # hardware threads. Needs bash, cargo, awk, sort; no jq.
@@ -261,11 +259,10 @@ json_field() {
     sed -n "s/.*\"$1\":\"\{0,1\}\([^,\"}]*\).*/\1/p"
 }
 
-# One line per run in $RESULTS: KEY WALL_S RSS_KIB CHECKSUM PASSES_ALONE (0 for the plain
-# loop, which has no such field).
+# One line per run in $RESULTS: KEY WALL_S RSS_KIB CHECKSUM.
 # run_one KEY CMD...
 run_one() {
-    local key="$1" json wall sum rss alone
+    local key="$1" json wall sum rss
     shift
     if ! json="$(run_measured "$WORK/rss" "$@")"; then
         echo "Error: this run failed: $*" >&2
@@ -274,13 +271,12 @@ run_one() {
     wall="$(json_field wall_s <<<"$json")"
     sum="$(json_field checksum <<<"$json")"
     rss="$(tr -d ' \n' <"$WORK/rss")"
-    alone="$(json_field passes_alone <<<"$json")"
     if [[ -z "$wall" || -z "$sum" ]]; then
         echo "Error: no wall_s/checksum in the output of: $*" >&2
         echo "  $json" >&2
         exit 1
     fi
-    echo "$key $wall ${rss:--} $sum ${alone:-0}" >>"$RESULTS"
+    echo "$key $wall ${rss:--} $sum" >>"$RESULTS"
     printf '  run %d/%d  %-44s %10s s\n' "$run" "$RUNS" "$key" "$wall" >&2
 }
 
@@ -288,7 +284,7 @@ run_one() {
 # efficiency in place of wall_s, and one more under step:KEY with the median of its
 # step-by-step speedups over the cores.
 run_paired() {
-    local key="$1" json eff med sum alone cores
+    local key="$1" json eff med sum cores
     shift
     if ! json="$("$@")"; then
         echo "Error: this run failed: $*" >&2
@@ -298,14 +294,13 @@ run_paired() {
     med="$(json_field median <<<"$json")"
     cores="$(json_field cores <<<"$json")"
     sum="$(json_field checksum <<<"$json")"
-    alone="$(json_field passes_alone <<<"$json")"
     if [[ -z "$eff" || -z "$med" || -z "$cores" || -z "$sum" ]]; then
         echo "Error: no efficiency/median/cores/checksum in the output of: $*" >&2
         echo "  $json" >&2
         exit 1
     fi
-    echo "$key $eff - $sum ${alone:-0}" >>"$RESULTS"
-    echo "step:$key $(awk -v m="$med" -v c="$cores" 'BEGIN { printf "%.17g", m / c }') - $sum 0" \
+    echo "$key $eff - $sum" >>"$RESULTS"
+    echo "step:$key $(awk -v m="$med" -v c="$cores" 'BEGIN { printf "%.17g", m / c }') - $sum" \
         >>"$RESULTS"
     printf '  run %d/%d  %-44s eff %s\n' "$run" "$RUNS" "$key" "$eff" >&2
 }
@@ -502,19 +497,6 @@ for simd in "${SIMDS[@]}"; do
             "$(awk -v a="$large" -v b="$small" 'BEGIN { printf "%.2fx", a / b }') (medians)"
     fi
 done
-
-# Runs whose strategy ran passes on one thread (crossbeam-pool, finding its cores short):
-# their times are not times on their cores.
-ALONE="$(awk '$5 > 0 { c[$1]++ } END { for (k in c) print k, c[k] }' "$RESULTS" | sort)"
-if [[ -z "$ALONE" ]]; then
-    say "runs that ran passes alone (passes_alone > 0): none"
-fi
-while read -r key count; do
-    if [[ -n "$key" ]]; then
-        say "warning: $count of $RUNS runs of $key ran passes alone (passes_alone > 0): not" \
-            "times on their cores, and the figures above include them"
-    fi
-done <<<"$ALONE"
 
 # ---- Checks -------------------------------------------------------------------------------
 say ""

@@ -30,11 +30,6 @@ pub struct Elapsed {
     pub cpu_s: f64,
     /// What other work used of the machine over the same window (`None` where unknown).
     pub foreign: Option<Foreign>,
-    /// Passes the run's strategy ran on one thread although it had more, over the same window
-    /// ([`Executor::passes_alone`](sph_strategies::Executor::passes_alone): `crossbeam-pool`
-    /// on cores it found shared). Filled in by the run ([`crate::run`]); a bare
-    /// [`Stopwatch`] says 0.
-    pub passes_alone: u64,
 }
 
 /// Measures a region from [`Stopwatch::start`] to [`Stopwatch::stop`].
@@ -75,7 +70,6 @@ impl Stopwatch {
             wall_s,
             cpu_s,
             foreign,
-            passes_alone: 0,
         }
     }
 }

@@ -1,7 +1,12 @@
 //! Every strategy gives the sequential run's bits, whatever the search (the grid with either
 //! list key, in index or cell order), cores, chunks, SIMD path and thread placement (`--pin`) (the portable path's unpinned sequential run is the reference),
 //! and a panic inside a kernel becomes an error of the run (never a hang) on every strategy.
+//! Whichever thread of whichever strategy runs a kernel call, it runs the code of the SIMD path
+//! that `seq` runs.
 
+use std::collections::BTreeSet;
+use std::sync::Mutex;
+use std::thread::ThreadId;
 use std::time::Duration;
 
 use bench_sph::run::run_timed;
@@ -11,7 +16,7 @@ use bench_sph::solver::Simulation;
 use bench_sph::sph::neighbors::{GridKeys, NeighborMode, SumOrder};
 use bench_sph::sph::params::Preset;
 use bench_sph::sph::state::{FIELD_NAMES, State};
-use sph_strategies::{Config, StrategyName};
+use sph_strategies::{Config, Executor, KernelPanic, Session, Split, StrategyName};
 
 mod common;
 
@@ -173,6 +178,146 @@ fn every_simd_path_this_machine_runs_gives_the_portable_bits() {
                     if let Some(diff) = first_bit_difference(&got, &reference) {
                         panic!(
                             "{preset} {mode} {keys:?} keys, order {order} {simd} {strategy}: {diff}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Records, from inside every kernel call, the thread that runs it and the SIMD paths its
+/// kernel was compiled for: a pass picks its path once (`with_lanes!`) and hands the strategy a
+/// kernel monomorphised for it, whose type names the lanes (`mueller::density<_, Avx512, _>`).
+struct PathRecorder<'a, E> {
+    inner: &'a E,
+    calls: &'a Mutex<Vec<(ThreadId, BTreeSet<SimdPath>)>>,
+}
+
+impl<E: Executor> Executor for PathRecorder<'_, E> {
+    fn for_each_chunk<O, F>(&self, out: O, kernel: F) -> Result<(), KernelPanic>
+    where
+        O: Split,
+        F: Fn(usize, O) + Sync,
+    {
+        let paths = paths_named_in(std::any::type_name::<F>());
+        self.inner.for_each_chunk(out, |first, chunk| {
+            let call = (std::thread::current().id(), paths.clone());
+            self.calls.lock().unwrap().push(call);
+            kernel(first, chunk);
+        })
+    }
+
+    fn threads(&self) -> usize {
+        self.inner.threads()
+    }
+}
+
+/// The SIMD paths whose lanes type a kernel's type name names (none for a kernel that does not
+/// depend on the path, such as the grid's rebuild).
+fn paths_named_in(type_name: &str) -> BTreeSet<SimdPath> {
+    let lanes = [
+        (SimdPath::Portable, "::Portable"),
+        (SimdPath::Avx2, "::Avx2"),
+        (SimdPath::Avx512, "::Avx512"),
+    ];
+    lanes
+        .into_iter()
+        .filter(|(_, name)| {
+            type_name.match_indices(name).any(|(at, _)| {
+                let next = type_name[at + name.len()..].chars().next();
+                !next.is_some_and(|c| c.is_alphanumeric() || c == '_')
+            })
+        })
+        .map(|(path, _)| path)
+        .collect()
+}
+
+/// Runs `steps` steps of `sim` on `strategy` with every kernel call recorded: its thread and the
+/// paths its kernel was compiled for.
+fn record_paths(
+    sim: &mut Simulation,
+    strategy: StrategyName,
+    config: &Config,
+    steps: usize,
+) -> Vec<(ThreadId, BTreeSet<SimdPath>)> {
+    struct Steps<'a> {
+        sim: &'a mut Simulation,
+        steps: usize,
+        calls: &'a Mutex<Vec<(ThreadId, BTreeSet<SimdPath>)>>,
+    }
+    impl Session for Steps<'_> {
+        type Output = ();
+        fn run<E: Executor>(self, exec: &E) {
+            let calls = self.calls;
+            let recorder = PathRecorder { inner: exec, calls };
+            self.sim
+                .advance(&recorder, self.steps)
+                .expect("the steps run");
+        }
+    }
+    let calls = Mutex::new(Vec::new());
+    sph_strategies::run(
+        strategy,
+        config,
+        Steps {
+            sim,
+            steps,
+            calls: &calls,
+        },
+    )
+    .expect("starts");
+    calls.into_inner().unwrap()
+}
+
+#[test]
+fn every_strategys_threads_run_the_simd_path_that_seq_runs() {
+    // Measured once: crossbeam-pool on 1 core took 3.4x seq's time on AVX-512 and AVX2 (and
+    // the same time on the portable path), as if its thread ran other instructions. It did
+    // not (a stack temporary straddled a page: see `simd::Near8`); this holds that it never
+    // does: whichever thread runs a kernel call, it runs the code of the path seq runs.
+    let me = std::thread::current().id();
+    for simd in SimdPath::available() {
+        for search @ (mode, keys, order) in SEARCHES {
+            let fresh = || simulation(Preset::Seed, search).with_simd(simd).unwrap();
+            let lanes_of = |calls: &[(ThreadId, BTreeSet<SimdPath>)]| -> BTreeSet<SimdPath> {
+                calls.iter().flat_map(|(_, p)| p.iter().copied()).collect()
+            };
+            let seq = record_paths(&mut fresh(), StrategyName::Seq, &Config::new(1, 1), 3);
+            let seq_paths = lanes_of(&seq);
+            if mode == NeighborMode::AllPairs {
+                assert_eq!(
+                    seq_paths,
+                    BTreeSet::from([simd]),
+                    "seq, all-pairs, --simd {simd}"
+                );
+            } else {
+                assert!(
+                    seq_paths.contains(&simd),
+                    "seq, grid, --simd {simd}: {seq_paths:?}"
+                );
+            }
+            for &strategy in StrategyName::ALL {
+                for (cores, chunks) in [(1, 10), (2, 7)] {
+                    let what = format!(
+                        "{mode} {keys:?} keys, order {order}, --simd {simd}, {strategy} \
+                         cores={cores} chunks={chunks}"
+                    );
+                    let calls =
+                        record_paths(&mut fresh(), strategy, &Config::new(cores, chunks), 3);
+                    assert_eq!(lanes_of(&calls), seq_paths, "{what}");
+                    for (thread, paths) in &calls {
+                        assert!(
+                            paths.is_subset(&seq_paths),
+                            "{what}: {thread:?} ran {paths:?}"
+                        );
+                    }
+                    // The kernels ran on the strategy's own threads, not only on this one.
+                    if strategy != StrategyName::Seq {
+                        let elsewhere = calls.iter().any(|(t, p)| *t != me && !p.is_empty());
+                        assert!(
+                            elsewhere,
+                            "{what}: no path-carrying call off the test's thread"
                         );
                     }
                 }

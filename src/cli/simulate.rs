@@ -74,8 +74,6 @@ struct Report {
     simulated_s: Option<f64>,
     wall_s: f64,
     cpu_s: f64,
-    /// Passes run on one thread although the strategy had more (see [`alone_note`]).
-    passes_alone: u64,
     particle_steps_per_s: f64,
     checksum: String,
     simd: SimdPath,
@@ -147,35 +145,12 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         simulated_s: args.t_end.map(|_| sim.time_s),
         wall_s: elapsed.wall_s,
         cpu_s: elapsed.cpu_s,
-        passes_alone: elapsed.passes_alone,
         particle_steps_per_s: (n * sim.steps_done) as f64 / elapsed.wall_s,
         checksum: checksum_hex(&sim.state),
         simd: sim.simd(),
         pin: args.parallel.pin,
     };
-    warn_if_alone(report.passes_alone, &report.strategy, report.cores);
     print_report(&report, args.json)
-}
-
-/// Warns on standard error when a run's strategy ran `passes` passes alone ([`alone_note`]).
-pub(crate) fn warn_if_alone(passes: u64, strategy: &str, cores: usize) {
-    if let Some(note) = alone_note(passes, strategy, cores) {
-        console::warn(&format!("warning: {note}"));
-    }
-}
-
-/// What a run whose strategy ran `passes` passes on one thread must say with its time: that
-/// time is not a time on `cores` cores. `None` when no pass ran alone.
-pub(crate) fn alone_note(passes: u64, strategy: &str, cores: usize) -> Option<String> {
-    (passes > 0).then(|| {
-        format!(
-            "{strategy} ran {} on one thread: its threads got less CPU time than its \
-             chunks had work for on {cores} cores (another program busy, or a stall of the \
-             machine), so it left them to that work for a while; this run's time is not a \
-             {cores}-core time",
-            console::plural(passes as usize, "pass", "passes")
-        )
-    })
 }
 
 /// Writes the state of `sim` (of `preset`) to the dump file and renames it into place.
@@ -226,25 +201,4 @@ fn print_report(r: &Report, json: bool) -> anyhow::Result<()> {
     ))?;
     say(&format!("checksum {}", r.checksum))?;
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_run_says_its_time_is_not_a_time_on_its_cores_only_when_passes_ran_alone() {
-        assert_eq!(alone_note(0, "crossbeam-pool", 2), None);
-        let note = alone_note(64, "crossbeam-pool", 2).unwrap();
-        assert!(
-            note.starts_with("crossbeam-pool ran 64 passes on one thread"),
-            "{note}"
-        );
-        assert!(note.ends_with("not a 2-core time"), "{note}");
-        assert!(
-            alone_note(1, "crossbeam-pool", 4)
-                .unwrap()
-                .contains("ran 1 pass on")
-        );
-    }
 }

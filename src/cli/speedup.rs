@@ -68,7 +68,6 @@ struct Report {
     efficiency: f64,
     /// Of each step's `seq` time over the strategy's.
     step_speedup: Spread,
-    passes_alone: u64,
     /// More threads than the machine's hardware threads: the speedup is not one of `cores`
     /// cores.
     oversubscribed: bool,
@@ -110,13 +109,11 @@ pub fn run(args: &SpeedupArgs) -> anyhow::Result<()> {
         speedup,
         efficiency: speedup / cores as f64,
         step_speedup: spread(&times),
-        passes_alone: times.passes_alone,
         oversubscribed: cores > super::hardware_threads(),
         checksum,
         simd: sim.simd(),
         pin: args.parallel.pin,
     };
-    super::simulate::warn_if_alone(report.passes_alone, &report.strategy, cores);
     if report.oversubscribed {
         console::warn(&format!(
             "warning: {cores} threads on {} hardware threads (oversubscribed): this is not a \
@@ -182,7 +179,6 @@ mod tests {
         let times = PairedTimes {
             seq_s: vec![2.0, 3.0, 1.0, 4.0, 10.0],
             strategy_s: vec![1.0, 1.0, 1.0, 1.0, 1.0],
-            passes_alone: 0,
         };
         let s = spread(&times);
         assert_eq!(
@@ -198,7 +194,6 @@ mod tests {
         let one = PairedTimes {
             seq_s: vec![3.0],
             strategy_s: vec![2.0],
-            passes_alone: 0,
         };
         assert_eq!(spread(&one).median, 1.5);
     }

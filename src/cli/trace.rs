@@ -66,7 +66,6 @@ struct Meta<'a> {
     warmup_steps: usize,
     wall_s: f64,
     cpu_s: f64,
-    passes_alone: u64,
     kernel_calls: usize,
     worker_threads: usize,
     workers_used: usize,
@@ -80,8 +79,6 @@ struct Meta<'a> {
 struct Comparison {
     untraced: Vec<f64>,
     traced: Vec<f64>,
-    /// Passes run alone over all the compared runs.
-    alone: u64,
 }
 
 /// Runs `trace`: checks the trace's size and claims `--out` before anything runs, then
@@ -122,7 +119,6 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
         warmup_steps: args.warmup,
         wall_s: run.elapsed.wall_s,
         cpu_s: run.elapsed.cpu_s,
-        passes_alone: run.elapsed.passes_alone,
         kernel_calls: stats.total.kernel_calls,
         worker_threads: stats.total.worker_threads,
         workers_used: stats.total.workers_used,
@@ -133,7 +129,6 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
     };
     write_files(&paths, &run, &stats, &meta)?;
     let removed = claimed.remove_stale(&paths)?;
-    super::simulate::warn_if_alone(meta.passes_alone, args.parallel.strategy.as_str(), cores);
 
     let mut lines = summary(&config, args.warmup, &stats, run.elapsed.wall_s);
     if args.compare.is_some() {
@@ -206,7 +201,6 @@ fn record(
     let mut comparison = Comparison {
         untraced: Vec::new(),
         traced: Vec::new(),
-        alone: 0,
     };
     let mut last = None;
     for _ in 0..args.compare.unwrap_or(0) {
@@ -222,7 +216,6 @@ fn record(
         let mut sim = fresh();
         let run = traced(&mut sim)?;
         comparison.traced.push(run.elapsed.wall_s);
-        comparison.alone += elapsed.passes_alone + run.elapsed.passes_alone;
         anyhow::ensure!(
             checksum_hex(&sim.state) == checksum_hex(&plain.state),
             "the traced run's final state differs from the untraced run's (a bug)"
@@ -383,7 +376,7 @@ fn comparison_lines(c: &Comparison, stats: &Stats, cost_ns: f64) -> Vec<String> 
     let (tmin, tmed) = min_median(&c.traced);
     let calls = stats.total.kernel_calls as f64;
     let added_s = calls * cost_ns * 1e-9 / stats.workers.len().max(1) as f64;
-    let mut lines = vec![
+    vec![
         format!(
             "compare ({} runs each, alternating): untraced min {:.4} s median {:.4} s; \
              traced min {:.4} s median {:.4} s; overhead {:+.1} % (min), {:+.1} % (median)",
@@ -403,13 +396,5 @@ fn comparison_lines(c: &Comparison, stats: &Stats, cost_ns: f64) -> Vec<String> 
             added_s * 1e3,
             100.0 * added_s / umin
         ),
-    ];
-    if c.alone > 0 {
-        lines.push(format!(
-            "warning: the compared runs ran {} on one thread (their threads got less than their \
-             cores): the overhead above compares times that are not times on their cores",
-            console::plural(c.alone as usize, "pass", "passes")
-        ));
-    }
-    lines
+    ]
 }

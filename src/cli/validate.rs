@@ -44,9 +44,6 @@ pub fn run(args: &ValidateArgs) -> anyhow::Result<()> {
     let v = validate::validate(args.resolution, args.parallel.strategy, &config)?;
     write_files(&paths, &v)?;
     claimed.remove_stale(&paths)?;
-    let info = args.parallel.strategy.info();
-    let cores = info.effective_cores(config.cores);
-    super::simulate::warn_if_alone(v.elapsed.passes_alone, info.name, cores);
 
     if args.json {
         let text = serde_json::to_string(&summary::Json::of(&v))?;

@@ -53,12 +53,4 @@ impl<E: Executor> Executor for Faulty<'_, E> {
     fn threads(&self) -> usize {
         self.inner.threads()
     }
-
-    fn passes_alone(&self) -> u64 {
-        self.inner.passes_alone()
-    }
-
-    fn forget_load(&self) {
-        self.inner.forget_load();
-    }
 }

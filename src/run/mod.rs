@@ -119,7 +119,7 @@ impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
         let mut done = 0;
         while done < total {
             let steps = every.max(1).min(total - done);
-            let (watch, alone) = (Stopwatch::start(), exec.passes_alone());
+            let watch = Stopwatch::start();
             let ran = match until_s {
                 None => self
                     .sim
@@ -127,10 +127,7 @@ impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
                     .map(|()| steps),
                 Some(t) => self.sim.advance_until(exec, steps, t, self.hooks),
             }?;
-            let elapsed = Elapsed {
-                passes_alone: exec.passes_alone() - alone,
-                ..watch.stop()
-            };
+            let elapsed = watch.stop();
             done += ran;
             let reached = until_s.is_some_and(|t| self.sim.time_s >= t);
             if self.observer.segment(self.sim, elapsed).is_break() || reached {
@@ -221,7 +218,6 @@ pub fn run_timed_steps<H: StepHooks + Send>(
     let mut last = LastSegment(None);
     run_steps(sim, strategy, config, steps, hooks, &mut last)?;
     Ok(last.0.unwrap_or(Elapsed {
-        passes_alone: 0,
         wall_s: 0.0,
         cpu_s: 0.0,
         foreign: None,

@@ -25,9 +25,6 @@ pub struct PairedTimes {
     pub seq_s: Vec<f64>,
     /// The strategy's time of each step.
     pub strategy_s: Vec<f64>,
-    /// Passes the strategy ran on one thread although it had more (see
-    /// [`Executor::passes_alone`]).
-    pub passes_alone: u64,
 }
 
 /// Runs `steps` steps of `seq_sim` on the session's thread alone and of `sim` with
@@ -75,11 +72,9 @@ impl Session for Paired<'_> {
         let seq = |e| (Some("seq"), e);
         let strategy = |e| (None, e);
         super::wake_threads(exec, self.cpus, self.sim.steps_done).map_err(strategy)?;
-        let alone = exec.passes_alone();
         let mut times = PairedTimes {
             seq_s: Vec::with_capacity(self.steps),
             strategy_s: Vec::with_capacity(self.steps),
-            passes_alone: 0,
         };
         for step in 0..self.steps {
             let seq_first = step % 2 == 0;
@@ -97,7 +92,6 @@ impl Session for Paired<'_> {
                     .push(timed(|| self.seq_sim.advance(&SeqExecutor, 1)).map_err(seq)?);
             }
         }
-        times.passes_alone = exec.passes_alone() - alone;
         Ok(times)
     }
 }

@@ -5,12 +5,22 @@ use super::quad::Quad;
 
 /// The squared distances to eight candidates and the bit mask of those below `hsq` (bit k set
 /// when candidate k is within reach).
+///
+/// Aligned to 64 bytes, `r2` first, like the lane arrays of [`Hits8`] and the neighbour
+/// search's `Eight`: a search stores the eight lanes with one vector store into a temporary on
+/// the stack and reads the hits back one by one. Only 16-byte aligned, that store straddled a
+/// cache line three times in four, and a 4 KiB page wherever the temporary happened to sit
+/// less than 64 bytes below a page boundary; there the all-pairs density pass took 3–4× as
+/// long on AVX2 and AVX-512 (`seq` now and then, as address-space randomisation placed the
+/// main thread's stack; `crossbeam-pool` on 1 core in every run, its session thread's fresh
+/// stack putting the temporary at the same place each time).
 #[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
 pub struct Near8 {
-    /// Bit k: `r2[k] < hsq`.
-    pub mask: u8,
     /// `dx*dx + dy*dy` per candidate, `d = x_j − x_i`, exactly as the scalar code computes it.
     pub r2: [f64; 8],
+    /// Bit k: `r2[k] < hsq`.
+    pub mask: u8,
 }
 
 /// Eight candidates of a grid's row, for [`Lanes::hits8`].
@@ -26,8 +36,10 @@ pub struct Row8<'a> {
     pub first: u32,
 }
 
-/// Eight candidates' hits ([`Lanes::hits8`]).
+/// Eight candidates' hits ([`Lanes::hits8`]), each lane array on a 64-byte boundary (see
+/// [`Near8`]).
 #[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
 pub struct Hits8 {
     /// Every candidate's squared distance, as [`Near8::r2`].
     pub r2: [f64; 8],
@@ -392,6 +404,32 @@ impl Quad for PackingPortable {
 mod tests {
     use super::*;
     use crate::simd::SimdPath;
+    use std::mem::{align_of, offset_of};
+
+    #[test]
+    fn the_lane_arrays_a_search_stores_whole_sit_on_64_byte_boundaries() {
+        // One vector store of eight f64 lanes then never straddles a cache line or a page,
+        // wherever the thread's stack puts the temporary (see `Near8`).
+        use crate::sph::neighbors::Eight;
+        for (what, align, offsets) in [
+            ("Near8", align_of::<Near8>(), vec![offset_of!(Near8, r2)]),
+            (
+                "Hits8",
+                align_of::<Hits8>(),
+                vec![
+                    offset_of!(Hits8, r2),
+                    offset_of!(Hits8, hits),
+                    offset_of!(Hits8, hit_r2),
+                ],
+            ),
+            ("Eight", align_of::<Eight>(), vec![offset_of!(Eight, r2)]),
+        ] {
+            assert_eq!(align, 64, "{what}");
+            for offset in offsets {
+                assert_eq!(offset % 64, 0, "{what}: a lane array at byte {offset}");
+            }
+        }
+    }
 
     /// Candidates at, just inside and just outside the radius, NaN, infinities, signed zeros.
     fn awkward() -> ([f64; 8], [f64; 8]) {

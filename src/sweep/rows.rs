@@ -80,7 +80,6 @@ mod tests {
         };
         let m = Measured {
             elapsed: Elapsed {
-                passes_alone: 0,
                 wall_s: 0.5,
                 cpu_s: 1.0,
                 foreign: Some(Foreign {

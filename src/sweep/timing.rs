@@ -10,9 +10,8 @@
 //!   1-minute load of f × hardware threads; the busy-machine check before the plan reads the
 //!   first item.
 //!
-//! `--fake-timings` alone implies `--fake-contention 0` (a quiet machine), and it records no
-//! pass run alone (`passes_alone` 0), so a test's files do not depend on what else the machine
-//! was doing.
+//! `--fake-timings` alone implies `--fake-contention 0` (a quiet machine), so a test's files do
+//! not depend on what else the machine was doing.
 //!
 //! The simulation still runs and its checksums are still checked; only the numbers written
 //! are replaced. Each timed run has a fixed number ([`fake_index`]): round r (from 1) of the
@@ -88,8 +87,6 @@ impl Timing {
             let (wall_s, cpu_s) = list[pick(list.len())];
             out.elapsed.wall_s = wall_s;
             out.elapsed.cpu_s = cpu_s;
-            // Whether a pass ran alone is the machine's doing too.
-            out.elapsed.passes_alone = 0;
         }
         if let Some(list) = &self.shares {
             let share = list[pick(list.len())];
@@ -162,7 +159,6 @@ mod tests {
 
     const MEASURED: Trial = Trial {
         elapsed: Elapsed {
-            passes_alone: 0,
             wall_s: 9.0,
             cpu_s: 9.0,
             foreign: None,

@@ -47,14 +47,6 @@ impl<E: Executor> Executor for TracingExecutor<'_, E> {
     fn threads(&self) -> usize {
         self.inner.threads()
     }
-
-    fn passes_alone(&self) -> u64 {
-        self.inner.passes_alone()
-    }
-
-    fn forget_load(&self) {
-        self.inner.forget_load();
-    }
 }
 
 /// Runs `kernel(first, chunk)` and records it as one call of `phase` in `step`.

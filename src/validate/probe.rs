@@ -115,7 +115,6 @@ impl Probe {
             next: 1,
             samples: Vec::new(),
             elapsed: Elapsed {
-                passes_alone: 0,
                 wall_s: 0.0,
                 cpu_s: 0.0,
                 foreign: None,
@@ -150,7 +149,6 @@ impl Observer for Probe {
     fn segment(&mut self, sim: &Simulation, elapsed: Elapsed) -> ControlFlow<()> {
         self.elapsed.wall_s += elapsed.wall_s;
         self.elapsed.cpu_s += elapsed.cpu_s;
-        self.elapsed.passes_alone += elapsed.passes_alone;
         self.observe(sim);
         ControlFlow::Continue(())
     }

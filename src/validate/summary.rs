@@ -26,7 +26,6 @@ pub struct Json<'a> {
     simulated_s: f64,
     wall_s: f64,
     cpu_s: f64,
-    passes_alone: u64,
     passed: bool,
     front_shift: f64,
     verdicts: Vec<JsonVerdict>,
@@ -62,7 +61,6 @@ impl<'a> Json<'a> {
             simulated_s: v.simulated_s,
             wall_s: v.elapsed.wall_s,
             cpu_s: v.elapsed.cpu_s,
-            passes_alone: v.elapsed.passes_alone,
             passed: v.outcome.passed(),
             front_shift: FRONT_SHIFT,
             verdicts: v

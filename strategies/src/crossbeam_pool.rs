@@ -33,12 +33,9 @@
 //! run; and a pass never waits for a worker that has not joined it: the pass closes when the
 //! session's thread finds no chunk left, and only the workers already inside it (each busy
 //! with a chunk it took) are waited for. A descheduled worker thus costs the pass its help,
-//! not a scheduling round-trip. And when the pool's threads do not get their cores at all
-//! (their CPU time, read from each thread's own clock (see `thread_clocks`), falls short of
-//! what the passes' chunks could keep busy, and below 1.5 cores' worth), the session's thread
-//! runs the next passes alone for a while (see the `degrade` module), so a 2-core run on a
-//! shared machine does not fall below the strategy's own 1-core speed. The results are the
-//! same bits.
+//! not a scheduling round-trip. The pool never gives its threads up: every pass offers its
+//! chunks to all of them, whatever the machine is doing, so a run does the same work on a
+//! busy machine as on a quiet one, and a busy machine shows in its time.
 //!
 //! **Panics.** A kernel panic is caught per chunk; the first one is returned as
 //! [`KernelPanic`] once the pass has finished, and the workers keep serving later passes.
@@ -52,16 +49,14 @@
 //! that `unsafe` is confined to the private module `erased_job`, whose safe API returns only
 //! after every worker that joined the pass is done with the job.
 
-use crate::degrade::Degrade;
 use crate::erased_job::JobBoard;
-use crate::thread_clocks::ThreadClocks;
 use crate::thread_start::ThreadStarts;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Placement, Session, Split, Strategy,
     balanced_chunks, panic,
 };
 use crossbeam::queue::ArrayQueue;
-use std::cell::{Cell, RefCell};
+use std::cell::Cell;
 use std::marker::PhantomData;
 use std::sync::OnceLock;
 
@@ -72,14 +67,6 @@ pub struct CrossbeamPool {
     chunks: usize,
     placement: Placement,
     starts: ThreadStarts,
-}
-
-impl CrossbeamPool {
-    /// A fresh degradation state for this pool: its threads can run at once on at most the
-    /// CPUs of its placement (for a pinned pool, not the one CPU its pinned caller may use).
-    fn degrade(&self) -> Degrade {
-        Degrade::new(self.cores, self.placement.parallelism())
-    }
 }
 
 impl Strategy for CrossbeamPool {
@@ -108,17 +95,14 @@ impl Strategy for CrossbeamPool {
     /// Re-raises a panic of `session` itself once the workers have been joined.
     fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError> {
         let board = JobBoard::new();
-        let clocks = ThreadClocks::new(self.cores);
         let executor = PoolExecutor {
             board: &board,
-            clocks: &clocks,
             threads: self.cores,
             chunks: self.chunks,
-            degrade: RefCell::new(self.degrade()),
             not_sync: PhantomData,
         };
         let (cores, placement) = (self.cores, self.placement);
-        let (board, clocks) = (&board, &clocks);
+        let board = &board;
         let outcome = crossbeam::scope(|scope| {
             // Created before the first worker, so that every way out of this closure — a
             // return, a refused thread, a panicking session — releases the workers first.
@@ -130,7 +114,6 @@ impl Strategy for CrossbeamPool {
                         .name(format!("crossbeam-pool-{i}"))
                         .spawn(move |_| {
                             placement.on_start(i);
-                            clocks.register(i);
                             board.serve()
                         })
                 })?;
@@ -141,7 +124,6 @@ impl Strategy for CrossbeamPool {
                     .name("crossbeam-pool-0".to_owned())
                     .spawn(move |_| {
                         placement.on_start(0);
-                        clocks.register(0);
                         session.run(&executor)
                     })
             })?;
@@ -168,13 +150,9 @@ impl Drop for ShutDownOnDrop<'_> {
 /// executor and start a nested pass from a worker, which would wait for itself forever.
 struct PoolExecutor<'a> {
     board: &'a JobBoard,
-    /// The CPU clocks of the pool's threads, which `degrade` reads.
-    clocks: &'a ThreadClocks,
     /// The pool's threads, the session's included.
     threads: usize,
     chunks: usize,
-    /// Whether the next passes run on the session's thread alone (see `degrade`).
-    degrade: RefCell<Degrade>,
     not_sync: PhantomData<Cell<()>>,
 }
 
@@ -188,7 +166,6 @@ impl Executor for PoolExecutor<'_> {
             return Ok(());
         }
         let chunks = balanced_chunks(out, self.chunks);
-        let chunk_count = chunks.len();
         // Not empty (`out` is not), so the capacity is at least 1 as `ArrayQueue` requires.
         let queue = ArrayQueue::new(chunks.len());
         for chunk in chunks {
@@ -207,17 +184,7 @@ impl Executor for PoolExecutor<'_> {
                 }
             }
         };
-        let mut degrade = self.degrade.borrow_mut();
-        let escaped = if degrade.solo_pass() {
-            // Alone: the same job, every chunk on this thread.
-            panic::catch(job)
-        } else {
-            degrade.before_parallel_pass(|| self.clocks.total());
-            let start = std::time::Instant::now();
-            let escaped = self.board.run(&job);
-            degrade.after_parallel_pass(start.elapsed(), chunk_count);
-            escaped
-        };
+        let escaped = self.board.run(&job);
 
         match first_panic.into_inner() {
             Some(p) => Err(p),
@@ -227,14 +194,6 @@ impl Executor for PoolExecutor<'_> {
 
     fn threads(&self) -> usize {
         self.threads
-    }
-
-    fn passes_alone(&self) -> u64 {
-        self.degrade.borrow().solo_total()
-    }
-
-    fn forget_load(&self) {
-        self.degrade.borrow_mut().forget();
     }
 }
 
@@ -255,101 +214,6 @@ mod tests {
         let all: Vec<_> = passes.concat();
         assert!(distinct(&all) <= 3, "{passes:?}");
         assert!(!all.contains(&std::thread::current().id()));
-    }
-
-    /// A pool executor of two threads on `board` and `clocks`, cutting each pass into `chunks`,
-    /// in the degradation state `degrade` (the tests serve the board themselves).
-    fn two_thread_executor<'a>(
-        board: &'a JobBoard,
-        clocks: &'a ThreadClocks,
-        chunks: usize,
-        degrade: Degrade,
-    ) -> PoolExecutor<'a> {
-        PoolExecutor {
-            board,
-            clocks,
-            threads: 2,
-            chunks,
-            degrade: RefCell::new(degrade),
-            not_sync: PhantomData,
-        }
-    }
-
-    #[test]
-    fn passes_run_alone_are_counted_and_leave_the_workers_idle() {
-        // One worker serves the board: a pass that asked for help would give it chunks (each
-        // takes a millisecond); a pass run alone gives it none. The degraded state lasts 3
-        // passes.
-        let (board, clocks) = (JobBoard::new(), ThreadClocks::new(2));
-        let executor = two_thread_executor(&board, &clocks, 4, Degrade::alone_for(3));
-        let caller = std::thread::current().id();
-        let pass = || {
-            let mut out = [None; 16];
-            executor
-                .for_each_chunk(&mut out[..], |_, chunk| {
-                    std::thread::sleep(std::time::Duration::from_millis(1));
-                    chunk.fill(Some(std::thread::current().id()));
-                })
-                .unwrap();
-            out
-        };
-        std::thread::scope(|s| {
-            let _stop = ShutDownOnDrop(&board);
-            s.spawn(|| board.serve());
-            assert_eq!(executor.passes_alone(), 0);
-            for k in 1..=3 {
-                assert!(pass().iter().all(|&t| t == Some(caller)), "pass {k}");
-                assert_eq!(executor.passes_alone(), k);
-            }
-            pass();
-            assert_eq!(
-                executor.passes_alone(),
-                3,
-                "a pass with help is not counted"
-            );
-        });
-    }
-
-    #[test]
-    fn passes_of_one_chunk_never_run_alone_however_little_cpu_they_use() {
-        // One chunk per pass keeps one thread busy: there is no help to give up, so the
-        // sleeping kernel (next to no CPU time over many windows) is not taken for a machine
-        // whose other work took the cores.
-        let (board, clocks) = (JobBoard::new(), ThreadClocks::new(2));
-        let executor = two_thread_executor(&board, &clocks, 1, Degrade::new(2, 2));
-        clocks.register(0);
-        std::thread::scope(|s| {
-            let _stop = ShutDownOnDrop(&board);
-            s.spawn(|| {
-                clocks.register(1);
-                board.serve();
-            });
-            for _ in 0..40 {
-                let mut out = [0u8; 16];
-                executor
-                    .for_each_chunk(&mut out[..], |_, chunk| {
-                        std::thread::sleep(std::time::Duration::from_micros(600));
-                        chunk.fill(1);
-                    })
-                    .unwrap();
-                assert!(out.iter().all(|&v| v == 1));
-            }
-        });
-        assert_eq!(executor.passes_alone(), 0);
-    }
-
-    #[test]
-    fn a_pinned_pool_judges_its_cores_by_its_placements_cpus() {
-        static NOTHING: fn(usize) = |_| {};
-        let pool = |cores, placement| CrossbeamPool {
-            cores,
-            chunks: 8,
-            placement,
-            starts: ThreadStarts::default(),
-        };
-        assert_eq!(pool(2, Placement::new(&NOTHING, 2)).degrade().threads(), 2);
-        assert_eq!(pool(4, Placement::new(&NOTHING, 3)).degrade().threads(), 3);
-        assert_eq!(pool(2, Placement::new(&NOTHING, 1)).degrade().threads(), 1);
     }
 
     #[test]

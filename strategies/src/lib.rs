@@ -25,7 +25,6 @@
 //! returns only once every worker is done with the kernel; see the `// SAFETY:` notes there).
 
 pub mod crossbeam_pool;
-mod degrade;
 mod erased_job;
 mod panic;
 pub mod placement;
@@ -40,7 +39,6 @@ mod split;
 pub mod std_static;
 #[cfg(test)]
 mod testing;
-mod thread_clocks;
 mod thread_start;
 pub mod wake;
 
@@ -194,18 +192,6 @@ pub trait Executor {
     /// to choose between ways of computing the same thing (the grid's counting sort runs in
     /// bands only with more than one thread).
     fn threads(&self) -> usize;
-
-    /// How many of its passes so far this executor ran on the calling thread alone although
-    /// it has more threads: `crossbeam-pool`, when it finds its threads short of cores, runs
-    /// passes alone for a while (see `degrade`). 0 for every other executor; a wrapper forwards
-    /// its inner executor's count. A run whose passes ran alone did not measure its cores.
-    fn passes_alone(&self) -> u64;
-
-    /// Forgets what its passes so far said about whether its threads get their cores
-    /// (`crossbeam-pool`'s degradation, see `degrade`): the passes that wake the threads
-    /// ([`wake()`]) spin, and a late thread in them is the start-up the wake absorbs, not
-    /// a busy machine. Nothing to forget for every other executor; a wrapper forwards it.
-    fn forget_load(&self) {}
 }
 
 /// The body of a run: everything that happens while a strategy's threads exist.

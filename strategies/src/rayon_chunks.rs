@@ -84,10 +84,6 @@ impl Executor for RayonChunksExecutor<'_> {
     fn threads(&self) -> usize {
         self.pool.current_num_threads()
     }
-
-    fn passes_alone(&self) -> u64 {
-        0
-    }
 }
 
 #[cfg(test)]

@@ -68,10 +68,6 @@ impl Executor for RayonIterExecutor<'_> {
     fn threads(&self) -> usize {
         self.pool.current_num_threads()
     }
-
-    fn passes_alone(&self) -> u64 {
-        0
-    }
 }
 
 /// Cuts `(first_index, out)` in two halves, unless it is a single element.

@@ -72,10 +72,6 @@ impl Executor for RayonSpawnExecutor<'_> {
     fn threads(&self) -> usize {
         self.pool.current_num_threads()
     }
-
-    fn passes_alone(&self) -> u64 {
-        0
-    }
 }
 
 #[cfg(test)]

@@ -42,8 +42,4 @@ impl Executor for SeqExecutor {
     fn threads(&self) -> usize {
         1
     }
-
-    fn passes_alone(&self) -> u64 {
-        0
-    }
 }

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use crossbeam::utils::Backoff;
 
 /// How long a thread watches a hint, spinning then yielding, before it sleeps.
-pub(crate) const LIMIT: Duration = Duration::from_micros(200);
+const LIMIT: Duration = Duration::from_micros(200);
 
 /// Returns `true` as soon as `done()` holds, or `false` once [`LIMIT`] has passed without it.
 ///

@@ -119,10 +119,6 @@ impl Executor for StdStaticExecutor {
     fn threads(&self) -> usize {
         self.strategy.cores
     }
-
-    fn passes_alone(&self) -> u64 {
-        0
-    }
 }
 
 #[cfg(test)]

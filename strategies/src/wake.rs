@@ -3,7 +3,7 @@
 //! A thread that has slept for a while does not get its core back at once on a virtual
 //! machine. On the project's 2-core VM, a `crossbeam-pool` run at N = 10⁶ started after the
 //! single-threaded build of its state: for its first 30–80 ms the second thread took each
-//! pass 2–4 ms late, or ran a fraction of the pass (the pool's own CPU clocks read 1.0–1.4
+//! pass 2–4 ms late, or ran a fraction of the pass (its threads' CPU time read 1.0–1.4
 //! cores over those windows), and then 2.0 cores for the rest of the run. A 10-step run of
 //! 0.45 s lost about a tenth of its time to that start, which `seq`, on the thread that built
 //! the state, never pays, and with the time charged to the strategy the efficiency read low.
@@ -12,10 +12,7 @@
 //! [`SPIN`], until the passes have taken no more than half again their time on all cores for
 //! [`SETTLED`] in a row, or until [`LONGEST`] has passed (a machine whose cores are taken
 //! stays slow: the run then goes on and says so as it would without the wake). On a quiet
-//! machine it costs about [`SETTLED`]. It computes nothing the run reads, and the executor
-//! forgets its passes when it judges whether its threads get their cores
-//! ([`Executor::forget_load`]): a late thread in them is the start-up being absorbed, and
-//! `crossbeam-pool` would otherwise run passes alone, the wake's and then the run's.
+//! machine it costs about [`SETTLED`]. It computes nothing the run reads.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
@@ -66,7 +63,6 @@ fn wake_with<E: Executor>(exec: &E, cores: usize, times: Times) -> Result<Woken,
     let mut settling = Settling::new(Instant::now());
     let mut cells = vec![0u8; 4 * cores];
     loop {
-        exec.forget_load();
         let (calls, pass) = (AtomicUsize::new(0), Instant::now());
         exec.for_each_chunk(&mut cells[..], |_, _| {
             calls.fetch_add(1, Ordering::Relaxed);
@@ -78,7 +74,6 @@ fn wake_with<E: Executor>(exec: &E, cores: usize, times: Times) -> Result<Woken,
         let now = Instant::now();
         let fast = on_all_cores(now - pass, calls.into_inner(), cores, times);
         if let Some(woken) = settling.after_pass(pass, now, fast, times) {
-            exec.forget_load();
             return Ok(woken);
         }
     }
@@ -211,11 +206,10 @@ mod tests {
     #[test]
     fn a_wake_on_threads_sharing_one_core_gives_up_and_one_judged_on_one_core_needs_none() {
         /// Claims two threads and runs every call on the caller: cores all taken. Counts its
-        /// passes and the times it was told to forget them.
+        /// passes.
         #[derive(Default)]
         struct Taken {
             passes: std::cell::Cell<usize>,
-            forgets: std::cell::Cell<usize>,
         }
         impl Executor for Taken {
             fn for_each_chunk<O, F>(&self, out: O, kernel: F) -> Result<(), KernelPanic>
@@ -229,14 +223,8 @@ mod tests {
                 }
                 Ok(())
             }
-            fn forget_load(&self) {
-                self.forgets.set(self.forgets.get() + 1);
-            }
             fn threads(&self) -> usize {
                 2
-            }
-            fn passes_alone(&self) -> u64 {
-                0
             }
         }
         let times = Times {
@@ -248,12 +236,10 @@ mod tests {
         let taken = Taken::default();
         let woken = wake_with(&taken, 2, times).unwrap();
         assert!(!woken.settled && woken.elapsed >= 20 * MS, "{woken:?}");
-        // Its passes are forgotten, each before the next and the last at the end.
         assert!(taken.passes.get() > 1);
-        assert_eq!(taken.forgets.get(), taken.passes.get() + 1);
         // Judged as one core (the CPUs it may use), the same executor needs no wake.
         let alone = Taken::default();
         assert!(wake_with(&alone, 1, times).unwrap().settled);
-        assert_eq!((alone.passes.get(), alone.forgets.get()), (0, 0));
+        assert_eq!(alone.passes.get(), 0);
     }
 }

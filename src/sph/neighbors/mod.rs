@@ -236,11 +236,12 @@ impl<N: Neighbors> Searched<N> {
     }
 }
 
-/// Eight lanes of a particle's candidates ([`Neighbors::for_each_eight`]).
+/// Eight lanes of a particle's candidates ([`Neighbors::for_each_eight`]), `r2` on a 64-byte
+/// boundary so that its vector loads and stores never straddle a cache line or a page (see
+/// [`Near8`](crate::simd::Near8)).
 #[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
 pub struct Eight {
-    /// Bit k: lane k holds a hit, a candidate j with `r2 < hsq` (self included).
-    pub within: u8,
     /// Each lane's squared distance, as [`distance_squared`] computes it; `+∞` in a lane that
     /// holds no candidate, so that `r2 < hsq` is the lane's bit.
     pub r2: [f64; 8],
@@ -248,6 +249,8 @@ pub struct Eight {
     pub j: [u32; 8],
     /// Each lane's key (see [`Neighbors::for_each_within`]).
     pub key: [u32; 8],
+    /// Bit k: lane k holds a hit, a candidate j with `r2 < hsq` (self included).
+    pub within: u8,
 }
 
 impl Eight {

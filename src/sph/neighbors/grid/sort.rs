@@ -327,10 +327,6 @@ mod tests {
         fn threads(&self) -> usize {
             2
         }
-
-        fn passes_alone(&self) -> u64 {
-            0
-        }
     }
 
     /// The grid's arrays after a rebuild over `x`, `y` on `exec`.
