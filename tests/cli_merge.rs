@@ -12,9 +12,11 @@ use std::sync::{Mutex, MutexGuard};
 use common::*;
 
 /// 1 group: seq, rayon-chunks at 1..2 cores × chunks 2,4 and std-static at 1..2 cores: 7
-/// cells, 6 of them dealt to shards.
+/// cells, 6 of them dealt to shards; no confirmation (a shard has none, and the unsharded
+/// sweep compared with the merge must have the same plan).
 const PLAN: &str = "--n 60 --steps 3 --trials 2 --warmup 0 --cores 1..2 --chunks 2,4 \
-                    --strategies rayon-chunks,std-static --fake-timings 1,1.1,0.9 --no-plots";
+                    --strategies rayon-chunks,std-static --confirm-rounds 0 \
+                    --fake-timings 1,1.1,0.9 --no-plots";
 
 /// Held by every test for its whole run: the tests of one file run on parallel threads.
 static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());

@@ -158,7 +158,7 @@ fn a_second_sweep_on_a_directory_in_use_is_refused_naming_the_holders_pid() {
         "sweep",
         "--resume",
         dir.to_str().unwrap(),
-        "--stop-after-cells",
+        "--stop-after-runs",
         "0",
     ]);
     let err = text(&o.stderr);
@@ -187,7 +187,7 @@ fn two_sweeps_racing_for_the_same_new_directory_leave_one_winner_and_a_clear_ref
                 && err.lines().count() == 1,
             "{err}"
         );
-        assert_eq!(rows(&dir.join("summary.csv")).len(), 3);
+        assert_eq!(grid_rows(&dir.join("summary.csv")), 3);
     }
 }
 
@@ -211,7 +211,7 @@ fn default_directories_of_sweeps_started_in_the_same_second_do_not_collide() {
         .collect();
     assert_eq!(dirs.len(), 3, "{dirs:?}");
     for d in dirs {
-        assert_eq!(rows(&d.join("summary.csv")).len(), 3, "{d:?}");
+        assert_eq!(grid_rows(&d.join("summary.csv")), 3, "{d:?}");
     }
 }
 
@@ -229,7 +229,7 @@ fn a_closed_standard_output_ends_the_sweep_like_ctrl_c_without_a_panic() {
     // And it resumes to the end.
     let o = run(&["sweep", "--resume", dir.to_str().unwrap(), "--no-plots"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    assert_eq!(rows(&dir.join("summary.csv")).len(), 3);
+    assert_eq!(grid_rows(&dir.join("summary.csv")), 3);
 
     // A full device.
     if Path::new("/dev/full").exists() {
@@ -277,7 +277,7 @@ fn the_plan_of_a_huge_all_pairs_sweep_is_printed_before_any_long_run() {
         all.contains("group: ") && all.contains("N = 300000"),
         "{all}"
     );
-    assert!(all.contains("estimated time: about"), "{all}");
+    assert!(all.contains("estimated time: at most about"), "{all}");
 }
 
 #[test]
@@ -324,16 +324,29 @@ fn resume_rechecks_its_meta_json_and_reruns_corrupt_or_short_cells() {
     );
     let again = rows(&dir.join("trials.csv"));
     assert!(again.iter().all(|r| num(r, "wall_s") > 0.0));
-    assert_eq!(again.len(), 9);
+    assert_eq!(grid_rows(&dir.join("trials.csv")), 9);
 
-    // trials changed from 3 to 5: every cell runs again with 5.
+    // trials changed from 3 to 5: every grid cell runs again with 5, and the confirmation,
+    // which chose its cells from the grid, runs again too.
     std::fs::write(&meta_path, meta.replace("\"trials\": 3", "\"trials\": 5")).unwrap();
     let o = run(&["sweep", "--resume", d, "--no-plots"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    assert!(text(&o.stderr).contains("3 trials, but the sweep asks for 5"));
+    assert!(
+        text(&o.stderr).contains("3 rounds, but the sweep's grid phase has 5"),
+        "{}",
+        text(&o.stderr)
+    );
     let summary = rows(&dir.join("summary.csv"));
-    assert!(summary.iter().all(|r| r["trials"] == "5"), "{summary:?}");
-    assert_eq!(rows(&dir.join("trials.csv")).len(), 15);
+    let grid: Vec<_> = summary.iter().filter(|r| r["phase"] == "grid").collect();
+    assert!(grid.iter().all(|r| r["trials"] == "5"), "{summary:?}");
+    assert_eq!(grid_rows(&dir.join("trials.csv")), 15);
+    let confirm_runs = rows(&dir.join("trials.csv")).len() - 15;
+    assert_eq!(confirm_runs, 9, "3 confirmed cells × 3 rounds, once");
+}
+
+/// The rows of a results CSV in the grid phase.
+fn grid_rows(path: &Path) -> usize {
+    rows(path).iter().filter(|r| r["phase"] == "grid").count()
 }
 
 #[test]

@@ -54,6 +54,14 @@ pub fn assemble(whole: &Plan, parts: &[Part]) -> anyhow::Result<Assembled> {
     for part in &sorted {
         let expected: HashSet<Cell> = whole.shard(part.shard).cells.into_iter().collect();
         for row in &part.rows {
+            if row.phase != crate::results::rows::Phase::Grid {
+                bail!(
+                    "'{}' holds confirmation rows ({}): a shard has none, so it is not a \
+                     shard of this plan as `sweep --shard` writes it",
+                    part.dir,
+                    row.key().label_with_group()
+                );
+            }
             if !expected.contains(&row.key()) {
                 bail!(
                     "'{}' holds {}, which is not a cell of shard {} of this plan",

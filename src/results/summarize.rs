@@ -43,6 +43,30 @@ pub fn speedup(seq: &[TrialRow], trials: &[TrialRow]) -> Option<Ratio> {
     intervals::paired_ratio(&by_round(seq), &by_round(trials))
 }
 
+/// How much slower the first run of a round is than the same cell's other runs: the
+/// geometric mean, over every ok run at position 1, of its time over the geometric mean of
+/// its cell's runs (same phase) at other positions, with its interval. A warm-up that falls
+/// short shows as a ratio above 1 whose interval excludes 1. `None` without such runs.
+pub fn first_run_effect(trials: &[TrialRow]) -> Option<Ratio> {
+    let ok: Vec<&TrialRow> = trials
+        .iter()
+        .filter(|t| t.status == Status::Ok && t.position.is_some())
+        .collect();
+    let ratios: Vec<f64> = ok
+        .iter()
+        .filter(|t| t.position == Some(1))
+        .filter_map(|first| {
+            let others: Vec<f64> = ok
+                .iter()
+                .filter(|t| t.phased_key() == first.phased_key() && t.position != Some(1))
+                .map(|t| t.wall_s.ln())
+                .collect();
+            (!others.is_empty()).then(|| first.wall_s / mean(&others).exp())
+        })
+        .collect();
+    intervals::ratio(&ratios)
+}
+
 /// The summary row of `cell` in `phase` from its trial rows, against the group's `seq` trial
 /// rows of the phase (`None`: no reference, so no speedup); `failure` says why the cell
 /// failed, if it did.
@@ -212,6 +236,35 @@ mod tests {
         assert_eq!(row.foreign_cpu_mean_s, Some(0.03));
         assert_eq!(row.contended, Some(false));
         assert_eq!(row.phase, Phase::Grid);
+    }
+
+    #[test]
+    fn a_first_run_of_each_round_slower_than_the_rest_shows_and_an_even_one_does_not() {
+        // Four cells, five rounds; each round's first run is cell (round mod 4), with a fixed
+        // ±2 % noise.
+        let rounds_of = |slow: f64| -> Vec<TrialRow> {
+            let mut all = Vec::new();
+            for c in 0..4usize {
+                let cell = cell(StrategyName::RayonChunks, 1, Some(c + 1));
+                let mut t = trials(&cell, &[1.0; 5]);
+                for (r, run) in t.iter_mut().enumerate() {
+                    let first = (r + 1) % 4 == c;
+                    run.position = Some(if first { 1 } else { 2 + (c + r) % 3 });
+                    let noise = [1.02, 0.98, 1.0, 1.01, 0.99][r];
+                    run.wall_s = if first { noise * slow } else { 1.0 };
+                }
+                all.extend(t);
+            }
+            all
+        };
+        let slow = first_run_effect(&rounds_of(1.1)).unwrap();
+        assert!(
+            slow.resolved() && (slow.value - 1.1).abs() < 0.03,
+            "{slow:?}"
+        );
+        let even = first_run_effect(&rounds_of(1.0)).unwrap();
+        assert!(!even.resolved(), "{even:?}");
+        assert_eq!(first_run_effect(&[]), None);
     }
 
     #[test]

@@ -261,6 +261,25 @@ pub fn contended_cells(dir: &std::path::Path, rows: &[SummaryRow]) -> Option<Str
     Some(text)
 }
 
+/// The line that says whether the first run of a round was slower than the same cell's other
+/// runs ([`crate::results::summarize::first_run_effect`]).
+pub fn first_run_line(effect: crate::results::intervals::Ratio) -> String {
+    let interval = effect
+        .interval
+        .map_or_else(String::new, |i| format!(" [{:.3}–{:.3}]", i.low, i.high));
+    let verdict = match effect.interval {
+        None => "too few rounds to tell",
+        Some(_) if !effect.resolved() => "no different",
+        Some(_) if effect.value > 1.0 => "SLOWER: the warm-up falls short (try --warmup 3)",
+        Some(_) => "faster",
+    };
+    format!(
+        "First run of each round against the same cell's other runs: {:.3}×{interval} over {} \
+         rounds: {verdict}",
+        effect.value, effect.rounds
+    )
+}
+
 /// The fastest finished cell of each strategy in each group, as a table, groups in plan
 /// order and strategies in registry order. `rows` may hold any number of sessions' rows.
 /// Where a group has confirmation rows, only those compete: they did not choose the cells.

@@ -116,6 +116,8 @@ pub struct Finished {
     rows: Vec<SummaryRow>,
     status: SweepStatus,
     shard: Option<Shard>,
+    /// Whether its runs were ordered in rounds (then the first run of each round is checked).
+    schedule: Schedule,
     _lock: DirLock,
 }
 
@@ -325,6 +327,7 @@ fn conclude(
         rows,
         status,
         shard: opened.meta.params.shard,
+        schedule: opened.meta.params.schedule,
         _lock: opened.lock,
     })
 }
@@ -346,8 +349,21 @@ impl Finished {
     }
 
     /// What it found: the fastest cell of each strategy in each group, after a blank line.
+    /// Under rounds, it ends with the check that a round's first run is not systematically
+    /// slower than the same cell's other runs (a warm-up that falls short).
     pub fn best_text(&self) -> String {
-        format!("\n{}", console::best_cells(&self.plan, &self.rows))
+        let mut text = format!("\n{}", console::best_cells(&self.plan, &self.rows));
+        if self.schedule == Schedule::Rounds {
+            let trials = crate::results::load::read_trials(&self.dir.join(TRIALS_FILE));
+            let effect = trials
+                .ok()
+                .and_then(|(t, _)| crate::results::summarize::first_run_effect(&t));
+            if let Some(line) = effect.map(console::first_run_line) {
+                text.push_str(&line);
+                text.push('\n');
+            }
+        }
+        text
     }
 
     /// Where everything is.
@@ -599,13 +615,29 @@ fn reopen(dir: &Path, session: Session, remeasure: bool) -> anyhow::Result<Opene
                     .map(TrialRow::group),
             )
             .collect();
-        let removed = repaired.without_groups(&contended);
+        let removed = repaired.without_groups(&contended, None);
         resume::write_back(dir, &repaired)?;
         print(&format!(
             "--remeasure-contended: {} with contended cells will be measured again from their \
              first round ({removed} rows removed)",
             plural(contended.len(), "group", "groups")
         ));
+    }
+    // A confirmation chose its cells from its group's grid rows: where the grid runs again,
+    // so does the confirmation.
+    let regrid: HashSet<Group> = plan
+        .cells
+        .iter()
+        .filter(|c| {
+            !repaired
+                .finished
+                .iter()
+                .any(|r| r.key() == **c && r.phase == Phase::Grid)
+        })
+        .map(|c| c.group)
+        .collect();
+    if repaired.without_groups(&regrid, Some(Phase::Confirm)) > 0 {
+        resume::write_back(dir, &repaired)?;
     }
     print(&format!(
         "Resuming '{}': {} and {} kept{}",

@@ -200,14 +200,15 @@ pub fn repair(
 }
 
 impl Repaired {
-    /// The same directory without any row of `groups` (`--remeasure-contended`): those groups
-    /// run again from their first round. Returns the rows removed.
-    pub fn without_groups(&mut self, groups: &HashSet<Group>) -> usize {
+    /// The same directory without the rows of `groups` — of every phase, or of `phase` only:
+    /// those run again from their first round. Returns the rows removed.
+    pub fn without_groups(&mut self, groups: &HashSet<Group>, phase: Option<Phase>) -> usize {
         let before = self.finished.len() + self.finished_trials.len() + self.pending.len();
-        self.finished.retain(|r| !groups.contains(&r.group()));
-        self.finished_trials
-            .retain(|r| !groups.contains(&r.group()));
-        self.pending.retain(|r| !groups.contains(&r.group()));
+        let gone =
+            |group: Group, of: Phase| groups.contains(&group) && phase.is_none_or(|p| p == of);
+        self.finished.retain(|r| !gone(r.group(), r.phase));
+        self.finished_trials.retain(|r| !gone(r.group(), r.phase));
+        self.pending.retain(|r| !gone(r.group(), r.phase));
         let after = self.finished.len() + self.finished_trials.len() + self.pending.len();
         let csv_bytes = |result: csv::Result<Vec<u8>>| result.expect("CSV into memory cannot fail");
         let all_trials: Vec<&TrialRow> = self.finished_trials.iter().chain(&self.pending).collect();
@@ -464,7 +465,8 @@ mod tests {
         let (t, s) = finished_phase();
         let mut r = repair_all(&t, &s);
         let groups: HashSet<Group> = [cell(1).group].into();
-        assert_eq!(r.without_groups(&groups), 8);
+        assert_eq!(r.without_groups(&groups, Some(Phase::Confirm)), 0);
+        assert_eq!(r.without_groups(&groups, None), 8);
         assert!(r.finished.is_empty() && r.finished_trials.is_empty());
         assert_eq!(String::from_utf8(r.trials_csv).unwrap().lines().count(), 1);
     }
