@@ -8,6 +8,9 @@
 # Writes (replacing earlier results of the same names):
 #   results/paper/            the paper's study: seed preset, all-pairs, N = 1000, 1000 steps,
 #                             every strategy, chunks 10..200 in steps of 10
+#   results/paper-again/      the same sweep again, at once: report/reproducibility/ compares
+#                             the two (report --compare: which intervals overlap, which
+#                             rankings flip)
 #   results/grid/             grid search at N = 1000, 10 000, 100 000, 100 steps
 #   results/all-pairs-small/  all-pairs at N = 1000, 3000, 100 steps (chart 6 beside the grid)
 #   results/wcsph/            the validated workload beside the toy at the same size: wcsph
@@ -34,8 +37,10 @@ fi
 cargo build --release
 BIN=target/release/bench-sph
 
-"$BIN" sweep --preset seed --neighbors all-pairs --n 1000 --steps 1000 \
-    --cores "$CORES" --chunks 10..200:10 --out results/paper --force --no-plots
+for out in results/paper results/paper-again; do
+    "$BIN" sweep --preset seed --neighbors all-pairs --n 1000 --steps 1000 \
+        --cores "$CORES" --chunks 10..200:10 --out "$out" --force --no-plots
+done
 "$BIN" sweep --preset seed --neighbors grid --n 1000,10000,100000 --steps 100 \
     --cores "$CORES" --chunks 10,50,200 --out results/grid --force --no-plots
 "$BIN" sweep --preset seed --neighbors all-pairs --n 1000,3000 --steps 100 \
@@ -69,12 +74,16 @@ mkdir -p report/pin
 mkdir -p report/compare
 "$BIN" report results/grid results/grid-50steps --compare --out report/compare --force
 
+# Does the paper study survive a second sweep? The two back-to-back sweeps compared.
+mkdir -p report/reproducibility
+"$BIN" report results/paper results/paper-again --compare --out report/reproducibility --force
+
 # A study measured while other work used the machine is not one to commit.
 # The `contended` column by name: columns are appended over time (reference_shard follows it).
 contended=$(awk -F, 'FNR == 1 {for (i = 1; i <= NF; i++) if ($i == "contended") c = i; next}
     $c == "true" {n++} END {print n + 0}' results/paper/summary.csv results/grid/summary.csv \
     results/all-pairs-small/summary.csv results/wcsph/summary.csv results/grid-50steps/summary.csv \
-    results/pin/summary.csv)
+    results/pin/summary.csv results/paper-again/summary.csv)
 if [ "$contended" -gt 0 ]; then
     echo "warning: $contended contended cells (see report/REPORT.md): rerun on a quiet machine" >&2
     exit 1

@@ -9,6 +9,11 @@
 //! with the group's `seq`. Only those rounds enter the findings and the best-cell tables: they
 //! did not choose the cells they measure.
 //!
+//! A strategy whose best cell at a core count took more than [`OUT_OF_THE_RUNNING`] times the
+//! fastest cell's mean there is not measured again: no timing noise turns a factor of two
+//! around, so the grid's rounds settle that it lost, and its rounds are better spent on the
+//! contenders (it keeps the sweep's cost within a quarter of the cell-by-cell schedule's).
+//!
 //! The choice is a pure function of the grid's summary rows, so a resumed sweep chooses the
 //! same cells. A sharded sweep has no confirmation: a shard holds only part of each strategy's
 //! cells, so its choice would not be the plan's.
@@ -21,6 +26,10 @@ use super::plan::Plan;
 use crate::results::key::Group;
 use crate::results::rows::{Phase, SummaryRow};
 use crate::topology::Pin;
+
+/// How many times the fastest cell's mean at a core count a strategy's best may take and
+/// still be confirmed.
+pub const OUT_OF_THE_RUNNING: f64 = 2.0;
 
 /// How a confirmed cell was chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -59,8 +68,19 @@ pub fn choose(plan: &Plan, group: &Group, rows: &[SummaryRow]) -> Vec<(usize, Ch
         .filter(|r| r.is_reference())
         .filter_map(|r| Some((position(r)?, Choice::Reference)))
         .collect();
-    for ((strategy, _, _), mut cells) in by_line {
+    // The fastest mean at each (cores, pin), over every strategy.
+    let mut fastest: BTreeMap<(usize, Pin), f64> = BTreeMap::new();
+    for (&(_, cores, pin), cells) in &by_line {
+        for &(mean, _) in cells {
+            let f = fastest.entry((cores, pin)).or_insert(mean);
+            *f = f.min(mean);
+        }
+    }
+    for ((strategy, cores, pin), mut cells) in by_line {
         cells.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        if cells[0].0 > OUT_OF_THE_RUNNING * fastest[&(cores, pin)] {
+            continue;
+        }
         chosen.push((cells[0].1, Choice::Best));
         if strategy.info().uses_chunks()
             && let Some(&(_, at)) = cells.get(1)
@@ -119,9 +139,9 @@ mod tests {
         let plan = plan();
         let group = plan.groups[0];
         // Plan positions: seq 0, rayon-iter 1–2, rayon-chunks 3–5 (1 core: 2, 5, 10 chunks)
-        // and 6–8 (2 cores). Means 1 + |position − 4|: at 1 core 5 chunks is fastest and 2 and
-        // 10 chunks tie (the plan's order breaks it); at 2 cores 2 chunks, then 5.
-        let rows = rows(&plan, |i| 1.0 + (i as f64 - 4.0).abs());
+        // and 6–8 (2 cores). Means 1 + |position − 4| / 10: at 1 core 5 chunks is fastest and
+        // 2 and 10 chunks tie (the plan's order breaks it); at 2 cores 2 chunks, then 5.
+        let rows = rows(&plan, |i| 1.0 + (i as f64 - 4.0).abs() / 10.0);
         let chosen = choose(&plan, &group, &rows);
         let named: Vec<(String, Choice)> = chosen
             .iter()
@@ -145,6 +165,21 @@ mod tests {
         assert_eq!(chosen.len(), want.len());
         assert!(chosen.windows(2).all(|w| w[0].0 < w[1].0), "plan order");
         assert_eq!(most_chosen(&plan, &group), want.len());
+    }
+
+    #[test]
+    fn a_strategy_at_more_than_twice_the_fastest_time_of_its_cores_is_not_confirmed() {
+        let plan = plan();
+        let group = plan.groups[0];
+        // rayon-iter (positions 1 and 2) twice as slow as rayon-chunks at 1 core, a hair more
+        // than twice at 2 cores.
+        let rows = rows(&plan, |i| match i {
+            1 => 2.0,
+            2 => 2.0001,
+            _ => 1.0,
+        });
+        let chosen: Vec<usize> = choose(&plan, &group, &rows).iter().map(|c| c.0).collect();
+        assert!(chosen.contains(&1) && !chosen.contains(&2), "{chosen:?}");
     }
 
     #[test]
