@@ -46,30 +46,7 @@ pub struct PinPair {
     pub b: Best,
 }
 
-/// What the paired rounds say about a [`PinPair`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PinOrder {
-    /// Placement `a` is faster.
-    AFaster,
-    /// Placement `b` is faster.
-    BFaster,
-    /// The interval of the time ratio contains 1.
-    Indistinguishable,
-    /// No interval (under 3 paired rounds, or runs that do not pair): no order can be told.
-    NoIntervals,
-}
-
 impl PinPair {
-    /// The order the paired rounds support.
-    pub fn order(&self) -> PinOrder {
-        match findings::order(&self.a, &self.b) {
-            Order::AFaster(_) => PinOrder::AFaster,
-            Order::BFaster(_) => PinOrder::BFaster,
-            Order::Unresolved(_) => PinOrder::Indistinguishable,
-            Order::Unknown(_) => PinOrder::NoIntervals,
-        }
-    }
-
     /// The relative difference of the two means, over the faster one.
     fn difference(&self) -> f64 {
         (self.a.mean_s - self.b.mean_s).abs() / self.a.mean_s.min(self.b.mean_s)
@@ -163,27 +140,29 @@ impl Placements {
     /// cannot tell, and the largest difference with both cells' numbers.
     pub fn sentence(&self) -> String {
         let (a, b) = (pin_name(self.a), pin_name(self.b));
-        let cores_where = |order: PinOrder| -> Vec<usize> {
-            self.at
-                .iter()
-                .filter(|p| p.order() == order)
-                .map(|p| p.a.cores)
-                .collect()
+        // What the paired rounds say of a pair, as the place of its phrase below.
+        let said = |p: &PinPair| match findings::order(&p.a, &p.b) {
+            Order::AFaster(_) => 0,
+            Order::BFaster(_) => 1,
+            Order::Unresolved(_) => 2,
+            Order::Unknown(_) => 3,
         };
         let mut parts = Vec::new();
-        for (order, phrase) in [
-            (PinOrder::AFaster, format!("{a} is faster (paired rounds)")),
-            (PinOrder::BFaster, format!("{b} is faster (paired rounds)")),
-            (
-                PinOrder::Indistinguishable,
-                "they are not distinguishable".to_owned(),
-            ),
-            (
-                PinOrder::NoIntervals,
-                "the paired rounds give no interval, so no order can be told".to_owned(),
-            ),
-        ] {
-            let cores = cores_where(order);
+        for (i, phrase) in [
+            format!("{a} is faster (paired rounds)"),
+            format!("{b} is faster (paired rounds)"),
+            "they are not distinguishable".to_owned(),
+            "the paired rounds give no interval, so no order can be told".to_owned(),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let cores: Vec<usize> = self
+                .at
+                .iter()
+                .filter(|p| said(p) == i)
+                .map(|p| p.a.cores)
+                .collect();
             if !cores.is_empty() {
                 parts.push(format!("{phrase} at {}", cores_list(&cores)));
             }

@@ -15,12 +15,12 @@ use std::fmt::Write as _;
 
 use super::plan::{CompareChart, ComparePlan, Compared, MachineBest, Ranking};
 use super::sides::{Side, SideRule, same_hardware_sets};
-use crate::report::findings::{Entry, and_list};
+use crate::report::findings::{Entry, and_list, describe};
 use crate::report::load::Sweep;
 use crate::report::markdown::{
     BEST_HEAD, BEST_RULE, CONTENDED, OVERSUBSCRIBED, banners, method, test_data_banner,
 };
-use crate::report::numbers::{faster, interval, secs};
+use crate::report::numbers::faster;
 use crate::report::series::{Best, Group};
 use crate::results::key::LabelStyle;
 use crate::results::rows::{Status, SummaryRow};
@@ -251,11 +251,6 @@ fn flags(b: &Best) -> String {
     }
 }
 
-/// A strategy's best cell in words, within its machine: `rayon-iter (1.14 s [1.12–1.16])`.
-fn named(e: &Entry) -> String {
-    format!("{} ({} s{})", e.0, secs(e.1.mean_s), interval(e.1.mean_ci))
-}
-
 /// The ranking column.
 fn ranking(b: &MachineBest) -> String {
     let text = match &b.ranking {
@@ -266,15 +261,15 @@ fn ranking(b: &MachineBest) -> String {
         Ranking::Only => "only one strategy measured".to_owned(),
         Ranking::Unknown { next, why } => format!(
             "**not resolved**: against the next lowest mean, {}, {}",
-            named(next),
+            describe(next),
             why.phrase()
         ),
         Ranking::Resolved { next, by } => format!(
             "resolved: {} by the paired rounds",
-            faster(by, &format!("the next fastest, {}", named(next)))
+            faster(by, &format!("the next fastest, {}", describe(next)))
         ),
         Ranking::NotResolved { overlapping } => {
-            let names: Vec<String> = overlapping.iter().map(named).collect();
+            let names: Vec<String> = overlapping.iter().map(describe).collect();
             format!(
                 "**not resolved**: not distinguishable from {}",
                 and_list(&names)
