@@ -1,15 +1,20 @@
 //! `bench-sph report` driven through the built binary on a committed fixture results
-//! directory (`tests/fixtures/report-results`: a tiny sweep under `--fake-timings`, so every
-//! number is known): every chart is a PNG of the documented size, REPORT.md carries the
-//! fixture's numbers, a chart that does not apply is skipped and said so, trace directories
-//! are embedded, bad input is one `Error: ...` line, and a sweep draws its own report.
-//! No test asserts a duration.
+//! directory (`tests/fixtures/report-results`: a tiny sweep under `--fake-timings` written
+//! before rounds, so every number is known and the report must say how little it shows): every
+//! chart is a PNG of the documented size, REPORT.md carries the fixture's numbers under a
+//! banner and withholds its findings, a chart that does not apply is skipped and said so,
+//! trace directories are embedded, bad input is one `Error: ...` line, and a sweep draws its own
+//! report. Sweeps in rounds, with their confirmation, are made here by the binary under
+//! `--fake-timings`: a finding appears only where the paired interval excludes 1, and which
+//! runs chose and measured the best cells is said. No test asserts a duration.
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
 mod common;
-use common::{assert_holds_all, png_size, run, scratch, sweep_into, text};
+use common::{
+    assert_holds_all, fake_sweep, line_containing, png_size, run, scratch, sweep_into, text,
+};
 
 const WIDTH: u32 = 1000;
 const HEIGHT: u32 = 650;
@@ -105,7 +110,7 @@ fn every_chart_of_the_fixture_is_a_png_of_the_documented_size() {
 }
 
 #[test]
-fn the_report_carries_the_fixture_best_cells_speedups_and_the_paper_beside_them() {
+fn an_older_directory_is_shown_as_measured_under_a_banner_and_its_findings_are_withheld() {
     let out = tempfile::tempdir().unwrap();
     report(&[
         fixture().to_str().unwrap(),
@@ -119,23 +124,107 @@ fn the_report_carries_the_fixture_best_cells_speedups_and_the_paper_beside_them(
         "--fake-timings",
         "## seed preset, all-pairs, N = 60, 3 steps",
         "Reference: `seq` at 1 core, 2.00 ± 0.04 s over 3 trials.",
-        // rayon-chunks, all-pairs N = 60: best cells beside the paper's Table 1 (at most
-        // three significant digits, the paper's numbers too).
-        "| 2 | 2 | 1.09 | 1.84× | 0.919 | 45 | 14.9 | 2.00× |",
-        "| 3 ⚠ oversubscribed | 5 | 1.31 | 1.53× | 0.509 | 90 | 10.4 | 2.87× |",
-        "| 6 | — | — | — | — | 150 | 5.82 | 5.13× |",
+        // rayon-chunks, all-pairs N = 60: best cells (mean, median, fastest) beside the
+        // paper's Table 1 (at most three significant digits, the paper's numbers too).
+        "| 2 | 2 | 1.09 | 1.09 | 1.07 | 1.84× | 0.919 | 45 | 14.9 | 2.00× |",
+        "| 3 ⚠ oversubscribed | 5 | 1.31 | 1.31 | 1.28 | 1.53× | 0.509 | 90 | 10.4 | 2.87× |",
+        "| 6 | — | — | — | — | — | — | 150 | 5.82 | 5.13× |",
         // rayon-iter has no chunks and so no paper columns.
-        "| 2 | — | 1.14 | 1.75× | 0.874 |",
+        "| 2 | — | 1.14 | 1.14 | 1.12 | 1.75× | 0.874 |",
         // The grid groups are not comparable with the paper: plain tables.
-        "| 2 | 2 | 0.544 | 1.84× | 0.919 |",
-        // The fixture predates confidence intervals: no winner is named.
-        "At 2 cores, the lowest mean is rayon-chunks with 2 chunks (1.09 s), but these cells \
-         have no confidence intervals",
-        "e = 0.0886",
+        "| 2 | 2 | 0.544 | 0.544 | 0.533 | 1.84× | 0.919 |",
         "Speedups compare; absolute times do not",
         "None: every cell reproduced its group's `seq` checksum.",
+        // What the tool does not know, said before any number.
+        "> ⚠ **Measured before rounds**",
+        "percentile-bootstrap intervals that under-cover (about 80 % of them hold the true \
+         value at 5 trials, not 95 %",
+        "speedups that divide two means rather than pair the runs of a round",
+        "- Findings withheld: this sweep was measured before rounds",
+        "the same 3 rounds of the grid (no confirmation rounds: the sweep was written before \
+         they existed)",
     ];
     assert_holds_all("REPORT.md", &md, &needles);
+    assert!(
+        md.find("Measured before rounds").unwrap() < md.find("## Machine and build").unwrap(),
+        "{md}"
+    );
+    // Four groups, each with its findings withheld; no winner, no serial fraction.
+    assert_eq!(md.matches("- Findings withheld").count(), 4, "{md}");
+    for absent in [
+        "is fastest",
+        "not distinguishable",
+        "Karp–Flatt serial fraction of",
+    ] {
+        assert!(!md.contains(absent), "{absent}:\n{md}");
+    }
+}
+
+/// Fake times of `fake_sweep`'s plan (seq, rayon-iter at 1 and 2 cores, rayon-chunks with 4
+/// chunks at 1 and 2 cores), round by round: every cell drifts alike from round to round
+/// (×1, ×1.3, ×0.8), rayon-chunks at 2 cores takes `chunks_2`. The run of cell c in round r
+/// gets item 3c + r − 1 (the confirmation's runs the same items again: the list repeats).
+fn drifting(chunks_2: [f64; 3]) -> String {
+    let drift = [1.0, 1.3, 0.8];
+    let mut times: Vec<f64> = Vec::new();
+    for mean in [1.0, 1.02, 0.6, 1.03] {
+        times.extend(drift.iter().map(|d| mean * d));
+    }
+    times.extend(chunks_2);
+    let times: Vec<String> = times.iter().map(|t| format!("{t:.4}")).collect();
+    times.join(",")
+}
+
+/// A fake sweep of `drifting(chunks_2)` with `extra` options, reported; returns REPORT.md.
+fn drifting_report(chunks_2: [f64; 3], extra: &[&str]) -> String {
+    let (_tmp, dir) = scratch("results");
+    let timings = drifting(chunks_2);
+    let mut args = fake_sweep("rayon-chunks,rayon-iter", &timings);
+    args.extend(extra);
+    args.extend(["--no-plots", "--out", dir.to_str().unwrap()]);
+    let o = run(&args);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    report(&[dir.to_str().unwrap()]);
+    std::fs::read_to_string(dir.join("REPORT.md")).unwrap()
+}
+
+#[test]
+fn a_strategy_is_called_fastest_only_where_its_paired_interval_excludes_one() {
+    // rayon-chunks takes 5 % longer than rayon-iter in every round: the drift (±30 %) makes
+    // each cell's own interval far wider than that, but their per-round ratio is steady.
+    let md = drifting_report([0.63, 0.819, 0.504], &[]);
+    assert_holds_all(
+        "REPORT.md",
+        &md,
+        &[
+            "was chosen by the grid's 3 rounds and measured again in 3 rounds of confirmation \
+             with `seq`",
+            "- At 2 cores, **rayon-iter (0.620 s [",
+            "is fastest, 1.67 ± 0.00× over seq: it is 1.05 ± 0.00× faster than the runner-up \
+             rayon-chunks with 4 chunks (0.651 s [",
+            "e = 0.200 [0.200–0.200]",
+            "| 2 | — | 0.620 [",
+        ],
+    );
+    // The same means, but rounds that disagree: no winner.
+    let md = drifting_report([0.66, 0.76, 0.52], &[]);
+    let at_two = line_containing(&md, "- At 2 cores");
+    assert!(
+        at_two.contains("are not distinguishable") && !at_two.contains("fastest"),
+        "{at_two}"
+    );
+}
+
+#[test]
+fn best_cells_without_confirmation_rounds_are_said_to_be_biased_fast() {
+    let md = drifting_report([0.63, 0.819, 0.504], &["--confirm-rounds", "0"]);
+    let note = line_containing(&md, "**Best cells biased fast**");
+    assert!(
+        note.contains("chosen and measured by the same 3 rounds of the grid")
+            && note.contains("the sweep ran with `--confirm-rounds 0`"),
+        "{note}"
+    );
+    assert!(!md.contains("rounds of confirmation"), "{md}");
 }
 
 #[test]
@@ -238,6 +327,18 @@ fn a_sweep_without_no_plots_writes_its_charts_and_report() {
     assert!(text(&o.stdout).contains("REPORT.md"), "{}", text(&o.stdout));
     let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
     assert!(md.contains("**rayon-chunks**"), "{md}");
+    // Two rounds give no interval, so no finding, and the report says so.
+    assert!(
+        md.contains(
+            "- No finding: these cells ran 2 rounds, and an interval, so a finding, \
+                     needs 3 or more"
+        ),
+        "{md}"
+    );
+    assert!(
+        !md.contains("is fastest") && !md.contains("not distinguishable"),
+        "{md}"
+    );
     for name in [
         "seed-all-pairs-n60-s3-1-runtime-vs-chunks-rayon-chunks.png",
         "seed-all-pairs-n60-s3-4-speedup.png",
@@ -284,11 +385,11 @@ fn a_toy_and_a_wcsph_sweep_get_a_ranking_comparison_and_one_preset_alone_does_no
         &[
             "## Toy vs real workload: does the ranking hold?",
             "### wcsph preset, grid, N = 128, 3 steps against seed preset, grid, N = 200, 3 steps",
-            "| rayon-chunks | 1 · 2.00×",
+            "| rayon-chunks | 1 · 2.00 ± 0.00×",
             "At 2 cores, the winner changes: **rayon-chunks** is fastest on the toy workload \
              and **std-static** on wcsph",
-            "Moved up on wcsph, with the 95 % intervals apart on both workloads: std-static \
-             (past rayon-chunks); moved down: rayon-chunks.",
+            "Moved up on wcsph, both orders resolved by their paired rounds: std-static (past \
+             rayon-chunks); moved down: rayon-chunks.",
             "## wcsph preset, grid, N = 128, 3 steps",
         ],
     );

@@ -3,8 +3,10 @@
 //! compared side by side and never pooled, the same cell on two machines is no repeat,
 //! `--compare` sets directories of one machine apart and says so, directories of one machine
 //! without it are one pooled study as before, steps that differ are said, and the comparison's
-//! charts and a normal report's replace each other in one directory. A machine is made
-//! "another" by editing `cpu_model` in a copy's `meta.json`. No test asserts a duration.
+//! charts and a normal report's replace each other in one directory; two sweeps of one
+//! machine set apart by `--compare` get a reproducibility section that lists every ranking
+//! the second reversed. A machine is made "another" by editing `cpu_model` in a copy's
+//! `meta.json`. No test asserts a duration.
 
 use std::path::{Path, PathBuf};
 
@@ -130,13 +132,13 @@ fn two_machines_are_compared_side_by_side_and_their_shared_cells_are_not_refused
     let row_a = line_containing(&md, "| A | 3 |");
     assert!(
         row_a.starts_with("| A | 3 | rayon-chunks | 2 | 4 | 0.500 [")
-            && row_a.contains("resolved: its 95 % CI is apart from the next fastest, rayon-iter"),
+            && row_a.contains("resolved: 1.40 ± 0.02× faster than the next fastest, rayon-iter"),
         "{row_a}"
     );
     let row_b = line_containing(&md, "| B | 3 |");
     assert!(
         row_b.starts_with("| B | 3 | rayon-iter | 2 | — | 0.500 [")
-            && row_b.contains("apart from the next fastest, rayon-chunks"),
+            && row_b.contains("faster than the next fastest, rayon-chunks"),
         "{row_b}"
     );
     // Not pooled: no study section of a single machine, no chart of a normal report.
@@ -188,6 +190,23 @@ fn compare_on_one_machine_sets_each_directory_apart_and_says_loudly_it_is_one_ma
         ],
     );
     assert_eq!(pngs(&out).len(), 2, "{:?}", pngs(&out));
+    // The second sweep reversed the first's ranking at 2 cores: listed, with each side's
+    // paired ratio. At 1 core the two strategies' times are equal on both sides: not
+    // resolved on either, so not a ranking.
+    let section = md.find("## Reproducibility: B against A").unwrap();
+    assert!(section < md.find("## Comparing machines").unwrap());
+    assert_holds_all(
+        "REPORT.md",
+        &md,
+        &[
+            "A and B ran on the same machine, so B is a second measurement of what A measured. \
+             Of the 10 cells both measured (matched by cell and phase), the 95 % speedup \
+             intervals overlap in 6 of 10 (60.0 %)",
+            "resolved on either side: 1; reversed on the other: 1; resolved on one side only: 0.",
+            "| seed preset, all-pairs, N = 60, 3 steps | 2 | rayon-iter | 1.40 ± 0.02× slower \
+             than rayon-chunks | 1.40 ± 0.02× faster than rayon-chunks | **reversed** |",
+        ],
+    );
     let o = run(&["report", a.to_str().unwrap(), "--compare"]);
     assert!(!o.status.success());
     assert!(
@@ -284,8 +303,9 @@ fn a_partial_side_keeps_its_banner_and_a_group_of_one_side_is_listed_as_not_comp
     let tmp = tempfile::tempdir().unwrap();
     let (a, b) = (tmp.path().join("a"), tmp.path().join("b"));
     sweep(&a, CHUNKS_WIN, &[("--n", "60,120")]);
-    let mut args = fake_sweep("rayon-chunks,rayon-iter", ITER_WINS);
-    args.extend(["--no-plots", "--stop-after-cells", "3"]);
+    // B measures rayon-iter only, and stops after its grid's 9 runs: no confirmation.
+    let mut args = fake_sweep("rayon-iter", ITER_WINS);
+    args.extend(["--no-plots", "--stop-after-runs", "9"]);
     args.extend(["--out", b.to_str().unwrap()]);
     assert!(!run(&args).status.success(), "the sweep stops early");
     move_to_machine(&b, "Test CPU B");

@@ -114,20 +114,20 @@ fn a_sweep_over_placements_gets_a_line_a_table_row_and_a_comparison_per_placemen
         &md,
         &[
             "![Chart 1: rayon-chunks (spread)]",
-            "| cores | pin | best chunks | mean time (s) [95 % CI] | speedup [95 % CI] | \
-             efficiency |",
-            "| 2 | none | 4 | 2.50 [2.40–2.60] |",
-            "| 2 | spread | 4 | 2.00 [1.90–2.10] | 2.00× [1.90–2.11] | 1.00 |",
-            // The fastest cell at 2 cores is named with its placement.
-            "At 2 cores, **rayon-chunks (spread) with 4 chunks (2.00 s [1.90–2.10])** is \
-             fastest",
+            "| cores | pin | best chunks | mean time (s) [95 % CI] | median (s) | min (s) | \
+             speedup (± 95 % CI) | efficiency |",
+            "| 2 | none | 4 | 2.50 [2.26–2.76] | 2.50 | 2.40 |",
+            "| 2 | spread | 4 | 2.00 [1.76–2.26] | 2.00 | 1.90 | 2.00 ± 0.26× | 1.00 |",
+            // The fastest cell at 2 cores is named with its placement; its lead is paired.
+            "At 2 cores, **rayon-chunks (spread) with 4 chunks (2.00 s [1.76–2.26])** is \
+             fastest, 2.00 ± 0.26× over seq: it is 1.25 ± 0.03× faster than the runner-up \
+             rayon-chunks with 4 chunks",
             "rayon-chunks, `spread` against unpinned (at each core count, the chunks value \
-             fastest under either): `spread` is faster (95 % intervals of the mean apart) at 2 \
-             cores; they are indistinguishable within the trial spread at 1 core; the largest \
-             difference is at 2 cores with 4 chunks: `spread` 2.00× [1.90–2.11] against \
-             unpinned 1.60× [1.54–1.67] over seq.",
-            "std-static, `spread` against unpinned: they are indistinguishable within the \
-             trial spread at 1 and 2 cores, where their means are equal.",
+             fastest under either): `spread` is faster (paired rounds) at 2 cores; they are \
+             not distinguishable at 1 core; the largest difference is at 2 cores with 4 \
+             chunks: `spread` 2.00 ± 0.26× against unpinned 1.60 ± 0.17× over seq.",
+            "std-static, `spread` against unpinned: they are not distinguishable at 1 and 2 \
+             cores, where their means are equal.",
         ],
     );
     // Two physical cores of one thread: nothing is on SMT siblings.
@@ -167,11 +167,11 @@ fn core_counts_on_smt_siblings_are_shaded_and_get_the_efficiency_per_physical_co
             "4 cells ran more threads than the machine's physical cores",
             "At 2 cores the threads outnumber the machine's 1 physical core",
             "S / min(p, 1)",
-            "| cores | pin | best chunks | mean time (s) [95 % CI] | speedup [95 % CI] | \
-             efficiency | efficiency per physical core |",
+            "| cores | pin | best chunks | mean time (s) [95 % CI] | median (s) | min (s) | \
+             speedup (± 95 % CI) | efficiency | efficiency per physical core |",
             // Speedup 2 on 2 threads of 1 physical core: 1 per thread, 2 per core.
-            "| 2 | spread | 4 | 2.00 [1.90–2.10] | 2.00× [1.90–2.11] | 1.00 | 2.00 |",
-            "| 1 | none | 4 | 4.00 [4.00–4.00] | 1.00× [1.00–1.00] | 1.00 | 1.00 |",
+            "| 2 | spread | 4 | 2.00 [1.76–2.26] | 2.00 | 1.90 | 2.00 ± 0.26× | 1.00 | 2.00 |",
+            "| 1 | none | 4 | 4.00 [4.00–4.00] | 4.00 | 4.00 | 1.00 ± 0.00× | 1.00 | 1.00 |",
         ],
     );
     for n in [4, 5] {

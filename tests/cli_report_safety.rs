@@ -8,15 +8,23 @@ use std::process::Output;
 mod common;
 use common::{assert_file_holds, fake_sweep, line_containing, run, scratch, sweep_into, text};
 
-/// A small finished sweep under fake times: seq, rayon-chunks and rayon-iter at 1 and 2 cores.
-fn sweep(dir: &Path, extra: &[&str]) -> Output {
+/// A small finished sweep under fake times: seq, rayon-chunks and rayon-iter at 1 and 2 cores,
+/// N = `n` (a list).
+fn sweep_of(n: &str, dir: &Path, extra: &[&str]) -> Output {
     let mut args = fake_sweep(
         "seq,rayon-chunks,rayon-iter",
         "1.0,1.1,0.9,0.5,0.55,0.6,0.7,0.8,0.75",
     );
+    let at = args.iter().position(|a| *a == "--n").unwrap();
+    args[at + 1] = n;
     args.extend(["--no-plots", "--out", dir.to_str().unwrap()]);
     args.extend(extra);
     run(&args)
+}
+
+/// [`sweep_of`] N = 60.
+fn sweep(dir: &Path, extra: &[&str]) -> Output {
+    sweep_of("60", dir, extra)
 }
 
 /// Runs `report` on `dirs` into `out`, then `extra`.
@@ -183,17 +191,18 @@ fn charts_of_an_earlier_report_that_are_not_drawn_again_are_removed() {
 }
 
 #[test]
-fn a_partial_study_says_so_at_the_top_naming_the_strategies_never_measured() {
+fn a_partial_study_says_so_at_the_top() {
     let (_tmp, dir) = scratch("r");
-    let o = sweep(&dir, &["--stop-after-cells", "3"]);
+    // Two groups; stopped after the first one's 15 grid and 15 confirmation runs.
+    let o = sweep_of("60,120", &dir, &["--stop-after-runs", "30"]);
     assert!(!o.status.success());
     let o = run(&["report", dir.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let md = std::fs::read_to_string(dir.join("REPORT.md")).unwrap();
     let banner = line_containing(&md, "Partial study");
     assert!(
-        banner.contains("3 of 5 planned cells measured")
-            && banner.contains("never measured: rayon-chunks"),
+        banner.contains("is interrupted — 5 of 10 planned cells measured")
+            && banner.contains("--resume"),
         "{banner}"
     );
     let first_section = md.find("## ").unwrap();

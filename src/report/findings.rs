@@ -1,55 +1,56 @@
 //! The findings of a group: sentences that never claim more than the data shows.
 //!
-//! - A strategy is called **fastest** at a core count only when its 95 % interval of the mean
-//!   does not overlap any other strategy's; otherwise the strategies whose intervals overlap
-//!   the fastest mean's are named as **indistinguishable within the trial spread**.
-//! - Contended cells (other work used the machine, or passes ran alone) enter no finding; the
-//!   sentence says how
+//! - Every comparison of two cells pairs their runs by round ([`order`]): the geometric mean
+//!   of the per-round ratios of their times, with its 95 % Student-t interval. One cell is
+//!   called faster only where that interval excludes 1; otherwise the two are **not
+//!   distinguishable**. Two separate intervals are never compared.
+//! - The cells compared are each strategy's best ones ([`GroupView::best_per_cores`]): from the
+//!   confirmation rounds where the group has them, so the runs that chose a cell do not also
+//!   measure it.
+//! - Under [`MIN_ROUNDS`] rounds there is no interval and so no finding; a sweep whose rounds
+//!   do not pair (written before rounds, or `--schedule cells`) gets none either ([`Withheld`]).
+//! - Contended cells (other work used the machine) enter no finding; the sentence says how
 //!   many were left out.
-//! - A speedup above 1 at one core is labelled noise in the reference, never a win.
-//! - The Karp–Flatt serial fraction is given only where the speedup is above 1 on at least 2
-//!   cores, as a measurement at that core count, never extrapolated.
+//! - At one core every strategy does `seq`'s work: a paired speedup whose interval excludes 1
+//!   there is the strategy's own cost or gain on one thread, and is stated as such.
+//! - The Karp–Flatt serial fraction is given only with its interval, and only where that
+//!   interval lies above 0 ([`Best::serial_fraction`]), as a measurement at that core count,
+//!   never extrapolated.
 //! - Each strategy at each placement (`sweep --pin`) is a series of its own
-//!   ([`series::SeriesKey`]), named `rayon-chunks (spread)` where pinned. Two placements of a
-//!   strategy are compared cell against cell, at the same cores and chunks ([`super::placements`]):
-//!   one is called faster at a core count only where their 95 % intervals of the mean are
-//!   apart, and each strategy gets one sentence per pair of placements, not one per cell.
-//!
-//! - Across workloads ([`super::rank_shift`]: the toy Müller model against wcsph at one core count),
-//!   a winner is named only when its interval overlaps no other's on both; a strategy has
-//!   moved up or down only when it passed another whose intervals are apart on both
-//!   workloads; any other change of place is said to be not resolved.
+//!   ([`series::SeriesKey`]); two placements are compared cell against cell
+//!   ([`super::placements`]).
+//! - Across workloads ([`super::rank_shift`]): a winner is named only where it is resolved on
+//!   both; a strategy has moved only where both orders are resolved.
 //!
 //! [`findings`] decides what the data supports, as [`Finding`] values; [`Finding::sentence`]
 //! words each one.
 
-use super::numbers::{interval, percent, secs, times};
+use super::numbers::{faster, interval, plus_minus, secs, sig};
 use super::paper;
-use super::placements::{Placements, pin_name};
+use super::placements::Placements;
 use super::rank_shift::RankShift;
-use super::series::{self, Best, Group, SeriesKey};
-use crate::results::rows::SummaryRow;
+use super::series::{self, Best, SeriesKey};
+use super::view::{Design, GroupView};
+use crate::results::intervals::{MIN_ROUNDS, Ratio};
 use crate::results::stats::Interval;
-use crate::topology::Pin;
 use sph_strategies::StrategyName;
 
 /// What the data of a group supports, decided before it is worded.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Finding {
+    /// No finding is drawn from the group, and why.
+    Withheld(Withheld),
     /// The group's `seq` reference was contended: no speedup-based finding follows.
     ContendedReference,
     /// Who is fastest at one core count, if anyone can be said to be.
     AtCores(AtCores),
-    /// A speedup above 1 at one core: the reference's noise, not a win.
-    OneCoreNoise {
-        /// The strategy.
-        strategy: StrategyName,
-        /// Per placement with such a speedup (in the order of [`series::pins`]): the
-        /// placement, its speedup at 1 core and the speedup's 95 % interval.
-        speedups: Vec<(Pin, f64, Option<Interval>)>,
-    },
+    /// Each strategy's best cell at one core against `seq` of the same rounds.
+    OneCore(Vec<Best>),
     /// Two placements of a strategy, compared where both were measured.
     Placements(Placements),
+    /// The grid's best chunks against its runner-up, both measured again in the
+    /// confirmation rounds, per core count.
+    BestChunks(Vec<(Best, Best)>),
     /// Where more chunks stop paying for a chunked strategy.
     ChunkingStops {
         /// The strategy, at one placement.
@@ -57,20 +58,30 @@ pub enum Finding {
         /// (chunks from which more stop paying, at this many cores), by cores.
         from: Vec<(usize, usize)>,
     },
-    /// The Karp–Flatt serial fraction of the fastest trusted cell at the most cores.
+    /// The Karp–Flatt serial fraction of the fastest trusted cell at the most cores, with its
+    /// interval.
     SerialFraction {
-        /// The strategy.
-        strategy: StrategyName,
-        /// Its cell.
+        /// The cell.
         best: Best,
         /// The serial fraction e.
         e: f64,
+        /// Its 95 % interval.
+        ci: Interval,
     },
     /// The paper's published speedups beside the best here, per comparable core count.
     AgainstPaper(Vec<PaperPoint>),
     /// How the strategy ranking changes from the toy workload to wcsph at one core count
     /// (boxed: it is the largest finding by far).
     RankShift(Box<RankShift>),
+}
+
+/// Why a group gets no finding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Withheld {
+    /// Its sweep's rounds do not pair.
+    Design(Design),
+    /// Its cells ran this many rounds, fewer than [`MIN_ROUNDS`].
+    Rounds(usize),
 }
 
 /// The verdict at one core count, with what its sentence needs.
@@ -91,119 +102,178 @@ pub struct AtCores {
 /// One core count of [`Finding::AgainstPaper`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct PaperPoint {
-    /// Worker threads.
-    pub cores: usize,
-    /// The best cell here was oversubscribed.
-    pub oversubscribed: bool,
-    /// The best speedup here.
-    pub speedup: f64,
-    /// Its strategy.
-    pub strategy: StrategyName,
+    /// The best cell here (the highest speedup).
+    pub best: Best,
     /// The paper's speedup at these cores.
     pub paper: f64,
-    /// Where its threads ran.
-    pub pin: Pin,
 }
 
-/// The findings for group `g` of `rows`.
-pub fn findings(rows: &[SummaryRow], g: &Group) -> Vec<Finding> {
-    let strategies: Vec<StrategyName> = series::strategies(rows, g)
-        .into_iter()
-        .filter(|&s| s != StrategyName::Seq)
-        .collect();
-    let bests: Vec<(StrategyName, Vec<Best>)> = series::series(rows, g)
-        .into_iter()
-        .map(|key| (key.strategy, series::best_per_cores(rows, g, key)))
-        .collect();
+/// A strategy's best cell at one core count (boxed: verdicts hold several).
+pub type Entry = (StrategyName, Box<Best>);
+
+/// Why two cells cannot be ordered.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Unknown {
+    /// They share this many rounds, fewer than [`MIN_ROUNDS`]: no interval.
+    Rounds(usize),
+    /// Their runs do not pair (other rounds: another shard or phase, or a sweep whose rounds
+    /// do not pair).
+    Unpaired,
+}
+
+/// What the paired rounds say about one cell `a` against another `b`. The ratio is `b`'s
+/// time over `a`'s, paired by round: how many times faster `a` is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Order {
+    /// `a` is faster: the interval lies above 1.
+    AFaster(Ratio),
+    /// `b` is faster: the interval lies below 1.
+    BFaster(Ratio),
+    /// The interval contains 1: not distinguishable.
+    Unresolved(Ratio),
+    /// No interval.
+    Unknown(Unknown),
+}
+
+/// `a` against `b`, by their runs paired by round (see [`Order`]).
+pub fn order(a: &Best, b: &Best) -> Order {
+    let Some(r) = b.runs.ratio(&a.runs) else {
+        return Order::Unknown(Unknown::Unpaired);
+    };
+    match r.interval {
+        None => Order::Unknown(Unknown::Rounds(r.rounds)),
+        Some(_) if !r.resolved() => Order::Unresolved(r),
+        Some(_) if r.value > 1.0 => Order::AFaster(r),
+        Some(_) => Order::BFaster(r),
+    }
+}
+
+impl Order {
+    /// Whether the order is resolved (either way).
+    pub fn resolved(&self) -> bool {
+        matches!(self, Order::AFaster(_) | Order::BFaster(_))
+    }
+}
+
+/// The paired speedup of `b` over `seq` as a ratio.
+pub fn speedup(b: &Best) -> Option<Ratio> {
+    Some(Ratio {
+        value: b.speedup?,
+        interval: b.speedup_ci,
+        rounds: b.runs.rounds.len(),
+    })
+}
+
+/// The findings for the group of `view`.
+pub fn findings(view: &GroupView) -> Vec<Finding> {
+    if !view.design.pairs() {
+        return vec![Finding::Withheld(Withheld::Design(view.design))];
+    }
+    let usable = view.findings_rows().iter().filter(|r| r.is_usable());
+    match usable.map(|r| r.trials).max() {
+        None => return Vec::new(),
+        Some(k) if k < MIN_ROUNDS => return vec![Finding::Withheld(Withheld::Rounds(k))],
+        Some(_) => {}
+    }
+    let bests = view.series_bests();
     // A contended reference makes every speedup doubtful: none enters a finding then.
-    let seq_trusted = !rows
-        .iter()
-        .any(|r| r.group() == *g && r.is_reference() && r.contended == Some(true));
+    let seq_trusted = view.reference().is_none_or(|r| r.contended != Some(true));
     let mut out = Vec::new();
     if !seq_trusted {
         out.push(Finding::ContendedReference);
     }
-    for c in series::cores(rows, g) {
+    for c in series::cores(&view.rows, &view.group) {
         let at: Vec<Entry> = bests
             .iter()
-            .filter_map(|(s, b)| Some((*s, b.iter().find(|b| b.cores == c)?.clone())))
+            .filter_map(|(k, b)| {
+                let b = b.iter().find(|b| b.cores == c)?;
+                Some((k.strategy, Box::new(b.clone())))
+            })
             .collect();
         out.extend(at_cores(c, &at, seq_trusted).map(Finding::AtCores));
-        if c == 1 && seq_trusted {
-            out.extend(one_core_noise(&at));
+        let one: Vec<Best> = at.into_iter().map(|(_, b)| *b).filter(calm).collect();
+        if c == 1 && seq_trusted && one.iter().any(|b| b.speedup_ci.is_some()) {
+            out.push(Finding::OneCore(one));
         }
     }
-    out.extend(
-        super::placements::compare(rows, g, &strategies, seq_trusted).map(Finding::Placements),
-    );
-    out.extend(chunking(rows, g, &strategies));
+    let strategies: Vec<StrategyName> = series::strategies(&view.rows, &view.group)
+        .into_iter()
+        .filter(|&s| s != StrategyName::Seq)
+        .collect();
+    out.extend(super::placements::compare(view, &strategies, seq_trusted).map(Finding::Placements));
+    out.extend(best_chunks(view, &bests));
+    out.extend(chunking(view, &bests));
     if seq_trusted {
         out.extend(karp_flatt(&bests));
-        out.extend(against_paper(rows, g, &bests));
+        out.extend(against_paper(view, &bests));
     }
     out
 }
 
-/// A strategy's best cell at one core count.
-pub type Entry = (StrategyName, Best);
+/// Whether a cell was measured without contention.
+fn calm(b: &Best) -> bool {
+    !b.contended
+}
 
 /// What can be said about the fastest strategy at one core count, from the cells measured
-/// without contention (fastest first).
+/// without contention (lowest mean first).
 #[derive(Debug, Clone, PartialEq)]
 pub enum Verdict {
     /// Only one cell.
     Only(Entry),
-    /// Several, but some without confidence intervals: the lowest mean only.
-    NoIntervals(Entry),
-    /// The fastest cell's interval overlaps no other's.
+    /// Some cell cannot be ordered against the lowest mean: that one, and why.
+    Unknown(Entry, Unknown),
+    /// The lowest mean is faster than every other cell, each by its paired rounds.
     Fastest {
         /// The fastest.
         winner: Entry,
-        /// The second fastest.
+        /// The second lowest mean.
         runner_up: Entry,
+        /// How many times faster the winner is than the runner-up.
+        by: Ratio,
     },
-    /// The fastest cell's interval overlaps these (the fastest first).
+    /// These cells are not distinguishable from the lowest mean (it first).
     Tied {
-        /// The cells whose intervals overlap the fastest one's, and it.
+        /// The lowest mean and the cells not distinguishable from it.
         tied: Vec<Entry>,
-        /// How many are slower beyond the overlap.
+        /// How many are slower by their paired rounds.
         slower: usize,
     },
 }
 
-/// The verdict on `trusted` (sorted fastest first); `None` when it is empty.
+/// The verdict on `trusted` (lowest mean first); `None` when it is empty.
 pub fn verdict(trusted: &[Entry]) -> Option<Verdict> {
     let first = trusted.first()?.clone();
-    if trusted.len() == 1 {
+    let Some(runner_up) = trusted.get(1).cloned() else {
         return Some(Verdict::Only(first));
-    }
-    if trusted.iter().any(|(_, b)| b.mean_ci.is_none()) {
-        return Some(Verdict::NoIntervals(first));
-    }
+    };
     let mut tied = vec![first.clone()];
-    tied.extend(
-        trusted[1..]
-            .iter()
-            .filter(|(_, b)| match (first.1.mean_ci, b.mean_ci) {
-                (Some(a), Some(o)) => a.overlaps(&o),
-                _ => true,
-            })
-            .cloned(),
-    );
-    Some(if tied.len() == 1 {
-        Verdict::Fastest {
-            winner: first,
-            runner_up: trusted[1].clone(),
+    let mut by = None;
+    for other in &trusted[1..] {
+        match order(&first.1, &other.1) {
+            Order::Unknown(why) => return Some(Verdict::Unknown(first, why)),
+            Order::AFaster(r) => {
+                by.get_or_insert(r);
+            }
+            Order::BFaster(_) | Order::Unresolved(_) => tied.push(other.clone()),
         }
-    } else {
-        let slower = trusted.len() - tied.len();
-        Verdict::Tied { tied, slower }
+    }
+    Some(match by {
+        Some(by) if tied.len() == 1 => Verdict::Fastest {
+            winner: first,
+            runner_up,
+            by,
+        },
+        _ => Verdict::Tied {
+            slower: trusted.len() - tied.len(),
+            tied,
+        },
     })
 }
 
-/// The cells of `at` measured without contention, fastest first (the first of equal means).
+/// The cells of `at` measured without contention, lowest mean first (the first of equals).
 pub(super) fn trusted(at: &[Entry]) -> Vec<Entry> {
-    let mut trusted: Vec<Entry> = at.iter().filter(|(_, b)| !b.contended).cloned().collect();
+    let mut trusted: Vec<Entry> = at.iter().filter(|(_, b)| calm(b)).cloned().collect();
     trusted.sort_by(|a, b| a.1.mean_s.total_cmp(&b.1.mean_s));
     trusted
 }
@@ -215,115 +285,88 @@ fn at_cores(cores: usize, at: &[Entry], seq_trusted: bool) -> Option<AtCores> {
         cores,
         oversubscribed: at.iter().any(|(_, b)| b.oversubscribed),
         contended: at.len() - trusted.len(),
-        // At one core a speedup is the reference's noise (said separately), not a result.
+        // At one core the speedups have a finding of their own.
         show_speedup: cores > 1 && seq_trusted,
         verdict: verdict(&trusted)?,
     })
 }
 
-/// Whether two cells' 95 % intervals are apart (both known and not overlapping).
-pub(super) fn apart(a: &Best, b: &Best) -> bool {
-    match (a.mean_ci, b.mean_ci) {
-        (Some(x), Some(y)) => !x.overlaps(&y),
-        _ => false,
-    }
-}
-
-/// A speedup above 1 at one core is the reference's noise: one finding per strategy, over
-/// its placements (`at` holds a strategy's series in the order of [`series::series`]).
-fn one_core_noise(at: &[Entry]) -> Vec<Finding> {
-    let mut out: Vec<Finding> = Vec::new();
-    for (s, b) in at.iter().filter(|(_, b)| !b.contended) {
-        let Some(speedup) = b.speedup.filter(|&sp| sp > 1.0) else {
-            continue;
-        };
-        let one = (b.pin, speedup, b.speedup_ci);
-        match out.last_mut() {
-            Some(Finding::OneCoreNoise { strategy, speedups }) if strategy == s => {
-                speedups.push(one);
-            }
-            _ => out.push(Finding::OneCoreNoise {
-                strategy: *s,
-                speedups: vec![one],
-            }),
-        }
-    }
-    out
-}
-
-/// Where more chunks stop paying, per chunked strategy at each of its placements.
-fn chunking(rows: &[SummaryRow], g: &Group, strategies: &[StrategyName]) -> Vec<Finding> {
-    let mut out = Vec::new();
-    for &s in strategies
+/// Per chunked series whose best cells were confirmed: each best cell against the grid's
+/// runner-up at its core count, both measured without contention.
+fn best_chunks(view: &GroupView, bests: &[(SeriesKey, Vec<Best>)]) -> Vec<Finding> {
+    bests
         .iter()
-        .filter(|&&s| series::is_chunked(rows, g, s))
-    {
-        for key in series::pins(rows, g, s)
-            .into_iter()
-            .map(|p| SeriesKey::new(s, p))
-        {
-            let from: Vec<(usize, usize)> = series::chunk_table(rows, g, key)
+        .map(|(_, best)| {
+            best.iter()
+                .filter(|b| calm(b))
+                .filter_map(|b| Some((b.clone(), view.runner_up(b).filter(calm)?)))
+                .collect::<Vec<_>>()
+        })
+        .filter(|pairs| !pairs.is_empty())
+        .map(Finding::BestChunks)
+        .collect()
+}
+
+/// Where more chunks stop paying, per chunked series.
+fn chunking(view: &GroupView, bests: &[(SeriesKey, Vec<Best>)]) -> Vec<Finding> {
+    bests
+        .iter()
+        .filter(|(k, _)| series::is_chunked(&view.rows, &view.group, k.strategy))
+        .filter_map(|&(key, _)| {
+            let from: Vec<(usize, usize)> = series::chunk_table(view, key)
                 .iter()
                 .filter(|(_, v)| v.len() > 1)
                 .filter_map(|(c, v)| Some((series::chunking_stops_paying(v)?, *c)))
                 .collect();
-            if !from.is_empty() {
-                out.push(Finding::ChunkingStops { series: key, from });
-            }
-        }
-    }
-    out
+            (!from.is_empty()).then_some(Finding::ChunkingStops { series: key, from })
+        })
+        .collect()
 }
 
 /// The serial fraction of the fastest trusted cell at the most cores not oversubscribed,
-/// where it means something.
-fn karp_flatt(bests: &[(StrategyName, Vec<Best>)]) -> Option<Finding> {
-    let (s, b) = bests
+/// among those whose serial fraction has an interval above 0.
+fn karp_flatt(bests: &[(SeriesKey, Vec<Best>)]) -> Option<Finding> {
+    let (best, (e, ci)) = bests
         .iter()
-        .flat_map(|(s, b)| b.iter().map(move |b| (*s, b)))
-        .filter(|(_, b)| b.cores > 1 && !b.oversubscribed && !b.contended)
-        .filter(|(_, b)| b.speedup.is_some_and(|sp| sp > 1.0))
+        .flat_map(|(_, b)| b)
+        .filter(|b| !b.oversubscribed && calm(b))
+        .filter_map(|b| Some((b, b.serial_fraction()?)))
         .max_by(|a, b| {
-            a.1.cores
-                .cmp(&b.1.cores)
-                .then(b.1.mean_s.total_cmp(&a.1.mean_s))
+            a.0.cores
+                .cmp(&b.0.cores)
+                .then(b.0.mean_s.total_cmp(&a.0.mean_s))
         })?;
     Some(Finding::SerialFraction {
-        strategy: s,
-        e: b.serial_fraction()?,
-        best: b.clone(),
+        best: best.clone(),
+        e,
+        ci,
     })
 }
 
 /// The paper's published speedups beside ours, where comparable.
-fn against_paper(
-    rows: &[SummaryRow],
-    g: &Group,
-    bests: &[(StrategyName, Vec<Best>)],
-) -> Option<Finding> {
-    if !paper::comparable(g) {
+fn against_paper(view: &GroupView, bests: &[(SeriesKey, Vec<Best>)]) -> Option<Finding> {
+    if !paper::comparable(&view.group) {
         return None;
     }
-    let mut points = Vec::new();
-    for c in series::cores(rows, g) {
-        let Some(p) = paper::at(c) else { continue };
-        let best = bests
-            .iter()
-            .filter_map(|(s, b)| Some((*s, b.iter().find(|b| b.cores == c)?)))
-            .filter(|(_, b)| !b.contended)
-            .filter_map(|(s, b)| Some((s, b.speedup?, b.oversubscribed, b.pin)))
-            .max_by(|a, b| a.1.total_cmp(&b.1));
-        if let Some((strategy, speedup, oversubscribed, pin)) = best {
-            points.push(PaperPoint {
-                cores: c,
-                oversubscribed,
-                speedup,
-                strategy,
+    let points: Vec<PaperPoint> = series::cores(&view.rows, &view.group)
+        .into_iter()
+        .filter_map(|c| {
+            let p = paper::at(c)?;
+            let best = bests
+                .iter()
+                .filter_map(|(_, b)| b.iter().find(|b| b.cores == c && calm(b)))
+                .filter(|b| b.speedup.is_some())
+                .max_by(|a, b| {
+                    a.speedup
+                        .unwrap_or(0.0)
+                        .total_cmp(&b.speedup.unwrap_or(0.0))
+                })?;
+            Some(PaperPoint {
+                best: best.clone(),
                 paper: p.speedup,
-                pin,
-            });
-        }
-    }
+            })
+        })
+        .collect();
     (!points.is_empty()).then_some(Finding::AgainstPaper(points))
 }
 
@@ -331,36 +374,40 @@ impl Finding {
     /// The finding in one sentence (Markdown).
     pub fn sentence(&self) -> String {
         match self {
+            Finding::Withheld(why) => why.sentence(),
             Finding::ContendedReference => "The seq reference was contended (other work used \
                 the machine while it ran): no speedup, serial fraction or comparison with the \
                 paper is given as a finding."
                 .to_owned(),
             Finding::AtCores(at) => at.sentence(),
-            Finding::OneCoreNoise { strategy, speedups } => match speedups.as_slice() {
-                [(pin, speedup, ci)] => format!(
-                    "{}'s speedup of {}{} at 1 core is noise in the seq reference, not a win: \
-                     one worker runs the same passes as seq.",
-                    SeriesKey::new(*strategy, *pin),
-                    times(*speedup),
-                    interval(*ci)
-                ),
-                several => format!(
-                    "{strategy}'s speedups of {} at 1 core are noise in the seq reference, not \
-                     a win: one worker runs the same passes as seq.",
-                    and_list(
-                        &several
-                            .iter()
-                            .map(|(pin, speedup, ci)| format!(
-                                "{}{} ({})",
-                                times(*speedup),
-                                interval(*ci),
-                                pin_name(*pin)
-                            ))
-                            .collect::<Vec<_>>()
-                    )
-                ),
-            },
+            Finding::OneCore(cells) => one_core(cells),
             Finding::Placements(p) => p.sentence(),
+            Finding::BestChunks(pairs) => {
+                let parts: Vec<String> = pairs
+                    .iter()
+                    .map(|(b, up)| {
+                        let chunks = |b: &Best| format!("{} chunks", b.chunks.unwrap_or(1));
+                        let (these, those) = (chunks(b), chunks(up));
+                        let said = match order(b, up) {
+                            Order::AFaster(r) | Order::BFaster(r) => {
+                                format!("{these} is {}", faster(&r, &those))
+                            }
+                            Order::Unresolved(r) => format!(
+                                "{these} and {those} are not distinguishable ({})",
+                                plus_minus(r.value, r.interval)
+                            ),
+                            Order::Unknown(_) => format!("{these} against {those}: no interval"),
+                        };
+                        format!("at {} {said}", series::cores_label(b.cores))
+                    })
+                    .collect();
+                format!(
+                    "{}: the grid's best chunks against its runner-up, both measured again in \
+                     the confirmation rounds: {}.",
+                    pairs[0].0.key(),
+                    parts.join("; ")
+                )
+            }
             Finding::ChunkingStops {
                 series: strategy,
                 from,
@@ -371,19 +418,19 @@ impl Finding {
                     .collect();
                 format!(
                     "{strategy}: more chunks stop paying (no larger chunk count is faster by \
-                     more than the trial spread) from {}.",
+                     the grid's paired rounds) from {}.",
                     parts.join(", ")
                 )
             }
-            Finding::SerialFraction { strategy, best, e } => format!(
-                "Karp–Flatt serial fraction of {} at {} ({}{}): e = {}. It describes \
+            Finding::SerialFraction { best, e, ci } => format!(
+                "Karp–Flatt serial fraction of {} at {} (speedup {}): e = {}{}. It describes \
                  the runs measured here; from so few core counts it forecasts nothing about \
                  more cores.",
-                SeriesKey::new(*strategy, best.pin),
+                best.key(),
                 series::cores_label(best.cores),
-                times(best.speedup.unwrap_or(f64::NAN)),
-                interval(best.speedup_ci),
-                super::numbers::sig(*e)
+                plus_minus(best.speedup.unwrap_or(f64::NAN), best.speedup_ci),
+                sig(*e),
+                interval(Some(*ci))
             ),
             Finding::RankShift(shift) => shift.sentence(),
             Finding::AgainstPaper(points) => format!(
@@ -398,19 +445,77 @@ impl Finding {
     }
 }
 
+/// The one-core finding: who is faster or slower than `seq` in the same rounds, and who is not
+/// distinguishable from it.
+fn one_core(cells: &[Best]) -> String {
+    let mut resolved = Vec::new();
+    let mut not = Vec::new();
+    for b in cells {
+        let Some(r) = speedup(b).filter(|r| r.interval.is_some()) else {
+            continue;
+        };
+        if r.resolved() {
+            resolved.push(format!("{} is {}", named(b), faster(&r, "seq")));
+        } else {
+            not.push(format!(
+                "{} ({})",
+                named(b),
+                plus_minus(r.value, r.interval)
+            ));
+        }
+    }
+    let mut parts = Vec::new();
+    if !resolved.is_empty() {
+        parts.push(format!(
+            "{} (its own cost or gain on one thread: the 95 % interval of the paired speedup \
+             excludes 1)",
+            and_list(&resolved)
+        ));
+    }
+    if !not.is_empty() {
+        parts.push(format!("not distinguishable from seq: {}", and_list(&not)));
+    }
+    format!(
+        "At 1 core, where every strategy does seq's work, against seq in the same rounds: {}.",
+        parts.join("; ")
+    )
+}
+
+impl Withheld {
+    fn sentence(self) -> String {
+        match self {
+            Withheld::Design(Design::BeforeRounds) => "Findings withheld: this sweep was \
+                measured before rounds (each cell's trials back to back, bootstrap intervals \
+                that under-cover, speedups that divide two means), so no comparison can be \
+                trusted to reproduce. The tables show what was measured."
+                .to_owned(),
+            Withheld::Design(_) => "Findings withheld: this sweep ran each cell's runs back to \
+                back (`--schedule cells`), so runs of one round are minutes apart and pairing \
+                them does not cancel the machine's drift. The tables show what was measured."
+                .to_owned(),
+            Withheld::Rounds(k) => format!(
+                "No finding: these cells ran {}, and an interval, so a finding, needs \
+                 {MIN_ROUNDS} or more (`--trials {MIN_ROUNDS}`).",
+                crate::output::console::plural(k, "round", "rounds")
+            ),
+        }
+    }
+}
+
 impl PaperPoint {
     fn phrase(&self) -> String {
+        let b = &self.best;
         format!(
-            "at {}{} the best here is {} ({}) against the paper's {}",
-            series::cores_label(self.cores),
-            if self.oversubscribed {
+            "at {}{} the best here is {} ({}) against the paper's {}×",
+            series::cores_label(b.cores),
+            if b.oversubscribed {
                 " (⚠ oversubscribed here)"
             } else {
                 ""
             },
-            times(self.speedup),
-            SeriesKey::new(self.strategy, self.pin),
-            times(self.paper)
+            plus_minus(b.speedup.unwrap_or(f64::NAN), b.speedup_ci),
+            b.key(),
+            sig(self.paper)
         )
     }
 }
@@ -441,31 +546,32 @@ impl AtCores {
                 };
                 format!("{where_}, only {} {only}{left_out}.", describe(w))
             }
-            Verdict::NoIntervals(w) => format!(
-                "{where_}, the lowest mean is {}, but these cells have no confidence intervals \
-                 (one trial, or a sweep older than them), so no strategy can be called \
+            Verdict::Unknown(w, why) => format!(
+                "{where_}, the lowest mean is {}, but {}, so no strategy can be called \
                  fastest{left_out}.",
-                describe(w)
+                describe(w),
+                why.phrase()
             ),
-            Verdict::Fastest { winner, runner_up } => {
-                let (wb, rb) = (&winner.1, &runner_up.1);
-                let speed = wb
-                    .speedup
+            Verdict::Fastest {
+                winner,
+                runner_up,
+                by,
+            } => {
+                let speed = speedup(&winner.1)
                     .filter(|_| self.show_speedup)
                     .map_or_else(String::new, |s| {
-                        format!(", {}{} over seq", times(s), interval(wb.speedup_ci))
+                        format!(", {} over seq", plus_minus(s.value, s.interval))
                     });
                 format!(
-                    "{where_}, **{}** is fastest{speed}; its 95 % interval does not overlap the \
-                     runner-up {}, which takes {} more time{left_out}.",
+                    "{where_}, **{}** is fastest{speed}: it is {} by the paired rounds (95 % \
+                     interval excluding 1){left_out}.",
                     describe(winner),
-                    describe(runner_up),
-                    percent((rb.mean_s - wb.mean_s) / wb.mean_s * 100.0)
+                    faster(by, &format!("the runner-up {}", describe(runner_up)))
                 )
             }
             Verdict::Tied { tied, slower } => format!(
-                "{where_}, {} are indistinguishable within the trial spread (their 95 % \
-                 intervals overlap){}{left_out}.",
+                "{where_}, {} are not distinguishable (the 95 % interval of each one's time \
+                 ratio to the lowest mean, paired by round, contains 1){}{left_out}.",
                 and_list(&tied.iter().map(describe).collect::<Vec<_>>()),
                 match slower {
                     0 => String::new(),
@@ -477,18 +583,31 @@ impl AtCores {
     }
 }
 
+impl Unknown {
+    /// Why no order: `only 2 paired rounds (3 are needed for an interval)`.
+    pub fn phrase(self) -> String {
+        match self {
+            Unknown::Rounds(k) => format!(
+                "with only {} in common ({MIN_ROUNDS} are needed for an interval)",
+                crate::output::console::plural(k, "paired round", "paired rounds")
+            ),
+            Unknown::Unpaired => "these cells did not run in the same rounds".to_owned(),
+        }
+    }
+}
+
 /// A verdict in a few words, strategies by name only (the table beside it has the numbers).
 pub(super) fn verdict_phrase(v: Option<&Verdict>) -> String {
     match v {
         None => "no cell was measured without contention".to_owned(),
         Some(Verdict::Only((s, _))) => format!("only {s} was measured"),
-        Some(Verdict::NoIntervals((s, _))) => format!(
-            "the lowest mean is {s}'s, but without confidence intervals no strategy can be \
-             called fastest"
+        Some(Verdict::Unknown((s, _), why)) => format!(
+            "the lowest mean is {s}'s, but {}, so no strategy can be called fastest",
+            why.phrase()
         ),
         Some(Verdict::Fastest { winner, .. }) => format!("**{}** is fastest", winner.0),
         Some(Verdict::Tied { tied, .. }) => format!(
-            "{} are indistinguishable within the trial spread (their 95 % intervals overlap)",
+            "{} are not distinguishable by their paired rounds",
             names(&tied.iter().map(|(s, _)| *s).collect::<Vec<_>>())
         ),
     }
@@ -499,17 +618,20 @@ pub(super) fn names(strategies: &[StrategyName]) -> String {
     and_list(&strategies.iter().map(|s| s.to_string()).collect::<Vec<_>>())
 }
 
-/// A cell as findings name it: `rayon-chunks with 45 chunks (0.412 s [0.40, 0.42])`, or
-/// pinned, `rayon-chunks (spread) with 45 chunks (…)`.
-pub(super) fn describe((s, b): &Entry) -> String {
+/// A cell by its series and chunks: `rayon-chunks with 45 chunks`, or pinned,
+/// `rayon-chunks (spread) with 45 chunks`.
+fn named(b: &Best) -> String {
     format!(
-        "{}{} ({} s{})",
-        SeriesKey::new(*s, b.pin),
+        "{}{}",
+        b.key(),
         b.chunks
-            .map_or_else(String::new, |k| format!(" with {k} chunks")),
-        secs(b.mean_s),
-        interval(b.mean_ci)
+            .map_or_else(String::new, |k| format!(" with {k} chunks"))
     )
+}
+
+/// A cell as findings name it: `rayon-chunks with 45 chunks (0.412 s [0.40–0.42])`.
+pub(super) fn describe((_, b): &Entry) -> String {
+    format!("{} ({} s{})", named(b), secs(b.mean_s), interval(b.mean_ci))
 }
 
 /// `a`, `a and b`, `a, b and c`.
@@ -524,61 +646,79 @@ pub(super) fn and_list(items: &[String]) -> String {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::results::rows::tests::row;
+    use crate::report::view::tests::{Spec, measured, view, with_trials};
+    use crate::results::rows::Phase;
+    use crate::topology::Pin;
+    use StrategyName::{RayonChunks, RayonIter, Seq};
 
-    fn sentences(rows: &[SummaryRow], g: &Group) -> Vec<String> {
-        findings(rows, g).iter().map(Finding::sentence).collect()
+    const NONE: Pin = Pin::None;
+    /// seq's times per round: the machine drifts from round to round.
+    pub(crate) const SEQ: [f64; 3] = [4.0, 4.8, 3.2];
+
+    fn said(v: &GroupView) -> Vec<String> {
+        findings(v).iter().map(Finding::sentence).collect()
     }
 
-    pub(crate) fn with_ci(mut r: SummaryRow, low: f64, high: f64) -> SummaryRow {
-        r.mean_ci_low_s = Some(low);
-        r.mean_ci_high_s = Some(high);
-        r
+    fn sentences(specs: &[Spec<'_>]) -> Vec<String> {
+        said(&view(specs))
     }
 
     #[test]
-    fn overlapping_intervals_name_no_winner() {
-        let rows = vec![
-            row(StrategyName::Seq, 1, None, 4.0),
-            with_ci(row(StrategyName::RayonChunks, 2, Some(10), 2.2), 2.0, 2.4),
-            with_ci(row(StrategyName::RayonIter, 2, None, 2.3), 2.1, 2.5),
-        ];
-        let f = sentences(&rows, &rows[0].group());
+    fn a_strategy_is_faster_only_where_its_paired_interval_excludes_one() {
+        // rayon-iter takes 5 % longer than rayon-chunks in every round, though the drift
+        // makes each one's own interval far wider than 5 %: paired, the order is resolved.
+        let f = sentences(&[
+            (Seq, 1, None, NONE, &SEQ),
+            (RayonChunks, 2, Some(10), NONE, &[2.0, 2.4, 1.6]),
+            (RayonIter, 2, None, NONE, &[2.1, 2.52, 1.68]),
+        ]);
         assert!(
-            f[0].contains("indistinguishable within the trial spread") && !f[0].contains("fastest"),
+            f[0].starts_with("At 2 cores, **rayon-chunks with 10 chunks (2.00 s [")
+                && f[0].contains("** is fastest, 2.00 ± 0.00× over seq: it is 1.05 ± 0.00× faster than the runner-up rayon-iter (2.10 s ["),
+            "{}",
+            f[0]
+        );
+        // The same means, but rounds that disagree: not distinguishable.
+        let f = sentences(&[
+            (Seq, 1, None, NONE, &SEQ),
+            (RayonChunks, 2, Some(10), NONE, &[2.0, 2.4, 1.6]),
+            (RayonIter, 2, None, NONE, &[2.3, 2.2, 1.8]),
+        ]);
+        assert!(
+            f[0].contains("are not distinguishable") && !f[0].contains("fastest"),
             "{}",
             f[0]
         );
     }
 
     #[test]
-    fn separate_intervals_name_the_fastest_with_its_margin() {
-        let rows = vec![
-            row(StrategyName::Seq, 1, None, 4.0),
-            with_ci(row(StrategyName::RayonChunks, 2, Some(10), 2.2), 2.1, 2.3),
-            with_ci(row(StrategyName::RayonIter, 2, None, 2.6), 2.5, 2.7),
-        ];
-        let f = sentences(&rows, &rows[0].group());
-        assert!(
-            f[0].starts_with(
-                "At 2 cores, **rayon-chunks with 10 chunks (2.20 s [2.10–2.30])** is fastest"
-            ),
-            "{}",
-            f[0]
+    fn fewer_than_three_rounds_give_no_finding_and_say_so() {
+        let f = sentences(&[
+            (Seq, 1, None, NONE, &[4.0, 4.0]),
+            (RayonChunks, 2, Some(10), NONE, &[2.0, 2.0]),
+            (RayonIter, 2, None, NONE, &[3.0, 3.0]),
+        ]);
+        assert_eq!(
+            f,
+            [
+                "No finding: these cells ran 2 rounds, and an interval, so a finding, needs 3 \
+              or more (`--trials 3`)."
+            ]
         );
-        assert!(f[0].contains("18.2 % more time"), "{}", f[0]);
     }
 
     #[test]
     fn contended_cells_enter_no_finding() {
-        let mut fast = with_ci(row(StrategyName::RayonIter, 2, None, 1.0), 0.9, 1.1);
-        fast.contended = Some(true);
-        let rows = vec![
-            row(StrategyName::Seq, 1, None, 4.0),
-            with_ci(row(StrategyName::RayonChunks, 2, Some(10), 2.2), 2.1, 2.3),
-            fast,
-        ];
-        let f = sentences(&rows, &rows[0].group());
+        let (mut rows, trials) = measured(
+            &[
+                (Seq, 1, None, NONE, &SEQ),
+                (RayonChunks, 2, Some(10), NONE, &[2.0, 2.4, 1.6]),
+                (RayonIter, 2, None, NONE, &[1.0, 1.2, 0.8]),
+            ],
+            Phase::Grid,
+        );
+        rows[2].contended = Some(true);
+        let f = said(&with_trials(rows, trials));
         assert!(
             f[0].contains("only rayon-chunks") && f[0].contains("1 contended cell left out"),
             "{}",
@@ -587,36 +727,79 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn a_one_core_speedup_above_one_is_called_noise_and_karp_flatt_never_extrapolates() {
-        let rows = vec![
-            row(StrategyName::Seq, 1, None, 4.0),
-            row(StrategyName::RayonChunks, 1, Some(10), 3.9),
-            row(StrategyName::RayonChunks, 2, Some(10), 2.2),
-        ];
-        let f = sentences(&rows, &rows[0].group()).join("\n");
-        assert!(f.contains("at 1 core is noise in the seq reference"), "{f}");
-        assert!(f.contains("e = 0.100"), "{f}");
-        assert!(!f.contains("no number of cores"), "{f}");
+    fn a_one_core_speedup_whose_interval_excludes_one_is_a_finding_about_the_strategy() {
+        let f = sentences(&[
+            (Seq, 1, None, NONE, &SEQ),
+            (RayonChunks, 1, Some(10), NONE, &[4.4, 5.28, 3.52]),
+            (RayonIter, 1, None, NONE, &[3.9, 4.9, 3.3]),
+            (RayonChunks, 2, Some(10), NONE, &[2.2, 2.64, 1.76]),
+        ])
+        .join("\n");
+        assert!(
+            f.contains(
+                "At 1 core, where every strategy does seq's work, against seq in the same \
+                 rounds: rayon-chunks with 10 chunks is 1.10 ± 0.00× slower than seq (its own \
+                 cost or gain on one thread: the 95 % interval of the paired speedup excludes \
+                 1); not distinguishable from seq: rayon-iter (0.991 ± 0.076×)."
+            ),
+            "{f}"
+        );
+        assert!(!f.contains("noise"), "{f}");
+    }
+
+    #[test]
+    fn karp_flatt_comes_with_its_interval_and_not_where_that_interval_reaches_zero() {
+        // Speedup 1.6 at 2 cores, the same in every round: e = 0.25, its interval a point.
+        let f = sentences(&[
+            (Seq, 1, None, NONE, &SEQ),
+            (RayonChunks, 2, Some(10), NONE, &[2.5, 3.0, 2.0]),
+        ])
+        .join("\n");
+        assert!(
+            f.contains("(speedup 1.60 ± 0.00×): e = 0.250 [0.250–0.250]"),
+            "{f}"
+        );
+        // Speedups of 1.9 to 2.1 by round: the interval of e reaches below 0.
+        let f = sentences(&[
+            (Seq, 1, None, NONE, &SEQ),
+            (
+                RayonChunks,
+                2,
+                Some(10),
+                NONE,
+                &[4.0 / 1.9, 4.8 / 2.1, 3.2 / 1.95],
+            ),
+        ])
+        .join("\n");
+        assert!(!f.contains("Karp–Flatt"), "{f}");
     }
 
     #[test]
     fn a_contended_reference_gives_no_speedup_finding() {
-        let mut seq = row(StrategyName::Seq, 1, None, 4.0);
-        seq.contended = Some(true);
-        let rows = vec![seq, row(StrategyName::RayonChunks, 2, Some(10), 2.2)];
-        let f = sentences(&rows, &rows[0].group()).join("\n");
+        let (mut rows, trials) = measured(
+            &[
+                (Seq, 1, None, NONE, &SEQ),
+                (RayonChunks, 2, Some(10), NONE, &[2.5, 3.0, 2.0]),
+            ],
+            Phase::Grid,
+        );
+        rows[0].contended = Some(true);
+        let f = said(&with_trials(rows, trials));
+        let f = f.join("\n");
         assert!(f.contains("The seq reference was contended"), "{f}");
         assert!(!f.contains("Karp–Flatt") && !f.contains("over seq"), "{f}");
         assert!(!f.contains("paper's"), "{f}");
     }
 
     #[test]
-    fn no_karp_flatt_without_a_speedup_above_one() {
-        let rows = vec![
-            row(StrategyName::Seq, 1, None, 4.0),
-            row(StrategyName::RayonIter, 2, None, 5.0),
-        ];
-        let f = sentences(&rows, &rows[0].group()).join("\n");
-        assert!(!f.contains("Karp–Flatt"), "{f}");
+    fn a_sweep_whose_rounds_do_not_pair_gets_no_finding() {
+        let mut v = view(&[
+            (Seq, 1, None, NONE, &SEQ),
+            (RayonChunks, 2, Some(10), NONE, &[2.5, 3.0, 2.0]),
+        ]);
+        v.design = Design::BeforeRounds;
+        let f = said(&v);
+        assert_eq!(f.len(), 1);
+        assert!(f[0].starts_with("Findings withheld: this sweep was measured before rounds"));
     }
 }

@@ -1,20 +1,22 @@
 //! `bench-sph report`: a results directory (or several) becomes PNG charts and `REPORT.md`.
 //!
-//! The pipeline: [`crate::results::load`] reads `meta.json` and `summary.csv`;
-//! [`series`] turns rows into the series each chart and table needs and [`plan`] into the
-//! charts to draw, with their captions (both pure); [`charts`] draws
+//! The pipeline: [`crate::results::load`] reads `meta.json`, `summary.csv` and `trials.csv`;
+//! [`view`] builds one view of each group (its grid and confirmation rows, each cell's runs by
+//! round), which every table, chart and finding reads; [`series`] turns it into the series
+//! each chart and table needs and [`plan`] into the charts to draw, with their captions (both
+//! pure); [`charts`] draws
 //! them (one file per chart kind, [`charts::WIDTH`] × [`charts::HEIGHT`] PNGs in the bundled
 //! font); [`traces`] finds trace directories to embed; [`markdown`] writes the report's text
 //! (pure); [`paper`] holds the seed paper's published numbers.
 //!
 //! Charts, per group (preset, neighbours, N, steps):
-//! 1. runtime against chunks, one line per core count, each line's minimum crossed, per chunked
-//!    strategy (the paper's Figure 7);
+//! 1. runtime against chunks, one line per core count, each line's minimum crossed, each trial
+//!    a dot beside its mean, per chunked strategy (the paper's Figure 7);
 //! 2. CPU time (user + sys) against chunks, the same way (Figure 8);
 //! 3. per strategy, best runtime and best speedup against cores, with the ideal and, for
 //!    `seed`/`all-pairs`, the paper's speedups (Figures 9 and 10);
-//! 4. every strategy's best speedup against cores, error bars from the trial spread;
-//! 5. efficiency and the Karp–Flatt serial fraction against cores;
+//! 4. every strategy's best speedup against cores, error bars its paired interval;
+//! 5. efficiency and the Karp–Flatt serial fraction (with its interval) against cores;
 //!
 //! where a strategy was measured at several placements (`sweep --pin`), charts 3–5 draw one
 //! line per placement and charts 1–2 are drawn per placement ([`plan`]); where the sweep's
@@ -45,6 +47,7 @@ pub mod plan;
 pub mod rank_shift;
 pub mod series;
 pub mod traces;
+pub mod view;
 pub mod workloads;
 
 use std::path::{Path, PathBuf};
@@ -152,7 +155,8 @@ pub fn generate_with(
         compared(&sweeps, &sides, rule, &claimed, &mut written)?
     } else {
         let traces = (results_dirs, out_dir, trace_dirs);
-        pooled(&sweeps, traces, &claimed, &mut written)?
+        // One study: one side, whose views are the study's.
+        pooled(&sweeps, &sides[0].views, traces, &claimed, &mut written)?
     };
     let report = out_dir.join(REPORT_FILE);
     crate::output::atomic::write(&report, text.as_bytes())?;
@@ -161,17 +165,17 @@ pub fn generate_with(
     Ok(written)
 }
 
-/// One study (one machine's directories): draws its charts into `claimed` (adding them to
-/// `written`), embeds the traces found from `(results_dirs, out_dir, trace_dirs)` (see
-/// [`embed_traces`]), and returns REPORT.md's text.
+/// One study (one machine's directories, whose groups are `views`): draws its charts into
+/// `claimed` (adding them to `written`), embeds the traces found from `(results_dirs,
+/// out_dir, trace_dirs)` (see [`embed_traces`]), and returns REPORT.md's text.
 fn pooled(
     sweeps: &[load::Sweep],
+    views: &[view::GroupView],
     (results_dirs, out_dir, trace_dirs): (&[PathBuf], &Path, &[PathBuf]),
     claimed: &crate::output::claim::Claimed,
     written: &mut Vec<PathBuf>,
 ) -> anyhow::Result<String> {
-    let rows: Vec<_> = sweeps.iter().flat_map(|s| s.rows.clone()).collect();
-    let planned = plan::plan(&rows, |g| markdown::topology_of(sweeps, g));
+    let planned = plan::plan(views, |g| markdown::topology_of(sweeps, g));
     for chart in &planned.charts {
         let path = claimed.check_writable(&chart.file)?;
         draw(&path, chart)?;
@@ -180,6 +184,7 @@ fn pooled(
     let traces = embed_traces(results_dirs, out_dir, trace_dirs, written)?;
     Ok(markdown::render(&markdown::Input {
         sweeps,
+        views,
         charts: &planned.charts,
         skipped: &planned.skipped,
         traces: &traces,

@@ -1,6 +1,8 @@
 //! How REPORT.md writes numbers: never more than three significant digits (a mean of five
-//! noisy trials does not know its fourth digit), intervals as `[low–high]`.
+//! noisy trials does not know its fourth digit); intervals of times as `[low–high]`, relative
+//! results as hyperfine writes them, `1.62 ± 0.04×` (± the larger half of the 95 % interval).
 
+use crate::results::intervals::Ratio;
 use crate::results::stats::Interval;
 
 /// `v` to three significant digits, without exponent: `0.412`, `2.20`, `39.7`, `1230`.
@@ -37,12 +39,39 @@ pub fn secs(v: f64) -> String {
 pub fn mean_sd(mean: f64, sd: Option<f64>) -> String {
     let m = sig(mean);
     match sd {
-        Some(sd) => {
-            let places = m.split_once('.').map_or(0, |(_, d)| d.len());
-            format!("{m} ± {sd:.places$}")
-        }
+        Some(sd) => format!("{m} ± {}", like(&m, sd)),
         None => m,
     }
+}
+
+/// `x` to as many decimals as `shown` (a number as [`sig`] wrote it) has.
+fn like(shown: &str, x: f64) -> String {
+    let places = shown.split_once('.').map_or(0, |(_, d)| d.len());
+    format!("{x:.places$}")
+}
+
+/// A ratio and its 95 % interval as hyperfine writes them: `1.62 ± 0.04×`, ± the larger
+/// half of the interval (which is not symmetric on a linear scale) to the value's decimals;
+/// `1.62×` without an interval.
+pub fn plus_minus(value: f64, i: Option<Interval>) -> String {
+    let v = sig(value);
+    match i {
+        Some(i) => format!("{v} ± {}×", like(&v, (value - i.low).max(i.high - value))),
+        None => format!("{v}×"),
+    }
+}
+
+/// How much faster `r` (a time ratio other / this, paired by round) says this is than
+/// `other`: `1.62 ± 0.04× faster than seq`, or below 1, `1.20 ± 0.02× slower than seq`.
+pub fn faster(r: &Ratio, other: &str) -> String {
+    if r.value >= 1.0 {
+        return format!("{} faster than {other}", plus_minus(r.value, r.interval));
+    }
+    let inverse = r.interval.map(|i| Interval {
+        low: 1.0 / i.high,
+        high: 1.0 / i.low,
+    });
+    format!("{} slower than {other}", plus_minus(1.0 / r.value, inverse))
 }
 
 /// A speedup: `1.84×`.
@@ -83,5 +112,28 @@ mod tests {
             high: 0.4234,
         };
         assert_eq!(interval(Some(i)), " [0.401–0.423]");
+    }
+
+    #[test]
+    fn relative_results_read_like_hyperfine_with_the_larger_half_of_the_interval() {
+        let i = |low, high| Some(Interval { low, high });
+        assert_eq!(plus_minus(1.62, i(1.59, 1.66)), "1.62 ± 0.04×");
+        assert_eq!(plus_minus(16.2, i(15.0, 16.4)), "16.2 ± 1.2×");
+        assert_eq!(plus_minus(2.0, i(2.0, 2.0)), "2.00 ± 0.00×");
+        assert_eq!(plus_minus(1.5, None), "1.50×");
+        let r = |value, low, high| Ratio {
+            value,
+            interval: i(low, high),
+            rounds: 3,
+        };
+        assert_eq!(
+            faster(&r(1.25, 1.2, 1.3), "seq"),
+            "1.25 ± 0.05× faster than seq"
+        );
+        // 0.8 [0.75–0.85] is 1.25 [1.18–1.33] the other way round.
+        assert_eq!(
+            faster(&r(0.8, 0.75, 0.85), "seq"),
+            "1.25 ± 0.08× slower than seq"
+        );
     }
 }

@@ -1,16 +1,17 @@
 //! Placements (`sweep --pin`) of one strategy set against each other, cell against cell: at
 //! each core count where both were measured without contention with the same chunks (the
-//! chunks value fastest under either), one placement is called faster only where the two 95 %
-//! intervals of the mean are apart; overlapping intervals are indistinguishable within the
-//! trial spread, and cells without intervals give no order. Each strategy gets one sentence
-//! per pair of placements (`compact` against `spread`, each pinned one against `none`): where
-//! each is faster, where the intervals cannot tell, and the largest difference with both
-//! cells' speedups and their intervals. [`compare`] decides, [`Placements::sentence`] words.
+//! chunks value fastest under either), among the cells the findings rest on (the confirmation
+//! rounds' where the group has them), one placement is called faster only where the 95 %
+//! interval of their time ratio, paired by round ([`findings::order`]), excludes 1; otherwise
+//! they are not distinguishable, and without an interval no order is told. Each strategy gets
+//! one sentence per pair of placements (`compact` against `spread`, each pinned one against
+//! `none`): where each is faster, where the rounds cannot tell, and the largest difference
+//! with both cells' speedups. [`compare`] decides, [`Placements::sentence`] words.
 
-use super::findings::and_list;
-use super::numbers::{interval, secs, times};
-use super::series::{self, Best, Group};
-use crate::results::rows::SummaryRow;
+use super::findings::{self, Order, and_list};
+use super::numbers::{interval, plus_minus, secs};
+use super::series::{self, Best};
+use super::view::GroupView;
 use crate::topology::Pin;
 use sph_strategies::StrategyName;
 
@@ -45,30 +46,7 @@ pub struct PinPair {
     pub b: Best,
 }
 
-/// What the intervals say about a [`PinPair`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PinOrder {
-    /// Placement `a` is faster: the 95 % intervals of the mean are apart.
-    AFaster,
-    /// Placement `b` is faster: the intervals are apart.
-    BFaster,
-    /// The intervals overlap.
-    Indistinguishable,
-    /// A cell has no interval (one trial, an older sweep): no order can be told.
-    NoIntervals,
-}
-
 impl PinPair {
-    /// The order the intervals support.
-    pub fn order(&self) -> PinOrder {
-        match (self.a.mean_ci, self.b.mean_ci) {
-            (Some(x), Some(y)) if x.overlaps(&y) => PinOrder::Indistinguishable,
-            (Some(_), Some(_)) if self.a.mean_s < self.b.mean_s => PinOrder::AFaster,
-            (Some(_), Some(_)) => PinOrder::BFaster,
-            _ => PinOrder::NoIntervals,
-        }
-    }
-
     /// The relative difference of the two means, over the faster one.
     fn difference(&self) -> f64 {
         (self.a.mean_s - self.b.mean_s).abs() / self.a.mean_s.min(self.b.mean_s)
@@ -83,41 +61,40 @@ const PIN_PAIRS: [(Pin, Pin); 3] = [
     (Pin::Compact, Pin::None),
 ];
 
-/// Per strategy of `strategies` measured at two placements or more in `g`, one comparison per
-/// pair of them (`compact` against `spread`, each pinned one against `none`); speedups are
-/// stated with `show_speedup` (the group's `seq` reference is trusted), times otherwise.
+/// Per strategy of `strategies` measured at two placements or more in the group of `view`,
+/// one comparison per pair of them (`compact` against `spread`, each pinned one against
+/// `none`); speedups are stated with `show_speedup` (the group's `seq` reference is trusted),
+/// times otherwise.
 pub fn compare<'a>(
-    rows: &'a [SummaryRow],
-    g: &'a Group,
+    view: &'a GroupView,
     strategies: &'a [StrategyName],
     show_speedup: bool,
 ) -> impl Iterator<Item = Placements> + 'a {
     strategies.iter().flat_map(move |&s| {
-        let pins = series::pins(rows, g, s);
+        let pins = series::pins(&view.rows, &view.group, s);
         PIN_PAIRS
             .iter()
             .filter(move |(a, b)| pins.contains(a) && pins.contains(b))
-            .filter_map(move |&(a, b)| placement_pair(rows, g, s, (a, b), show_speedup))
+            .filter_map(move |&(a, b)| placement_pair(view, s, (a, b), show_speedup))
     })
 }
 
 /// Placement `a` of `s` against `b`, where some core count has both (`None` where none has).
 fn placement_pair(
-    rows: &[SummaryRow],
-    g: &Group,
+    view: &GroupView,
     s: StrategyName,
     (a, b): (Pin, Pin),
     show_speedup: bool,
 ) -> Option<Placements> {
-    let ok = series::ok_rows(rows, g);
+    let ok = series::ok_rows(view.findings_rows(), &view.group);
     let cell = |pin: Pin, cores: usize, chunks: Option<usize>| {
         ok.iter()
             .find(|r| r.strategy == s && r.pin == pin && r.cores == cores && r.chunks == chunks)
-            .and_then(|r| Best::of(r))
+            .and_then(|r| view.best(r))
     };
     let mut at = Vec::new();
     let mut contended = 0;
-    for c in series::cores(rows, g) {
+    for c in series::cores(&view.rows, &view.group) {
         let both: Vec<PinPair> = ok
             .iter()
             .filter(|r| r.strategy == s && r.pin == a && r.cores == c)
@@ -144,7 +121,7 @@ fn placement_pair(
         a,
         b,
         at,
-        chunked: series::is_chunked(rows, g, s),
+        chunked: series::is_chunked(&view.rows, &view.group, s),
         show_speedup,
         contended,
     })
@@ -163,33 +140,29 @@ impl Placements {
     /// cannot tell, and the largest difference with both cells' numbers.
     pub fn sentence(&self) -> String {
         let (a, b) = (pin_name(self.a), pin_name(self.b));
-        let cores_where = |order: PinOrder| -> Vec<usize> {
-            self.at
-                .iter()
-                .filter(|p| p.order() == order)
-                .map(|p| p.a.cores)
-                .collect()
+        // What the paired rounds say of a pair, as the place of its phrase below.
+        let said = |p: &PinPair| match findings::order(&p.a, &p.b) {
+            Order::AFaster(_) => 0,
+            Order::BFaster(_) => 1,
+            Order::Unresolved(_) => 2,
+            Order::Unknown(_) => 3,
         };
         let mut parts = Vec::new();
-        for (order, phrase) in [
-            (
-                PinOrder::AFaster,
-                format!("{a} is faster (95 % intervals of the mean apart)"),
-            ),
-            (
-                PinOrder::BFaster,
-                format!("{b} is faster (95 % intervals of the mean apart)"),
-            ),
-            (
-                PinOrder::Indistinguishable,
-                "they are indistinguishable within the trial spread".to_owned(),
-            ),
-            (
-                PinOrder::NoIntervals,
-                "the cells have no confidence intervals, so no order can be told".to_owned(),
-            ),
-        ] {
-            let cores = cores_where(order);
+        for (i, phrase) in [
+            format!("{a} is faster (paired rounds)"),
+            format!("{b} is faster (paired rounds)"),
+            "they are not distinguishable".to_owned(),
+            "the paired rounds give no interval, so no order can be told".to_owned(),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let cores: Vec<usize> = self
+                .at
+                .iter()
+                .filter(|p| said(p) == i)
+                .map(|p| p.a.cores)
+                .collect();
             if !cores.is_empty() {
                 parts.push(format!("{phrase} at {}", cores_list(&cores)));
             }
@@ -219,7 +192,7 @@ impl Placements {
             );
         }
         let value = |c: &Best| match c.speedup.filter(|_| self.show_speedup) {
-            Some(s) => format!("{}{}", times(s), interval(c.speedup_ci)),
+            Some(s) => plus_minus(s, c.speedup_ci),
             None => format!("{} s{}", secs(c.mean_s), interval(c.mean_ci)),
         };
         let unit = if self.show_speedup && largest.a.speedup.is_some() {
@@ -268,56 +241,45 @@ fn cores_list(cores: &[usize]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::findings::tests::with_ci;
+    use crate::report::findings::tests::SEQ;
     use crate::report::findings::{Finding, findings};
-    use crate::report::series::tests::pinned;
+    use crate::report::view::tests::{Spec, of_rows, view};
     use crate::results::rows::tests::row;
+    use StrategyName::{RayonChunks, Seq, StdStatic};
 
-    fn sentences(rows: &[SummaryRow], g: &Group) -> Vec<String> {
-        findings(rows, g).iter().map(Finding::sentence).collect()
+    fn sentences(specs: &[Spec<'_>]) -> Vec<String> {
+        findings(&view(specs))
+            .iter()
+            .map(Finding::sentence)
+            .collect()
     }
 
     #[test]
-    fn placements_apart_name_the_faster_one_and_overlapping_ones_are_indistinguishable() {
-        use StrategyName::RayonChunks;
-        let rows = vec![
-            row(StrategyName::Seq, 1, None, 4.0),
-            with_ci(row(RayonChunks, 1, Some(10), 3.9), 3.8, 4.0),
-            with_ci(
-                pinned(row(RayonChunks, 1, Some(10), 3.95), Pin::Spread),
-                3.85,
-                4.05,
-            ),
-            with_ci(row(RayonChunks, 2, Some(10), 2.2), 2.1, 2.3),
-            with_ci(
-                pinned(row(RayonChunks, 2, Some(10), 1.8), Pin::Spread),
-                1.7,
-                1.9,
-            ),
+    fn a_placement_is_faster_only_where_the_paired_rounds_resolve_it() {
+        let (none, spread) = (Pin::None, Pin::Spread);
+        let f = sentences(&[
+            (Seq, 1, None, none, &SEQ),
+            (RayonChunks, 1, Some(10), none, &[3.9, 4.9, 3.3]),
+            (RayonChunks, 1, Some(10), spread, &[4.0, 4.7, 3.3]),
+            (RayonChunks, 2, Some(10), none, &[2.2, 2.64, 1.76]),
+            (RayonChunks, 2, Some(10), spread, &[1.8, 2.16, 1.44]),
             // Spread's 5 chunks have no unpinned twin: not compared, though faster.
-            with_ci(
-                pinned(row(RayonChunks, 2, Some(5), 1.0), Pin::Spread),
-                0.9,
-                1.1,
-            ),
-        ];
-        let f = sentences(&rows, &rows[0].group());
+            (RayonChunks, 2, Some(5), spread, &[1.0, 1.2, 0.8]),
+        ]);
         let compared = |s: &&String| s.contains("` against ");
         let s = f.iter().find(compared).unwrap();
         assert_eq!(
             s,
             "rayon-chunks, `spread` against unpinned (at each core count, the chunks value \
-             fastest under either): `spread` is faster (95 % intervals of the mean apart) at \
-             2 cores; they are indistinguishable within the trial spread at 1 core; the \
-             largest difference is at 2 cores with 10 chunks: `spread` 2.22× [2.11–2.33] \
-             against unpinned 1.82× [1.73–1.91] over seq."
+             fastest under either): `spread` is faster (paired rounds) at 2 cores; they are \
+             not distinguishable at 1 core; the largest difference is at 2 cores with 10 \
+             chunks: `spread` 2.22 ± 0.00× against unpinned 1.82 ± 0.00× over seq."
         );
         assert_eq!(f.iter().filter(compared).count(), 1, "{f:#?}");
         assert!(
-            f.iter().any(|s| s.starts_with(
-                "rayon-chunks (spread): more chunks stop paying (no larger chunk count is \
-                 faster by more than the trial spread) from 5 chunks at 2 cores."
-            )),
+            f.iter().any(|s| s
+                == "rayon-chunks (spread): more chunks stop paying (no larger chunk count is \
+                    faster by the grid's paired rounds) from 5 chunks at 2 cores."),
             "{f:#?}"
         );
         // Pinned cells are named as such wherever a finding names a cell.
@@ -326,56 +288,41 @@ mod tests {
                 .any(|s| s.contains("**rayon-chunks (spread) with 5 chunks (1.00 s")),
             "{f:?}"
         );
-        // One sentence for the noise at 1 core, over both placements.
-        let noise: Vec<&String> = f.iter().filter(|s| s.contains("noise")).collect();
-        assert_eq!(noise.len(), 1, "{noise:?}");
-        assert_eq!(
-            noise[0],
-            "rayon-chunks's speedups of 1.03× [0.974–1.08] (unpinned) and 1.01× [0.962–1.06] \
-             (`spread`) at 1 core are noise in the seq reference, not a win: one worker runs \
-             the same passes as seq."
-        );
     }
 
     #[test]
-    fn compact_against_spread_with_overlapping_intervals_claims_no_order() {
-        use StrategyName::StdStatic;
-        let rows = vec![
-            row(StrategyName::Seq, 1, None, 4.0),
-            with_ci(pinned(row(StdStatic, 2, None, 2.0), Pin::Compact), 1.9, 2.1),
-            with_ci(
-                pinned(row(StdStatic, 2, None, 2.05), Pin::Spread),
-                1.95,
-                2.15,
-            ),
-        ];
-        let f = sentences(&rows, &rows[0].group());
+    fn compact_against_spread_with_rounds_that_disagree_claims_no_order() {
+        let f = sentences(&[
+            (Seq, 1, None, Pin::None, &SEQ),
+            (StdStatic, 2, None, Pin::Compact, &[2.0, 2.5, 1.5]),
+            (StdStatic, 2, None, Pin::Spread, &[2.1, 2.3, 1.65]),
+        ]);
         let s = f.iter().find(|s| s.contains("against")).unwrap();
-        assert_eq!(
-            s,
-            "std-static, `compact` against `spread`: they are indistinguishable within the \
-             trial spread at 2 cores (2 cores: `compact` 2.00× [1.90–2.10] against `spread` \
-             1.95× [1.85–2.05] over seq)."
+        assert!(
+            s.starts_with(
+                "std-static, `compact` against `spread`: they are not distinguishable at 2 \
+                 cores (2 cores: `compact` "
+            ),
+            "{s}"
         );
         assert!(!s.contains("faster"), "{s}");
     }
 
     #[test]
-    fn without_intervals_two_placements_get_no_order() {
-        let mut none = row(StrategyName::RayonIter, 2, None, 2.0);
-        none.mean_ci_low_s = None;
-        let rows = vec![
-            row(StrategyName::Seq, 1, None, 4.0),
-            none,
-            pinned(row(StrategyName::RayonIter, 2, None, 1.0), Pin::Spread),
-        ];
-        let f = sentences(&rows, &rows[0].group()).join("\n");
+    fn cells_whose_runs_do_not_pair_get_no_order() {
+        let mut spread = row(StrategyName::RayonIter, 2, None, 1.0);
+        spread.pin = Pin::Spread;
+        let v = of_rows(vec![
+            row(Seq, 1, None, 4.0),
+            row(StrategyName::RayonIter, 2, None, 2.0),
+            spread,
+        ]);
+        let f: Vec<String> = findings(&v).iter().map(Finding::sentence).collect();
+        let f = f.join("\n");
         assert!(
-            f.contains(
-                "the cells have no confidence intervals, so no order can be told at 2 cores"
-            ),
+            f.contains("the paired rounds give no interval, so no order can be told at 2 cores"),
             "{f}"
         );
-        assert!(!f.contains("is faster (95 %"), "{f}");
+        assert!(!f.contains("is faster"), "{f}");
     }
 }

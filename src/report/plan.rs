@@ -1,7 +1,9 @@
 //! Which charts a report draws, as data: for each chart its file name, caption, titles and
-//! series, and for each chart that does not apply, why. A pure function of the summary rows
+//! series, and for each chart that does not apply, why. A pure function of the groups' views
 //! and the machine's topology ([`plan`]); [`super::generate`] then only draws each
-//! [`ChartPlan`] and writes the text (criterion's "compute the series, then draw").
+//! [`ChartPlan`] and writes the text (criterion's "compute the series, then draw"). Charts
+//! 1–2 show the grid (every cell, each trial a dot); charts 3–5 each strategy's best cells,
+//! as the tables do ([`GroupView::best_per_cores`]).
 //!
 //! Placements (`sweep --pin`): charts 3–5 draw one line per strategy and placement, the
 //! pinned ones in the strategy's colour, dashed (`spread`) or dotted (`compact`); charts 1–2
@@ -16,6 +18,7 @@ use super::charts::best::BestChart;
 use super::markdown::Skipped;
 use super::paper;
 use super::series::{self, Line, Metric, SeriesKey, SmtBand};
+use super::view::GroupView;
 use crate::results::key::{Group, LabelStyle};
 use crate::results::rows::SummaryRow;
 use crate::sph::params::Preset;
@@ -81,20 +84,22 @@ pub struct ReportPlan {
     pub skipped: Vec<Skipped>,
 }
 
-/// The charts of `rows` (see the module docs of [`super`] for the list); `topology` gives
+/// The charts of `views` (see the module docs of [`super`] for the list); `topology` gives
 /// the recorded topology of the machine that measured a group, where known.
 pub fn plan<'t>(
-    rows: &[SummaryRow],
+    views: &[GroupView],
     topology: impl Fn(&Group) -> Option<&'t Topology>,
 ) -> ReportPlan {
     let mut out = ReportPlan::default();
-    for g in series::groups(rows) {
-        chunk_charts(rows, &g, &mut out);
-        let smt = topology(&g).and_then(|t| series::smt_band(t, &series::cores(rows, &g)));
-        cores_charts(rows, &g, smt, &mut out);
+    for v in views {
+        chunk_charts(v, &mut out);
+        let cores = series::cores(&v.rows, &v.group);
+        let smt = topology(&v.group).and_then(|t| series::smt_band(t, &cores));
+        cores_charts(v, smt, &mut out);
     }
-    for preset in series::presets(rows) {
-        neighbor_chart(rows, preset, &mut out);
+    let rows: Vec<SummaryRow> = views.iter().flat_map(|v| v.rows.clone()).collect();
+    for preset in series::presets(&rows) {
+        neighbor_chart(&rows, preset, &mut out);
     }
     out
 }
@@ -126,8 +131,9 @@ impl ReportPlan {
     }
 }
 
-/// Charts 1 and 2 for each chunked strategy of `g`, at each of its placements.
-fn chunk_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
+/// Charts 1 and 2 for each chunked strategy of `v`, at each of its placements.
+fn chunk_charts(v: &GroupView, out: &mut ReportPlan) {
+    let (rows, g) = (&v.rows, &v.group);
     let subtitle = g.label(LabelStyle::Report);
     let chunked: Vec<StrategyName> = series::strategies(rows, g)
         .into_iter()
@@ -150,7 +156,7 @@ fn chunk_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
             (Metric::Wall, 1, "runtime", "mean runtime (s)"),
             (Metric::Cpu, 2, "cpu", "mean CPU time, user + sys (s)"),
         ] {
-            let lines = series::chunk_lines(rows, g, key, metric);
+            let lines = series::chunk_lines(v, key, metric);
             if lines.is_empty() {
                 continue;
             }
@@ -158,8 +164,10 @@ fn chunk_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
                 Metric::Wall => (
                     format!("Runtime against chunks: {key}"),
                     format!(
-                        "Chart 1: {key}, mean runtime against chunks per pass, one line per core \
-                         count, each line's minimum crossed (the paper's Figure 7); {subtitle}."
+                        "Chart 1: {key}, mean runtime against chunks per pass over the grid's \
+                         rounds, one line per core count, each line's minimum crossed, bars \
+                         the 95 % interval, each trial a small dot beside its mean (the paper's \
+                         Figure 7); {subtitle}."
                     ),
                 ),
                 Metric::Cpu => (
@@ -190,13 +198,15 @@ fn chunk_charts(rows: &[SummaryRow], g: &Group, out: &mut ReportPlan) {
     }
 }
 
-/// Charts 3–5 of `g`, or why they are not drawn.
-fn cores_charts(rows: &[SummaryRow], g: &Group, smt: Option<SmtBand>, out: &mut ReportPlan) {
-    let cores = series::cores(rows, g);
-    match series::seq_mean(rows, g) {
+/// Charts 3–5 of `v`, or why they are not drawn.
+fn cores_charts(v: &GroupView, smt: Option<SmtBand>, out: &mut ReportPlan) {
+    let g = &v.group;
+    let cores = series::cores(&v.rows, g);
+    match v.reference().and_then(|r| r.mean_s) {
         Some(seq_s) if cores.len() > 1 => {
-            best_charts(rows, g, seq_s, out);
-            speedup_and_efficiency_charts(rows, g, smt, out);
+            let bests = v.series_bests();
+            best_charts(v, &bests, seq_s, out);
+            speedup_and_efficiency_charts(g, &bests, smt, out);
         }
         Some(_) => match cores.first() {
             Some(&c) => out.skip(
@@ -219,26 +229,28 @@ fn cores_charts(rows: &[SummaryRow], g: &Group, smt: Option<SmtBand>, out: &mut 
     }
 }
 
-/// Chart 3 for each strategy of `g` with at least two core counts (at some placement), one
-/// line per placement.
-fn best_charts(rows: &[SummaryRow], g: &Group, seq_s: f64, out: &mut ReportPlan) {
+/// Chart 3 for each strategy of `v` with at least two core counts (at some placement), one
+/// line per placement; `bests` are its series' best cells.
+fn best_charts(
+    v: &GroupView,
+    bests: &[(SeriesKey, Vec<series::Best>)],
+    seq_s: f64,
+    out: &mut ReportPlan,
+) {
+    let g = &v.group;
     let subtitle = g.label(LabelStyle::Report);
     let comparable = paper::comparable(g);
-    let speedups = series::speedup_lines(rows, g);
-    for s in series::strategies(rows, g)
+    let speedups = series::speedup_lines(bests);
+    for s in series::strategies(&v.rows, g)
         .into_iter()
         .filter(|&s| s != StrategyName::Seq)
     {
         let mut runtime = Vec::new();
         let mut speedup = Vec::new();
-        for key in series::pins(rows, g, s)
-            .into_iter()
-            .map(|p| SeriesKey::new(s, p))
-        {
-            let best = series::best_per_cores(rows, g, key);
-            let line = speedups.iter().find(|l| l.series == Some(key));
+        for (key, best) in bests.iter().filter(|(k, _)| k.strategy == s) {
+            let line = speedups.iter().find(|l| l.series == Some(*key));
             if let (false, Some(line)) = (best.is_empty(), line) {
-                runtime.push(series::runtime_line(&best, key));
+                runtime.push(series::runtime_line(best, *key));
                 speedup.push(line.clone());
             }
         }
@@ -254,8 +266,9 @@ fn best_charts(rows: &[SummaryRow], g: &Group, seq_s: f64, out: &mut ReportPlan)
             paper: comparable,
         };
         let caption = format!(
-            "Chart 3: {s}, best runtime (above) and best speedup (below) against cores, \
+            "Chart 3: {s}, best runtime (above) and best speedup (below) against cores{}, \
              bars: 95 % confidence intervals{} (the paper's Figures 9 and 10){}; {subtitle}.",
+            chosen(v),
             if comparable {
                 "; grey triangles: the paper's published speedups on its own machine, at the \
                  core counts measured here"
@@ -270,15 +283,24 @@ fn best_charts(rows: &[SummaryRow], g: &Group, seq_s: f64, out: &mut ReportPlan)
     }
 }
 
-/// Charts 4 and 5 of `g`, with the core counts in `smt` shaded.
+/// How charts 3–5 say where their best cells come from.
+fn chosen(v: &GroupView) -> &'static str {
+    if v.is_confirmed() {
+        " (each best cell as the confirmation rounds measured it)"
+    } else {
+        " (each best cell as the grid's rounds that chose it measured it: biased fast)"
+    }
+}
+
+/// Charts 4 and 5 of `g`, from the best cells `bests`, with the core counts in `smt` shaded.
 fn speedup_and_efficiency_charts(
-    rows: &[SummaryRow],
     g: &Group,
+    bests: &[(SeriesKey, Vec<series::Best>)],
     smt: Option<SmtBand>,
     out: &mut ReportPlan,
 ) {
     let subtitle = g.label(LabelStyle::Report);
-    let lines = series::speedup_lines(rows, g);
+    let lines = series::speedup_lines(bests);
     let keys: Vec<SeriesKey> = lines.iter().filter_map(|l| l.series).collect();
     let styles = line_styles(&keys);
     let shaded = smt.as_ref().map_or_else(String::new, |b| {
@@ -294,14 +316,14 @@ fn speedup_and_efficiency_charts(
         "Speedup against cores, every strategy".to_owned(),
         format!(
             "Chart 4: every strategy's best speedup against cores, error bars the 95 % \
-             bootstrap interval of the best cell's speedup{styles}{shaded}; {subtitle}."
+             interval of the best cell's speedup paired by round{styles}{shaded}; {subtitle}."
         ),
         ChartKind::Speedup {
             lines,
             smt: smt.clone(),
         },
     );
-    let (efficiency, serial) = series::efficiency_lines(rows, g);
+    let (efficiency, serial) = series::efficiency_lines(bests);
     let per_physical = if smt.is_some() {
         " (the tables give the efficiency per physical core)"
     } else {
@@ -313,8 +335,9 @@ fn speedup_and_efficiency_charts(
         "Efficiency and Karp–Flatt serial fraction against cores".to_owned(),
         format!(
             "Chart 5: parallel efficiency S/p (above) and the Karp–Flatt serial fraction \
-             e = (1/S − 1/p)/(1 − 1/p) (below, only where S > 1 and p > 1) against \
-             cores{styles}{shaded}{per_physical}; {subtitle}."
+             e = (1/S − 1/p)/(1 − 1/p) with its 95 % interval (below, only where S > 1 and \
+             the interval lies above 0) against cores{styles}{shaded}{per_physical}; \
+             {subtitle}."
         ),
         ChartKind::Efficiency {
             efficiency,
@@ -373,6 +396,12 @@ mod tests {
     use crate::results::rows::tests::row;
     use crate::sph::neighbors::NeighborMode;
 
+    /// The plan of `rows` (no trials), the topology `topology`.
+    fn plan_of(rows: &[SummaryRow], topology: Option<&Topology>) -> ReportPlan {
+        let views = crate::report::view::tests::views(rows.to_vec(), Vec::new());
+        plan(&views, |_| topology)
+    }
+
     fn files(p: &ReportPlan) -> Vec<&str> {
         p.charts.iter().map(|c| c.file.as_str()).collect()
     }
@@ -385,7 +414,7 @@ mod tests {
             row(StrategyName::RayonChunks, 2, Some(5), 2.5),
             row(StrategyName::RayonChunks, 2, Some(10), 2.2),
         ];
-        let p = plan(&rows, |_| None);
+        let p = plan_of(&rows, None);
         assert_eq!(
             files(&p),
             [
@@ -420,7 +449,7 @@ mod tests {
             pinned(row(StrategyName::RayonChunks, 1, Some(5), 4.0), Pin::Spread),
             pinned(row(StrategyName::RayonChunks, 2, Some(5), 2.1), Pin::Spread),
         ];
-        let p = plan(&rows, |_| None);
+        let p = plan_of(&rows, None);
         assert_eq!(
             files(&p),
             [
@@ -472,7 +501,7 @@ mod tests {
             threads_per_core: Some(2),
             ..Topology::default()
         };
-        let p = plan(&rows, |_| Some(&smt));
+        let p = plan_of(&rows, Some(&smt));
         let band = |k: &ChartKind| match k {
             ChartKind::Speedup { smt, .. } | ChartKind::Efficiency { smt, .. } => smt.clone(),
             _ => None,
@@ -495,7 +524,7 @@ mod tests {
             physical_cores: Some(2),
             ..Topology::default()
         };
-        for p in [plan(&rows, |_| None), plan(&rows, |_| Some(&flat))] {
+        for p in [plan_of(&rows, None), plan_of(&rows, Some(&flat))] {
             assert!(p.charts.iter().all(|c| band(&c.kind).is_none()));
             assert!(p.charts.iter().all(|c| !c.caption.contains("shaded")));
         }
@@ -507,7 +536,7 @@ mod tests {
             row(StrategyName::Seq, 1, None, 4.0),
             row(StrategyName::RayonIter, 2, None, 2.0),
         ];
-        let p = plan(&rows, |_| None);
+        let p = plan_of(&rows, None);
         assert!(p.charts.is_empty(), "{:?}", files(&p));
         let notes: Vec<&str> = p.skipped.iter().map(|s| s.note.as_str()).collect();
         assert!(notes[0].contains("no strategy with chunks"), "{notes:?}");
@@ -520,7 +549,7 @@ mod tests {
             row(StrategyName::RayonIter, 2, None, 2.0),
             row(StrategyName::RayonIter, 3, None, 1.5),
         ];
-        let p = plan(&rows, |_| None);
+        let p = plan_of(&rows, None);
         assert!(p.charts.is_empty());
         assert!(p.skipped[1].note.contains("no usable seq reference"));
     }
@@ -531,7 +560,7 @@ mod tests {
         let mut grid = row(StrategyName::Seq, 1, None, 1.0);
         grid.neighbors = NeighborMode::Grid;
         rows.push(grid);
-        let p = plan(&rows, |_| None);
+        let p = plan_of(&rows, None);
         assert_eq!(files(&p), ["seed-6-neighbors.png"]);
         assert_eq!(p.charts[0].group, None);
         assert!(matches!(&p.charts[0].kind, ChartKind::Neighbors(lines) if lines.len() == 2));

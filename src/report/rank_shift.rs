@@ -1,12 +1,18 @@
 //! How the strategy ranking changes from the toy workload (a Müller preset) to the real one
 //! (`wcsph`) at one core count: a [`RankShift`], decided by [`rank_shift`] from each
-//! strategy's best cell, and its sentence. A change of place is stated only where the 95 %
-//! intervals are apart on both workloads.
+//! strategy's best cell, and its sentence. A change of place is stated only where both
+//! orders are resolved by their own workload's paired rounds ([`order`]): the two workloads
+//! ran at different times, so no number of one is set against the other's.
 
 use sph_strategies::StrategyName;
 
-use super::findings::{Entry, Verdict, and_list, apart, names, trusted, verdict, verdict_phrase};
+use super::findings::{Entry, Verdict, and_list, names, order, trusted, verdict, verdict_phrase};
 use super::series::{self, Best};
+
+/// Whether `a` is resolved faster than `b` by their paired rounds.
+fn ahead(a: &Best, b: &Best) -> bool {
+    matches!(order(a, b), super::findings::Order::AFaster(_))
+}
 
 /// The ranking of the toy workload (a Müller preset) against the real one (`wcsph`) at one
 /// core count, from each strategy's best cell there (see [`rank_shift`]).
@@ -22,15 +28,15 @@ pub struct RankShift {
     pub toy: Option<Verdict>,
     /// Who is fastest on wcsph.
     pub real: Option<Verdict>,
-    /// Strategies that passed others on wcsph with the intervals apart on both workloads,
-    /// each with those it passed (in toy order).
+    /// Strategies that passed others on wcsph with both orders resolved, each with those it
+    /// passed (in toy order).
     pub up: Vec<(StrategyName, Vec<StrategyName>)>,
     /// Strategies passed that way (in toy order).
     pub down: Vec<StrategyName>,
-    /// Pairs that swap places with overlapping (or missing) intervals on at least one
-    /// workload: (ahead on the toy workload, ahead on wcsph).
+    /// Pairs that swap places with an order not resolved on at least one workload: (ahead on
+    /// the toy workload, ahead on wcsph).
     pub unresolved: Vec<(StrategyName, StrategyName)>,
-    /// Without swaps: whether every neighbouring pair's intervals are apart on both.
+    /// Without swaps: whether every neighbouring pair's order is resolved on both.
     pub order_resolved: bool,
     /// Strategies with a trusted cell on only one workload: (toy only, wcsph only).
     pub one_sided: (Vec<StrategyName>, Vec<StrategyName>),
@@ -48,7 +54,7 @@ pub fn rank_shift(cores: usize, toy: &[Entry], real: &[Entry]) -> RankShift {
     let (ct, cr) = (common(&t, &r), common(&r, &t));
     let place = |v: &[Entry], s: StrategyName| v.iter().position(|(x, _)| *x == s);
     fn cell(v: &[Entry], s: StrategyName) -> Option<&Best> {
-        v.iter().find(|(x, _)| *x == s).map(|e| &e.1)
+        v.iter().find(|(x, _)| *x == s).map(|e| &*e.1)
     }
     let (mut up, mut down, mut unresolved) = (Vec::new(), Vec::new(), Vec::new());
     for (i, (a, ta)) in ct.iter().enumerate() {
@@ -60,7 +66,7 @@ pub fn rank_shift(cores: usize, toy: &[Entry], real: &[Entry]) -> RankShift {
             let (Some(ra), Some(rb)) = (cell(&cr, *a), cell(&cr, *b)) else {
                 continue;
             };
-            if apart(ta, tb) && apart(ra, rb) {
+            if ahead(ta, tb) && ahead(rb, ra) {
                 match up
                     .iter_mut()
                     .find(|(s, _): &&mut (StrategyName, Vec<_>)| s == b)
@@ -76,7 +82,7 @@ pub fn rank_shift(cores: usize, toy: &[Entry], real: &[Entry]) -> RankShift {
             }
         }
     }
-    let neighbours_apart = |v: &[Entry]| v.windows(2).all(|w| apart(&w[0].1, &w[1].1));
+    let neighbours_apart = |v: &[Entry]| v.windows(2).all(|w| ahead(&w[0].1, &w[1].1));
     let only = |v: &[Entry], other: &[Entry]| -> Vec<StrategyName> {
         v.iter()
             .map(|(s, _)| *s)
@@ -117,13 +123,13 @@ impl RankShift {
                 .map(|(s, past)| format!("{s} (past {})", names(past)))
                 .collect();
             out.push_str(&format!(
-                " Moved up on wcsph, with the 95 % intervals apart on both workloads: {}; \
-                 moved down: {}.",
+                " Moved up on wcsph, both orders resolved by their paired rounds: {}; moved \
+                 down: {}.",
                 up.join(", "),
                 names(&self.down)
             ));
         }
-        let not_resolved = "the 95 % intervals overlapping (or missing) on at least one workload";
+        let not_resolved = "the order not resolved by the paired rounds on at least one workload";
         match self.unresolved.len() {
             0 => {}
             // Past three swaps a list reads worse than the table beside it.
@@ -144,11 +150,11 @@ impl RankShift {
         }
         if self.up.is_empty() && self.unresolved.is_empty() {
             out.push_str(if self.order_resolved {
-                " Every strategy measured on both keeps its place, with the 95 % intervals \
-                 apart on both workloads."
+                " Every strategy measured on both keeps its place, each place resolved by the \
+                 paired rounds on both workloads."
             } else {
                 " Ranked by mean, every strategy measured on both keeps its place, though the \
-                 95 % intervals do not resolve every place."
+                 paired rounds do not resolve every place."
             });
         }
         let (toy_only, real_only) = &self.one_sided;
@@ -178,12 +184,12 @@ impl RankShift {
         };
         match (fastest(&self.toy), fastest(&self.real)) {
             (Some(a), Some(b)) if a == b => format!(
-                "the winner is the same: **{a}** is fastest on both workloads, its 95 % \
-                 interval apart from every other strategy's on each"
+                "the winner is the same: **{a}** is fastest on both workloads, faster than \
+                 every other strategy by the paired rounds on each"
             ),
             (Some(a), Some(b)) => format!(
                 "the winner changes: **{a}** is fastest on the toy workload and **{b}** on \
-                 wcsph, each with its 95 % interval apart from every other strategy's"
+                 wcsph, each faster than every other strategy by its own paired rounds"
             ),
             _ => format!(
                 "whether the winner is the same is not resolved: on the toy workload {}; on \
@@ -199,21 +205,34 @@ impl RankShift {
 mod tests {
     use super::*;
     use crate::report::findings::Finding;
-    use crate::report::findings::tests::with_ci;
+    use crate::report::view::{Batch, Runs};
+    use crate::results::rows::Phase;
     use crate::results::rows::tests::row;
 
-    /// A strategy's best cell at 2 cores: `mean` seconds, its interval `mean ± half`.
-    fn entry(s: StrategyName, mean: f64, half: f64) -> Entry {
-        let r = with_ci(row(s, 2, None, mean), mean - half, mean + half);
-        (
-            s,
-            series::best_per_cores(
-                std::slice::from_ref(&r),
-                &r.group(),
-                series::SeriesKey::unpinned(s),
-            )
-            .remove(0),
-        )
+    /// A strategy's best cell at 2 cores with these walls per round (its mean theirs), its
+    /// runs paired with the other cells of its workload.
+    fn entry(s: StrategyName, walls: &[f64]) -> Entry {
+        let mean = walls.iter().sum::<f64>() / walls.len() as f64;
+        let runs = Runs {
+            batch: Batch {
+                source: 0,
+                phase: Phase::Grid,
+                shard: None,
+                paired: true,
+            },
+            rounds: walls
+                .iter()
+                .copied()
+                .enumerate()
+                .map(|(i, w)| (i + 1, w))
+                .collect(),
+        };
+        (s, Box::new(Best::of(&row(s, 2, None, mean), runs).unwrap()))
+    }
+
+    /// `mean` times the same drift in every strategy: orders between these are resolved.
+    fn steady(s: StrategyName, mean: f64) -> Entry {
+        entry(s, &[mean, mean * 1.05, mean * 0.95])
     }
 
     fn shift(toy: &[Entry], real: &[Entry]) -> String {
@@ -221,34 +240,35 @@ mod tests {
     }
 
     #[test]
-    fn a_ranking_that_holds_with_intervals_apart_names_the_same_winner() {
+    fn a_ranking_resolved_on_both_workloads_names_the_same_winner() {
         use StrategyName::{RayonChunks, RayonIter};
-        let toy = [entry(RayonChunks, 2.0, 0.05), entry(RayonIter, 2.6, 0.05)];
-        let real = [entry(RayonIter, 3.0, 0.05), entry(RayonChunks, 2.5, 0.05)];
+        let toy = [steady(RayonChunks, 2.0), steady(RayonIter, 2.6)];
+        let real = [steady(RayonIter, 3.0), steady(RayonChunks, 2.5)];
         assert_eq!(
             shift(&toy, &real),
             "At 2 cores, the winner is the same: **rayon-chunks** is fastest on both workloads, \
-             its 95 % interval apart from every other strategy's on each. Every strategy \
-             measured on both keeps its place, with the 95 % intervals apart on both workloads."
+             faster than every other strategy by the paired rounds on each. Every strategy \
+             measured on both keeps its place, each place resolved by the paired rounds on both \
+             workloads."
         );
     }
 
     #[test]
-    fn a_strategy_that_passes_another_beyond_the_intervals_moved_up_and_the_other_down() {
+    fn a_strategy_that_passes_another_with_both_orders_resolved_moved_up_and_the_other_down() {
         use StrategyName::{CrossbeamPool, RayonChunks, RayonIter, StdStatic};
         let toy = [
-            entry(RayonChunks, 1.0, 0.01),
-            entry(CrossbeamPool, 1.1, 0.01),
-            entry(RayonIter, 1.2, 0.01),
-            entry(StdStatic, 1.3, 0.01),
+            steady(RayonChunks, 1.0),
+            steady(CrossbeamPool, 1.1),
+            steady(RayonIter, 1.2),
+            steady(StdStatic, 1.3),
         ];
         // On wcsph std-static passes crossbeam-pool and rayon-iter; rayon-iter passes
-        // crossbeam-pool within the intervals only.
+        // crossbeam-pool, but their rounds disagree.
         let real = [
-            entry(RayonChunks, 1.0, 0.01),
-            entry(StdStatic, 1.05, 0.01),
-            entry(RayonIter, 1.2, 0.03),
-            entry(CrossbeamPool, 1.21, 0.03),
+            steady(RayonChunks, 1.0),
+            steady(StdStatic, 1.05),
+            steady(RayonIter, 1.2),
+            entry(CrossbeamPool, &[1.21, 1.24, 1.18]),
         ];
         let f = shift(&toy, &real);
         assert!(
@@ -257,14 +277,15 @@ mod tests {
         );
         assert!(
             f.contains(
-                "Moved up on wcsph, with the 95 % intervals apart on both workloads: std-static \
-                 (past crossbeam-pool and rayon-iter); moved down: crossbeam-pool and rayon-iter."
+                "Moved up on wcsph, both orders resolved by their paired rounds: std-static \
+                 (past crossbeam-pool and rayon-iter); moved down: crossbeam-pool and \
+                 rayon-iter."
             ),
             "{f}"
         );
         assert!(
             f.contains(
-                "Not resolved, the 95 % intervals overlapping (or missing) on at least one \
+                "Not resolved, the order not resolved by the paired rounds on at least one \
                  workload: rayon-iter now ahead of crossbeam-pool."
             ),
             "{f}"
@@ -272,16 +293,19 @@ mod tests {
     }
 
     #[test]
-    fn overlapping_intervals_leave_the_winner_and_the_swap_unresolved() {
+    fn rounds_that_disagree_leave_the_winner_and_the_swap_unresolved() {
         use StrategyName::{RayonChunks, RayonIter};
-        let toy = [entry(RayonChunks, 2.0, 0.2), entry(RayonIter, 2.1, 0.2)];
-        let real = [entry(RayonIter, 2.0, 0.05), entry(RayonChunks, 2.5, 0.05)];
+        let toy = [
+            entry(RayonChunks, &[2.0, 2.4, 1.6]),
+            entry(RayonIter, &[2.1, 2.2, 1.9]),
+        ];
+        let real = [steady(RayonIter, 2.0), steady(RayonChunks, 2.5)];
         let f = shift(&toy, &real);
         assert!(
             f.starts_with(
                 "At 2 cores, whether the winner is the same is not resolved: on the toy \
-                 workload rayon-chunks and rayon-iter are indistinguishable within the trial \
-                 spread (their 95 % intervals overlap); on wcsph **rayon-iter** is fastest."
+                 workload rayon-chunks and rayon-iter are not distinguishable by their paired \
+                 rounds; on wcsph **rayon-iter** is fastest."
             ),
             "{f}"
         );
@@ -292,12 +316,12 @@ mod tests {
     #[test]
     fn contended_and_oversubscribed_cells_are_named_as_caveats_and_left_out() {
         use StrategyName::{RayonChunks, RayonIter, StdStatic};
-        let mut noisy = entry(StdStatic, 0.5, 0.01);
+        let mut noisy = steady(StdStatic, 0.5);
         noisy.1.contended = true;
-        let mut over = entry(RayonIter, 2.6, 0.05);
+        let mut over = steady(RayonIter, 2.6);
         over.1.oversubscribed = true;
-        let toy = [noisy, entry(RayonChunks, 2.0, 0.05), over];
-        let real = [entry(RayonChunks, 2.0, 0.05), entry(StdStatic, 2.2, 0.05)];
+        let toy = [noisy, steady(RayonChunks, 2.0), over];
+        let real = [steady(RayonChunks, 2.0), steady(StdStatic, 2.2)];
         let f = shift(&toy, &real);
         assert!(
             f.starts_with(
@@ -323,18 +347,20 @@ mod tests {
     #[test]
     fn without_intervals_no_winner_and_no_move_is_claimed() {
         use StrategyName::{RayonChunks, RayonIter};
-        let bare = |s, mean| {
-            let mut e = entry(s, mean, 0.0);
-            e.1.mean_ci = None;
-            e
-        };
-        let toy = [bare(RayonChunks, 2.0), bare(RayonIter, 2.6)];
-        let real = [bare(RayonIter, 2.0), bare(RayonChunks, 2.6)];
+        let toy = [
+            entry(RayonChunks, &[2.0, 2.0]),
+            entry(RayonIter, &[2.6, 2.6]),
+        ];
+        let real = [
+            entry(RayonIter, &[2.0, 2.0]),
+            entry(RayonChunks, &[2.6, 2.6]),
+        ];
         let f = shift(&toy, &real);
         assert!(
             f.contains(
-                "on the toy workload the lowest mean is rayon-chunks's, but without \
-                        confidence intervals no strategy can be called fastest"
+                "on the toy workload the lowest mean is rayon-chunks's, but with only 2 paired \
+                 rounds in common (3 are needed for an interval), so no strategy can be called \
+                 fastest"
             ),
             "{f}"
         );

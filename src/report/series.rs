@@ -1,5 +1,6 @@
-//! Pure functions from summary rows to what the charts and the report show: groups, lines of
-//! points, the best cell per core count, speedup spreads, the Karp–Flatt serial fraction.
+//! Pure functions from summary rows and a group's view ([`GroupView`]) to what the charts and
+//! the report show: groups, lines of points, a best cell's numbers ([`Best`]), speedup
+//! intervals, the Karp–Flatt serial fraction with its interval.
 //!
 //! Only cells with `status = ok` and a mean enter a series; failed cells are listed by the
 //! report instead. Times are seconds.
@@ -14,6 +15,7 @@ use crate::results::stats::Interval;
 
 use sph_strategies::StrategyName;
 
+use super::view::{GroupView, Runs};
 pub use crate::results::key::Group;
 use crate::results::rows::{Contended, SummaryRow, fastest};
 use crate::sph::neighbors::NeighborMode;
@@ -72,7 +74,7 @@ impl SeriesKey {
     }
 
     /// Whether a row belongs to the series (any group).
-    fn holds(&self, r: &SummaryRow) -> bool {
+    pub fn holds(&self, r: &SummaryRow) -> bool {
         r.strategy == self.strategy && r.pin == self.pin
     }
 }
@@ -135,14 +137,6 @@ pub fn cores(rows: &[SummaryRow], group: &Group) -> Vec<usize> {
     set.into_iter().collect()
 }
 
-/// The group's reference: `seq`'s mean seconds.
-pub fn seq_mean(rows: &[SummaryRow], group: &Group) -> Option<f64> {
-    ok_rows(rows, group)
-        .iter()
-        .find(|r| r.is_reference())
-        .and_then(|r| r.mean_s)
-}
-
 /// A point with its uncertainty: `y` the value, `lo..hi` its 95 % confidence interval
 /// (equal to `y` when unknown).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -157,8 +151,7 @@ pub struct Point {
     pub hi: f64,
     /// Whether the cell used more threads than the machine has.
     pub oversubscribed: bool,
-    /// Whether other work used the machine while the cell was measured (or a trial ran
-    /// passes alone: its threads got less CPU time than its chunks had work for).
+    /// Whether other work used the machine while the cell was measured.
     pub contended: bool,
 }
 
@@ -186,15 +179,27 @@ pub struct Line {
     /// The strategy and placement it shows, where it shows one (its colour and line style);
     /// `None` for lines of core counts or neighbour searches.
     pub series: Option<SeriesKey>,
+    /// Each trial behind the points, as (its point's x, its value): chart 1 draws them beside
+    /// their mean.
+    pub dots: Vec<(f64, f64)>,
 }
 
 impl Line {
-    /// A line that shows no series (see [`Line::series`]).
+    /// A line that shows no series (see [`Line::series`]) and no trials.
     pub fn new(label: impl Into<String>, points: Vec<Point>) -> Line {
         Line {
             label: label.into(),
             points,
             series: None,
+            dots: Vec::new(),
+        }
+    }
+
+    /// A line of the series `key`, without trials.
+    pub fn of(key: SeriesKey, points: Vec<Point>) -> Line {
+        Line {
+            series: Some(key),
+            ..Line::new(key.to_string(), points)
         }
     }
 
@@ -217,26 +222,33 @@ impl Line {
 /// What a chunks chart shows on its y axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Metric {
-    /// Mean wall seconds (spread: fastest to slowest trial).
+    /// Mean wall seconds (bars: the 95 % interval; dots: each trial).
     Wall,
     /// Mean CPU seconds, user + system.
     Cpu,
 }
 
 /// One line per core count: `metric` against chunks, for the series `key` of a chunked
-/// strategy in `group` (Figures 7 and 8 of the paper).
-pub fn chunk_lines(
-    rows: &[SummaryRow],
-    group: &Group,
-    key: SeriesKey,
-    metric: Metric,
-) -> Vec<Line> {
+/// strategy in the grid rows of `view` (Figures 7 and 8 of the paper); runtime lines carry
+/// each trial as a dot.
+pub fn chunk_lines(view: &GroupView, key: SeriesKey, metric: Metric) -> Vec<Line> {
+    let (rows, group) = (&view.rows, &view.group);
     let ok = ok_rows(rows, group);
     let mut out = Vec::new();
     for c in cores(rows, group) {
-        let mut points: Vec<Point> = ok
+        let cells: Vec<&SummaryRow> = ok
             .iter()
+            .copied()
             .filter(|r| key.holds(r) && r.cores == c)
+            .collect();
+        let mut dots: Vec<(f64, f64)> = Vec::new();
+        for r in cells.iter().filter(|_| metric == Metric::Wall) {
+            if let Some(k) = r.chunks {
+                dots.extend(view.runs(r).walls().map(|w| (k as f64, w)));
+            }
+        }
+        let mut points: Vec<Point> = cells
+            .iter()
             .filter_map(|r| {
                 let x = r.chunks? as f64;
                 let (y, lo, hi) = match metric {
@@ -267,7 +279,10 @@ pub fn chunk_lines(
             continue;
         }
         points.sort_by(|a, b| a.x.total_cmp(&b.x));
-        out.push(Line::new(cores_label(c), points));
+        out.push(Line {
+            dots,
+            ..Line::new(cores_label(c), points)
+        });
     }
     out
 }
@@ -277,81 +292,82 @@ pub fn cores_label(c: usize) -> String {
     format!("{c} {}", if c == 1 { "core" } else { "cores" })
 }
 
-/// The fastest cell of a strategy at one core count.
+/// A strategy's best cell at one core count ([`GroupView::best_per_cores`]), or any cell
+/// with its runs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Best {
+    /// The strategy.
+    pub strategy: StrategyName,
     /// Worker threads.
     pub cores: usize,
-    /// Chunks of the fastest cell (`None` for strategies without chunks).
+    /// Chunks of the cell (`None` for strategies without chunks).
     pub chunks: Option<usize>,
     /// Where its threads ran.
     pub pin: Pin,
     /// Mean wall seconds.
     pub mean_s: f64,
-    /// Sample standard deviation (`None` for one trial).
-    pub stddev_s: Option<f64>,
+    /// Median wall seconds.
+    pub median_s: f64,
     /// Fastest trial.
     pub min_s: f64,
-    /// Slowest trial.
-    pub max_s: f64,
-    /// The group's `seq` mean over this mean.
+    /// The speedup over the group's `seq` of the same rounds (paired by round).
     pub speedup: Option<f64>,
     /// Speedup over cores.
     pub efficiency: Option<f64>,
     /// More threads than the machine has.
     pub oversubscribed: bool,
-    /// 95 % interval of the mean seconds (`None` for one trial or an older sweep).
+    /// 95 % interval of the typical seconds (`None` under 3 trials or in an older sweep).
     pub mean_ci: Option<Interval>,
     /// 95 % interval of the speedup.
     pub speedup_ci: Option<Interval>,
     /// Other work used the machine while it was measured.
     pub contended: bool,
+    /// Whether its numbers come from confirmation rounds, which did not choose it; `false`:
+    /// from the grid's rounds, which chose it too (biased fast).
+    pub confirmed: bool,
+    /// Its runs, by round: what comparisons pair.
+    pub runs: Runs,
 }
 
 impl Best {
-    /// A usable cell's numbers (`None` without a mean).
-    pub fn of(r: &SummaryRow) -> Option<Best> {
+    /// A usable cell's numbers with its `runs` (`None` without a mean).
+    pub fn of(r: &SummaryRow, runs: Runs) -> Option<Best> {
         let mean_s = r.mean_s?;
         Some(Best {
+            strategy: r.strategy,
             cores: r.cores,
             chunks: r.chunks,
             pin: r.pin,
             mean_s,
-            stddev_s: r.stddev_s,
+            median_s: r.median_s.unwrap_or(mean_s),
             min_s: r.min_s.unwrap_or(mean_s),
-            max_s: r.max_s.unwrap_or(mean_s),
             speedup: r.speedup,
             efficiency: r.efficiency,
             oversubscribed: r.oversubscribed,
             mean_ci: interval(r.mean_ci_low_s, r.mean_ci_high_s),
             speedup_ci: interval(r.speedup_ci_low, r.speedup_ci_high),
             contended: r.contended == Some(true),
+            confirmed: r.phase == crate::results::rows::Phase::Confirm,
+            runs,
         })
     }
 
-    /// The Karp–Flatt serial fraction at this cell (see [`karp_flatt`]).
-    pub fn serial_fraction(&self) -> Option<f64> {
-        karp_flatt(self.speedup?, self.cores)
+    /// The series it belongs to.
+    pub fn key(&self) -> SeriesKey {
+        SeriesKey::new(self.strategy, self.pin)
     }
-}
 
-/// The fastest usable cell of the series `key` in `group` at each core count, by cores.
-pub fn best_per_cores(rows: &[SummaryRow], group: &Group, key: SeriesKey) -> Vec<Best> {
-    let ok = ok_rows(rows, group);
-    let mut set: BTreeSet<usize> = BTreeSet::new();
-    for r in ok.iter().filter(|r| key.holds(r)) {
-        set.insert(r.cores);
+    /// The Karp–Flatt serial fraction at this cell with its 95 % interval, the speedup's
+    /// carried through [`karp_flatt`] (which falls as the speedup rises); `None` without an
+    /// interval, at a speedup of 1 or less, and wherever the interval reaches 0 or below.
+    pub fn serial_fraction(&self) -> Option<(f64, Interval)> {
+        let s = self.speedup.filter(|&s| s > 1.0)?;
+        let i = self.speedup_ci?;
+        let e = karp_flatt(s, self.cores)?;
+        let low = karp_flatt(i.high, self.cores)?;
+        let high = karp_flatt(i.low, self.cores)?;
+        (low > 0.0).then_some((e, Interval { low, high }))
     }
-    set.into_iter()
-        .filter_map(|c| {
-            // The fastest trustworthy cell; a contended one only when all of them are.
-            let r = fastest(
-                ok.iter().copied().filter(|r| key.holds(r) && r.cores == c),
-                Contended::LastResort,
-            )?;
-            Best::of(r)
-        })
-        .collect()
 }
 
 /// An interval from its two ends, if both are known.
@@ -372,88 +388,76 @@ pub fn karp_flatt(speedup: f64, p: usize) -> Option<f64> {
     Some((1.0 / speedup - 1.0 / p) / (1.0 - 1.0 / p))
 }
 
-/// Best lines per series of `group` ([`series`]: every strategy but `seq`, at each of its
-/// placements): speedup against cores, with the best cell's 95 % interval of the speedup.
-pub fn speedup_lines(rows: &[SummaryRow], group: &Group) -> Vec<Line> {
-    let Some(seq) = seq_mean(rows, group) else {
-        return Vec::new();
-    };
-    series(rows, group)
-        .into_iter()
-        .filter_map(|key| {
-            let points: Vec<Point> = best_per_cores(rows, group, key)
+/// A best cell as a point at its cores: `y` and its interval `(lo, hi)`.
+fn at_cores(b: &Best, y: f64, (lo, hi): (f64, f64)) -> Point {
+    Point {
+        x: b.cores as f64,
+        y,
+        lo,
+        hi,
+        oversubscribed: b.oversubscribed,
+        contended: b.contended,
+    }
+}
+
+/// Per series of `bests` ([`GroupView::series_bests`]): speedup against cores, bars the 95 %
+/// interval of the best cell's paired speedup.
+pub fn speedup_lines(bests: &[(SeriesKey, Vec<Best>)]) -> Vec<Line> {
+    bests
+        .iter()
+        .filter_map(|(key, best)| {
+            let points: Vec<Point> = best
                 .iter()
-                .map(|b| {
-                    let y = seq / b.mean_s;
-                    Point {
-                        x: b.cores as f64,
-                        y,
-                        lo: b.speedup_ci.map_or(y, |i| i.low),
-                        hi: b.speedup_ci.map_or(y, |i| i.high),
-                        oversubscribed: b.oversubscribed,
-                        contended: b.contended,
-                    }
+                .filter_map(|b| {
+                    let y = b.speedup?;
+                    let i = b.speedup_ci.map_or((y, y), |i| (i.low, i.high));
+                    Some(at_cores(b, y, i))
                 })
                 .collect();
-            (!points.is_empty()).then_some(Line {
-                label: key.to_string(),
-                points,
-                series: Some(key),
-            })
+            (!points.is_empty()).then(|| Line::of(*key, points))
         })
         .collect()
 }
 
-/// Best runtime against cores for one series (bars: 95 % interval of the mean).
+/// Best runtime against cores for one series (bars: 95 % interval of the typical time).
 pub fn runtime_line(best: &[Best], key: SeriesKey) -> Line {
-    Line {
-        label: key.to_string(),
-        series: Some(key),
-        points: best
-            .iter()
-            .map(|b| Point {
-                x: b.cores as f64,
-                y: b.mean_s,
-                lo: b.mean_ci.map_or(b.mean_s, |i| i.low),
-                hi: b.mean_ci.map_or(b.mean_s, |i| i.high),
-                oversubscribed: b.oversubscribed,
-                contended: b.contended,
-            })
-            .collect(),
-    }
+    let points = best
+        .iter()
+        .map(|b| {
+            let i = b.mean_ci.map_or((b.mean_s, b.mean_s), |i| (i.low, i.high));
+            at_cores(b, b.mean_s, i)
+        })
+        .collect();
+    Line::of(key, points)
 }
 
-/// Per strategy, efficiency against cores (all core counts) and the Karp–Flatt fraction
-/// against cores (only where it means something: at least 2 cores and a speedup above 1).
-pub fn efficiency_lines(rows: &[SummaryRow], group: &Group) -> (Vec<Line>, Vec<Line>) {
+/// Per series of `bests`, efficiency against cores (every core count with a speedup) and the
+/// Karp–Flatt serial fraction with its interval, only where [`Best::serial_fraction`] gives
+/// one.
+pub fn efficiency_lines(bests: &[(SeriesKey, Vec<Best>)]) -> (Vec<Line>, Vec<Line>) {
     let mut eff = Vec::new();
     let mut kf = Vec::new();
-    for line in speedup_lines(rows, group) {
-        let point = |p: &Point, y: f64| Point {
-            x: p.x,
-            y,
-            lo: y,
-            hi: y,
-            oversubscribed: p.oversubscribed,
-            contended: p.contended,
-        };
-        eff.push(Line {
-            label: line.label.clone(),
-            points: line.points.iter().map(|p| point(p, p.y / p.x)).collect(),
-            series: line.series,
-        });
-        let k: Vec<Point> = line
-            .points
+    for (key, best) in bests {
+        let e: Vec<Point> = best
             .iter()
-            .filter(|p| p.y > 1.0)
-            .filter_map(|p| Some(point(p, karp_flatt(p.y, p.x as usize)?)))
+            .filter_map(|b| {
+                let y = b.speedup? / b.cores as f64;
+                Some(at_cores(b, y, (y, y)))
+            })
+            .collect();
+        if e.is_empty() {
+            continue;
+        }
+        eff.push(Line::of(*key, e));
+        let k: Vec<Point> = best
+            .iter()
+            .filter_map(|b| {
+                let (e, i) = b.serial_fraction()?;
+                Some(at_cores(b, e, (i.low, i.high)))
+            })
             .collect();
         if !k.is_empty() {
-            kf.push(Line {
-                label: line.label,
-                points: k,
-                series: line.series,
-            });
+            kf.push(Line::of(*key, k));
         }
     }
     (eff, kf)
@@ -541,38 +545,37 @@ pub fn presets(rows: &[SummaryRow]) -> Vec<Preset> {
     out
 }
 
-/// One cell of a chunks line: (chunks, mean seconds, stddev seconds).
-pub type ChunkCell = (usize, f64, f64);
-
-/// For a chunks line: the smallest chunk count from which no larger count improves the mean by
-/// more than the spread (the larger of the two cells' stddevs; 0 when unknown). `None` for an
-/// empty line.
-pub fn chunking_stops_paying(line: &[ChunkCell]) -> Option<usize> {
-    // line: (chunks, mean, stddev), sorted by chunks.
-    (0..line.len())
-        .find(|&i| {
-            let (_, t, s) = line[i];
-            line[i + 1..].iter().all(|&(_, u, su)| t - u <= s.max(su))
-        })
-        .map(|i| line[i].0)
+/// For a chunks line (chunks ascending, each cell's grid runs): the smallest chunk count from
+/// which no larger count is faster by the paired rounds (the 95 % interval of the time ratio
+/// below 1). `None` for an empty line, or where some pair has no interval (under 3 rounds,
+/// runs that do not pair): then nothing is known.
+pub fn chunking_stops_paying(line: &[(usize, Runs)]) -> Option<usize> {
+    let mut from = None;
+    for (i, (k, runs)) in line.iter().enumerate().rev() {
+        let mut beaten = false;
+        for (_, later) in &line[i + 1..] {
+            let r = later.ratio(runs)?;
+            r.interval?;
+            beaten |= r.resolved() && r.value < 1.0;
+        }
+        if !beaten {
+            from = Some(*k);
+        }
+    }
+    from
 }
 
-/// The chunks lines of a series in a form for [`chunking_stops_paying`]: per core count,
-/// `(cores, [(chunks, mean, stddev)])`.
-pub fn chunk_table(
-    rows: &[SummaryRow],
-    group: &Group,
-    key: SeriesKey,
-) -> Vec<(usize, Vec<ChunkCell>)> {
-    let ok = ok_rows(rows, group);
-    cores(rows, group)
+/// The chunks lines of a series in the grid rows of `view`, for [`chunking_stops_paying`]:
+/// per core count, `(cores, [(chunks, runs)])` of its cells measured without contention.
+pub fn chunk_table(view: &GroupView, key: SeriesKey) -> Vec<(usize, Vec<(usize, Runs)>)> {
+    let ok = ok_rows(&view.rows, &view.group);
+    cores(&view.rows, &view.group)
         .into_iter()
         .map(|c| {
-            let mut v: Vec<ChunkCell> = ok
+            let mut v: Vec<(usize, Runs)> = ok
                 .iter()
-                .filter(|r| key.holds(r) && r.cores == c)
-                .filter(|r| r.contended != Some(true))
-                .filter_map(|r| Some((r.chunks?, r.mean_s?, r.stddev_s.unwrap_or(0.0))))
+                .filter(|r| key.holds(r) && r.cores == c && r.contended != Some(true))
+                .filter_map(|r| Some((r.chunks?, view.runs(r))))
                 .collect();
             v.sort_by_key(|t| t.0);
             (c, v)
@@ -626,6 +629,7 @@ pub fn smt_band(topology: &Topology, cores: &[usize]) -> Option<SmtBand> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::report::view::tests::{of_rows, view, views};
     use crate::results::rows::Status;
     use crate::results::rows::tests::row;
 
@@ -655,10 +659,44 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn the_serial_fraction_carries_the_speedups_interval_and_needs_it_above_zero() {
+        let v = of_rows(sample());
+        let mut b = v.best_per_cores(SeriesKey::unpinned(StrategyName::RayonIter))[0].clone();
+        // Speedup 1.6 [1.5–1.7] at 2 cores: e = 0.25, from e(1.7) to e(1.5).
+        (b.speedup, b.speedup_ci) = (
+            Some(1.6),
+            Some(Interval {
+                low: 1.5,
+                high: 1.7,
+            }),
+        );
+        let (e, i) = b.serial_fraction().unwrap();
+        assert!((e - 0.25).abs() < 1e-12);
+        assert!((i.low - (2.0 / 1.7 - 1.0)).abs() < 1e-12);
+        assert!((i.high - (2.0 / 1.5 - 1.0)).abs() < 1e-12);
+        // An interval reaching the ideal speedup (e ≤ 0), a speedup of 1 or less, or no
+        // interval: none.
+        b.speedup_ci = Some(Interval {
+            low: 1.5,
+            high: 2.0,
+        });
+        assert_eq!(b.serial_fraction(), None);
+        (b.speedup, b.speedup_ci) = (
+            Some(0.9),
+            Some(Interval {
+                low: 0.8,
+                high: 0.95,
+            }),
+        );
+        assert_eq!(b.serial_fraction(), None);
+        (b.speedup, b.speedup_ci) = (Some(1.6), None);
+        assert_eq!(b.serial_fraction(), None);
+    }
+
+    #[test]
     fn the_best_cell_per_cores_is_the_fastest_usable_one() {
-        let rows = sample();
-        let g = rows[0].group();
-        let best = best_per_cores(&rows, &g, SeriesKey::unpinned(StrategyName::RayonChunks));
+        let v = of_rows(sample());
+        let best = v.best_per_cores(SeriesKey::unpinned(StrategyName::RayonChunks));
         assert_eq!(best.len(), 2);
         assert_eq!(
             (best[0].cores, best[0].chunks, best[0].mean_s),
@@ -672,56 +710,77 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn chunk_lines_have_one_line_per_cores_sorted_by_chunks_with_their_minimum() {
-        let rows = sample();
-        let g = rows[0].group();
-        let lines = chunk_lines(
-            &rows,
-            &g,
-            SeriesKey::unpinned(StrategyName::RayonChunks),
-            Metric::Wall,
-        );
+    fn chunk_lines_have_one_line_per_cores_sorted_by_chunks_each_trial_a_dot() {
+        use StrategyName::{RayonChunks, Seq};
+        let none = Pin::None;
+        let v = view(&[
+            (Seq, 1, None, none, &[4.0, 4.0, 4.0]),
+            (RayonChunks, 1, Some(10), none, &[4.2, 4.3, 4.1]),
+            (RayonChunks, 1, Some(5), none, &[4.1, 4.0, 4.2]),
+            (RayonChunks, 2, Some(5), none, &[2.5, 2.6, 2.4]),
+            (RayonChunks, 2, Some(10), none, &[2.2, 2.1, 2.3]),
+        ]);
+        let key = SeriesKey::unpinned(RayonChunks);
+        let lines = chunk_lines(&v, key, Metric::Wall);
         assert_eq!(lines.len(), 2);
         assert_eq!(lines[0].label, "1 core");
         assert_eq!(lines[0].points[0].x, 5.0);
         assert_eq!(lines[0].min_index(), Some(0));
         assert_eq!(lines[1].min_index(), Some(1));
-        let cpu = chunk_lines(
-            &rows,
-            &g,
-            SeriesKey::unpinned(StrategyName::RayonChunks),
-            Metric::Cpu,
+        // Every trial of the line is a dot at its cell's chunks.
+        assert_eq!(
+            lines[1].dots,
+            [
+                (5.0, 2.5),
+                (5.0, 2.6),
+                (5.0, 2.4),
+                (10.0, 2.2),
+                (10.0, 2.1),
+                (10.0, 2.3)
+            ]
         );
-        assert_eq!(cpu[1].points[1].y, 4.4);
+        let cpu = chunk_lines(&v, key, Metric::Cpu);
+        assert!((cpu[1].points[1].y - 4.4).abs() < 1e-12);
+        assert!(cpu.iter().all(|l| l.dots.is_empty()));
     }
 
     #[test]
-    fn speedup_lines_skip_seq_and_carry_the_trial_spread_and_oversubscription() {
-        let rows = sample();
-        let g = rows[0].group();
-        let lines = speedup_lines(&rows, &g);
+    fn speedup_lines_skip_seq_and_carry_the_paired_interval_and_oversubscription() {
+        let v = of_rows(sample());
+        let lines = speedup_lines(&v.series_bests());
         let labels: Vec<&str> = lines.iter().map(|l| l.label.as_str()).collect();
         assert_eq!(labels, ["rayon-chunks", "rayon-iter"]);
         let p = lines[1].points[1];
         assert_eq!((p.x, p.y), (3.0, 4.0 / 2.4));
         assert!(p.oversubscribed);
         assert!(p.lo < p.y && p.y < p.hi);
-        let (eff, kf) = efficiency_lines(&rows, &g);
+        let (eff, kf) = efficiency_lines(&v.series_bests());
         assert_eq!(eff[1].points[0].y, 1.0);
+        // rayon-chunks at 2 cores: speedup 1.82 [1.73–1.91], so e from 0.0476 to 0.156.
         assert_eq!(kf[0].points.len(), 1, "no Karp–Flatt value at 1 core");
+        let k = kf[0].points[0];
+        assert!(k.lo > 0.0 && k.lo < k.y && k.y < k.hi, "{k:?}");
     }
 
     #[test]
-    fn chunking_stops_paying_where_no_larger_count_beats_the_spread() {
-        let line = [
-            (2, 10.0, 0.1),
-            (5, 8.0, 0.1),
-            (10, 7.95, 0.1),
-            (20, 7.9, 0.1),
-        ];
-        assert_eq!(chunking_stops_paying(&line), Some(5));
-        assert_eq!(chunking_stops_paying(&[(2, 1.0, 0.0)]), Some(2));
+    fn chunking_stops_paying_where_no_larger_count_is_faster_by_the_paired_rounds() {
+        use StrategyName::{RayonChunks, Seq};
+        let none = Pin::None;
+        let v = view(&[
+            (Seq, 1, None, none, &[4.0, 4.4, 3.6]),
+            (RayonChunks, 2, Some(2), none, &[3.0, 3.3, 2.7]),
+            (RayonChunks, 2, Some(5), none, &[2.0, 2.2, 1.8]),
+            // Faster on average, but not in every round.
+            (RayonChunks, 2, Some(10), none, &[1.9, 2.3, 1.7]),
+        ]);
+        let table = chunk_table(&v, SeriesKey::unpinned(RayonChunks));
+        assert_eq!(chunking_stops_paying(&table[0].1), Some(5));
+        assert_eq!(chunking_stops_paying(&table[0].1[..1]), Some(2));
         assert_eq!(chunking_stops_paying(&[]), None);
+        // Without trials nothing pairs, and nothing is known.
+        let bare = of_rows(sample());
+        let table = chunk_table(&bare, SeriesKey::unpinned(RayonChunks));
+        assert_eq!(chunking_stops_paying(&table[0].1), None);
     }
 
     #[test]
@@ -773,10 +832,11 @@ pub(crate) mod tests {
         );
         assert!(is_pinned(&rows, &g));
         assert!(!is_pinned(&rows[..2], &g));
-        let none = best_per_cores(&rows, &g, SeriesKey::unpinned(RayonChunks));
+        let v = views(rows, Vec::new()).remove(0);
+        let none = v.best_per_cores(SeriesKey::unpinned(RayonChunks));
         assert_eq!(none.len(), 1);
         assert_eq!((none[0].mean_s, none[0].pin), (2.2, Pin::None));
-        let spread = best_per_cores(&rows, &g, SeriesKey::new(RayonChunks, Pin::Spread));
+        let spread = v.best_per_cores(SeriesKey::new(RayonChunks, Pin::Spread));
         assert_eq!(
             spread
                 .iter()
@@ -785,7 +845,8 @@ pub(crate) mod tests {
             [(1, 4.1), (2, 1.9)]
         );
 
-        let lines = speedup_lines(&rows, &g);
+        let bests = v.series_bests();
+        let lines = speedup_lines(&bests);
         let labels: Vec<&str> = lines.iter().map(|l| l.label.as_str()).collect();
         assert_eq!(
             labels,
@@ -800,16 +861,11 @@ pub(crate) mod tests {
         assert_eq!(pins, [Pin::None, Pin::Compact, Pin::Spread, Pin::None]);
         assert_eq!(lines[0].points[0].y, 4.0 / 2.2);
         assert_eq!(lines[2].points[1].y, 4.0 / 1.9);
-        let (eff, _) = efficiency_lines(&rows, &g);
+        let (eff, _) = efficiency_lines(&bests);
         assert_eq!(eff[2].series, lines[2].series);
 
         // A chunks chart per placement: the spread one holds only spread cells.
-        let wall = chunk_lines(
-            &rows,
-            &g,
-            SeriesKey::new(RayonChunks, Pin::Spread),
-            Metric::Wall,
-        );
+        let wall = chunk_lines(&v, SeriesKey::new(RayonChunks, Pin::Spread), Metric::Wall);
         let ys: Vec<f64> = wall
             .iter()
             .flat_map(|l| l.points.iter().map(|p| p.y))

@@ -1,7 +1,8 @@
 //! Chart 5: parallel efficiency `S / p` (above) and the Karp–Flatt serial fraction
-//! `e = (1/S − 1/p) / (1 − 1/p)` (below, from 2 cores and only where S > 1) against cores, one
-//! line per strategy and placement; the serial-fraction axis is clipped to [−0.5, 1] and says
-//! when it clips. Core counts on SMT siblings are shaded in both panels.
+//! `e = (1/S − 1/p) / (1 − 1/p)` with its 95 % interval as bars (below, only where S > 1 and
+//! the interval lies above 0: [`crate::report::series::Best::serial_fraction`]) against cores,
+//! one line per strategy and placement; the serial-fraction axis is clipped to [0, 1] and
+//! says when it clips. Core counts on SMT siblings are shaded in both panels.
 
 use std::path::Path;
 
@@ -59,9 +60,9 @@ fn plot(
     let any_clipped = clipped
         .iter()
         .zip(serial)
-        .any(|(c, l)| c.points.iter().zip(&l.points).any(|(a, b)| a.y != b.y));
+        .any(|(c, l)| c.points != l.points);
     let serial = &clipped[..];
-    let ys = serial.iter().flat_map(|l| l.points.iter().map(|p| p.y));
+    let ys = serial.iter().flat_map(|l| l.points.iter().map(|p| p.hi));
     let lo = ys.clone().fold(0f64, f64::min);
     let hi = ys.fold(0.1f64, f64::max);
     let pad = (hi - lo) * 0.1;
@@ -77,7 +78,7 @@ fn plot(
     }
     draw_dashed(&mut ch, vec![(x0, 0.0), (x1, 0.0)], grey)?;
     for line in serial {
-        draw_line(&mut ch, line, line_color(line), false)?;
+        draw_line(&mut ch, line, line_color(line), true)?;
     }
     if any_clipped {
         let style = TextStyle::from((crate::plot::font::FAMILY, 14).into_font())
@@ -91,15 +92,16 @@ fn plot(
     Ok(())
 }
 
-/// The lowest serial fraction the panel shows (a superlinear speedup gives e < 0).
-const SERIAL_MIN: f64 = -0.5;
+/// The lowest serial fraction the panel shows (only fractions whose interval lies above 0
+/// are drawn).
+const SERIAL_MIN: f64 = 0.0;
 
-/// `line` with every value clipped to `[SERIAL_MIN, 1]`.
+/// `line` with every value and interval end clipped to `[SERIAL_MIN, 1]`.
 fn clip(line: &Line) -> Line {
     let mut out = line.clone();
     for p in &mut out.points {
-        p.y = p.y.clamp(SERIAL_MIN, 1.0);
-        (p.lo, p.hi) = (p.y, p.y);
+        let clip = |v: f64| v.clamp(SERIAL_MIN, 1.0);
+        (p.y, p.lo, p.hi) = (clip(p.y), clip(p.lo), clip(p.hi));
     }
     out
 }

@@ -222,7 +222,9 @@ pub enum Mark {
     Dashed(RGBColor),
     /// A hollow dot (oversubscribed).
     Hollow(RGBColor),
-    /// A red ring (contended: other work used the machine, or passes ran alone).
+    /// A small dot (one trial).
+    Dot(RGBColor),
+    /// A red ring (contended: other work used the machine).
     Ring,
     /// A large cross (a line's minimum).
     Cross(RGBColor),
@@ -249,6 +251,9 @@ impl LegendEntry {
     }
 }
 
+/// The radius of a trial's dot, pixels.
+pub const TRIAL_DOT: i32 = 2;
+
 /// The colour of the ring around a contended point.
 pub const CONTENDED: RGBColor = RGBColor(220, 0, 0);
 
@@ -264,7 +269,7 @@ pub fn oversubscribed_entry(lines: &[Line]) -> Vec<LegendEntry> {
     }
     if lines.iter().any(|l| l.points.iter().any(|p| p.contended)) {
         out.push(LegendEntry::new(
-            "contended: other work or\ntoo few cores (untrustworthy)",
+            "contended: other work\nused the machine",
             Mark::Ring,
         ));
     }
@@ -369,6 +374,7 @@ fn draw_legend(area: &Area<'_>, entries: &[LegendEntry]) -> DrawResult {
                 ))?;
             }
             Mark::Hollow(c) => area.draw(&Circle::new((cx, y), 5, c.stroke_width(2)))?,
+            Mark::Dot(c) => area.draw(&Circle::new((cx, y), TRIAL_DOT, c.filled()))?,
             Mark::Ring => area.draw(&Circle::new((cx, y), 9, CONTENDED.stroke_width(2)))?,
             Mark::Cross(c) => area.draw(&Cross::new((cx, y), 7, c.stroke_width(3)))?,
             Mark::Triangle(c) => area.draw(&TriangleMarker::new((cx, y), 7, c.filled()))?,

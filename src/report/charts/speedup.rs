@@ -1,6 +1,6 @@
-//! Chart 4: every strategy's best speedup against cores, error bars the 95 % bootstrap interval of
-//! the best cell (`T_seq / slowest` to `T_seq / fastest`), with the ideal `S = p`; one line per
-//! strategy and placement, and the core counts on SMT siblings shaded.
+//! Chart 4: every strategy's best speedup against cores, error bars the 95 % interval of the
+//! best cell's speedup, paired by round, with the ideal `S = p`; one line per strategy and
+//! placement, and the core counts on SMT siblings shaded.
 
 use std::path::Path;
 

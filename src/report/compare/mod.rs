@@ -4,8 +4,10 @@
 //! per machine ([`sides`]; `--compare` makes every directory a side), and the report becomes
 //! a comparison: the machines, then per workload measured on two sides or more each machine's
 //! fastest strategy and one chart per strategy with a line per machine ([`plan`], pure), then
-//! per side a short summary ([`markdown`], pure). [`crate::report::generate`] draws the
-//! charts ([`crate::report::charts::compare`]) and writes the text.
+//! per side a short summary ([`markdown`], pure). Where `--compare` sets apart directories of
+//! the same machine, each pair also gets a reproducibility section ([`reproduce`]): how much of
+//! the first the second reproduced. [`crate::report::generate`] draws the charts
+//! ([`crate::report::charts::compare`]) and writes the text.
 //!
 //! A cell counts once within a side (the same cell in two directories of one machine is
 //! refused, as in a single study); the same cell on two sides is what a comparison compares.
@@ -14,6 +16,7 @@
 
 pub mod markdown;
 pub mod plan;
+pub mod reproduce;
 pub mod sides;
 
 pub use sides::SideRule;

@@ -10,10 +10,10 @@
 //!    compare, their seconds do not, and the report says so;
 //! 3. anything else was measured on one side only and is listed as not compared.
 //!
-//! Every value is each cores value's best cell ([`series::best_per_cores`], the report's one
-//! "best cell" rule: the lowest mean, a contended cell only where nothing else was measured)
-//! and its 95 % interval where the sweep recorded one; speedups are over each side's own
-//! `seq`. Machines are compared on their unpinned cells (`pin = none`, where the operating
+//! Every value is each cores value's best cell ([`GroupView::best_per_cores`], the report's
+//! one "best cell" rule: the grid's choice, measured again where the side's sweep confirmed
+//! it) and its 95 % interval where the sweep recorded one; speedups are over each side's own
+//! `seq`, and a machine's fastest strategy is told from the next by their paired rounds. Machines are compared on their unpinned cells (`pin = none`, where the operating
 //! system places the threads): placements (`sweep --pin`) are compared within each machine's
 //! own report.
 
@@ -21,11 +21,12 @@ use sph_strategies::StrategyName;
 
 use super::sides::{Side, names};
 use crate::report::charts::compare::MachineLines;
-use crate::report::findings::{self, Entry, Verdict};
+use crate::report::findings::{self, Entry, Unknown, Verdict};
 use crate::report::series::{self, Best, Group, Line, Point, SeriesKey};
+use crate::report::view::GroupView;
 use crate::results::files::COMPARE_CHART_PREFIX;
+use crate::results::intervals::Ratio;
 use crate::results::key::LabelStyle;
-use crate::results::rows::SummaryRow;
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
 
@@ -176,10 +177,10 @@ pub fn match_groups(per_side: &[Vec<Group>]) -> Matching {
 }
 
 /// A strategy's best unpinned cell in a group over every cores value: the best cell of each
-/// cores value ([`series::best_per_cores`]), and of those the lowest mean, a contended one
+/// cores value ([`GroupView::best_per_cores`]), and of those the lowest mean, a contended one
 /// only where every one is.
-pub fn strategy_best(rows: &[SummaryRow], g: &Group, s: StrategyName) -> Option<Best> {
-    series::best_per_cores(rows, g, SeriesKey::unpinned(s))
+pub fn strategy_best(v: &GroupView, s: StrategyName) -> Option<Best> {
+    v.best_per_cores(SeriesKey::unpinned(s))
         .into_iter()
         .min_by(|a, b| {
             a.contended
@@ -188,12 +189,12 @@ pub fn strategy_best(rows: &[SummaryRow], g: &Group, s: StrategyName) -> Option<
         })
 }
 
-/// Every parallel strategy's best cell in `g` over every cores value, in registry order.
-pub fn strategy_bests(rows: &[SummaryRow], g: &Group) -> Vec<Entry> {
-    series::strategies(rows, g)
+/// Every parallel strategy's best cell in `v` over every cores value, in registry order.
+pub fn strategy_bests(v: &GroupView) -> Vec<Entry> {
+    series::strategies(&v.rows, &v.group)
         .into_iter()
         .filter(|&s| s != StrategyName::Seq)
-        .filter_map(|s| Some((s, strategy_best(rows, g, s)?)))
+        .filter_map(|s| Some((s, Box::new(strategy_best(v, s)?))))
         .collect()
 }
 
@@ -206,19 +207,23 @@ pub enum Ranking {
     AllContended,
     /// Only one strategy was measured (without contention).
     Only,
-    /// Some best cells have no confidence interval: the lowest mean, no verdict.
-    NoIntervals {
+    /// Some best cell cannot be ordered against the fastest: the lowest mean, no verdict.
+    Unknown {
         /// The next fastest strategy's best cell.
         next: Entry,
+        /// Why.
+        why: Unknown,
     },
-    /// The fastest's 95 % interval overlaps no other strategy's.
+    /// The fastest is faster than every other strategy by their paired rounds.
     Resolved {
         /// The next fastest strategy's best cell.
         next: Entry,
+        /// How many times faster than it.
+        by: Ratio,
     },
-    /// The fastest's 95 % interval overlaps these strategies' (fastest first).
+    /// The fastest is not distinguishable from these strategies (fastest first).
     NotResolved {
-        /// The best cells whose intervals overlap the fastest's.
+        /// The best cells not distinguishable from the fastest.
         overlapping: Vec<Entry>,
     },
 }
@@ -238,23 +243,32 @@ pub struct MachineBest {
     pub contended_left_out: usize,
 }
 
-/// The fastest strategy of `g` on side `side` (its `rows`): the verdict of the group's
+/// The fastest strategy of the group of `v` on side `side`: the verdict of the group's
 /// findings ([`findings::verdict`]) on each strategy's best cell, contended ones left out.
-pub fn machine_best(side: usize, rows: &[SummaryRow], g: &Group) -> MachineBest {
-    let entries = strategy_bests(rows, g);
+pub fn machine_best(side: usize, v: &GroupView) -> MachineBest {
+    let entries = strategy_bests(v);
     let trusted = findings::trusted(&entries);
     let contended_left_out = entries.len() - trusted.len();
     let (best, ranking) = match findings::verdict(&trusted) {
         Some(Verdict::Only(e)) => (Some(e), Ranking::Only),
-        Some(Verdict::NoIntervals(e)) => (
+        Some(Verdict::Unknown(e, why)) => (
             Some(e),
-            Ranking::NoIntervals {
+            Ranking::Unknown {
                 next: trusted[1].clone(),
+                why,
             },
         ),
-        Some(Verdict::Fastest { winner, runner_up }) => {
-            (Some(winner), Ranking::Resolved { next: runner_up })
-        }
+        Some(Verdict::Fastest {
+            winner,
+            runner_up,
+            by,
+        }) => (
+            Some(winner),
+            Ranking::Resolved {
+                next: runner_up,
+                by,
+            },
+        ),
         Some(Verdict::Tied { mut tied, .. }) => {
             let first = tied.remove(0);
             (Some(first), Ranking::NotResolved { overlapping: tied })
@@ -274,7 +288,7 @@ pub fn machine_best(side: usize, rows: &[SummaryRow], g: &Group) -> MachineBest 
     };
     MachineBest {
         side,
-        group: *g,
+        group: v.group,
         best,
         ranking,
         contended_left_out,
@@ -323,12 +337,18 @@ pub struct ComparePlan {
     pub alone: Vec<(usize, Group)>,
     /// Per side, per group in order: every parallel strategy's best cell.
     pub per_side: Vec<Vec<(Group, Vec<Entry>)>>,
+    /// Per pair of sides on the same hardware (only `--compare` makes them): how well the
+    /// second reproduces the first.
+    pub reproduced: Vec<super::reproduce::Reproduced>,
 }
 
 /// The comparison of `sides` (see the module docs).
 pub fn plan(sides: &[Side<'_>]) -> ComparePlan {
     let names = names(sides);
-    let per_side_groups: Vec<Vec<Group>> = sides.iter().map(|s| series::groups(&s.rows)).collect();
+    let per_side_groups: Vec<Vec<Group>> = sides
+        .iter()
+        .map(|s| s.views.iter().map(|v| v.group).collect())
+        .collect();
     let matching = match_groups(&per_side_groups);
     let compared = matching
         .matched
@@ -337,11 +357,10 @@ pub fn plan(sides: &[Side<'_>]) -> ComparePlan {
         .collect();
     let per_side = sides
         .iter()
-        .zip(&per_side_groups)
-        .map(|(side, groups)| {
-            groups
+        .map(|side| {
+            side.views
                 .iter()
-                .map(|g| (*g, strategy_bests(&side.rows, g)))
+                .map(|v| (v.group, strategy_bests(v)))
                 .collect()
         })
         .collect();
@@ -350,30 +369,34 @@ pub fn plan(sides: &[Side<'_>]) -> ComparePlan {
         compared,
         alone: matching.alone,
         per_side,
+        reproduced: super::reproduce::pairs(sides),
     }
 }
 
 /// The best cells, charts and notes of one matched workload.
 fn compare(sides: &[Side<'_>], names: &[String], matched: Matched) -> Compared {
+    let view = |i: usize, g: &Group| sides[i].view(g).expect("a matched group is measured");
     let best = matched
         .groups
         .iter()
-        .map(|(i, g)| machine_best(*i, &sides[*i].rows, g))
+        .map(|(i, g)| machine_best(*i, view(*i, g)))
         .collect();
     let mut notes = Vec::new();
     // Per side: its speedup lines in this workload (none without a usable seq).
     let mut speedups: Vec<(usize, Vec<Line>)> = Vec::new();
     let mut strategies: Vec<StrategyName> = Vec::new();
     for (i, g) in &matched.groups {
-        let rows = &sides[*i].rows;
-        if series::seq_mean(rows, g).is_none() {
+        let v = view(*i, g);
+        if v.reference().is_none() {
             notes.push(format!(
                 "{} has no usable `seq` reference here: no speedup or efficiency from it.",
                 sides[*i].tag
             ));
+            speedups.push((*i, Vec::new()));
+        } else {
+            speedups.push((*i, series::speedup_lines(&v.series_bests())));
         }
-        speedups.push((*i, series::speedup_lines(rows, g)));
-        for s in series::strategies(rows, g) {
+        for s in series::strategies(&v.rows, g) {
             if s != StrategyName::Seq && !strategies.contains(&s) {
                 strategies.push(s);
             }
@@ -446,8 +469,6 @@ pub fn wrap(text: &str, width: usize) -> String {
 /// Efficiency against cores from a speedup line: each value and its interval over the cores.
 pub fn efficiency_of(speedup: &Line) -> Line {
     Line {
-        label: speedup.label.clone(),
-        series: speedup.series,
         points: speedup
             .points
             .iter()
@@ -458,6 +479,7 @@ pub fn efficiency_of(speedup: &Line) -> Line {
                 ..*p
             })
             .collect(),
+        ..speedup.clone()
     }
 }
 
@@ -466,7 +488,10 @@ mod tests {
     use super::*;
     use crate::report::compare::sides::tests::sweep_on;
     use crate::report::compare::sides::{SideRule, sides};
+    use crate::report::view::tests::{measured, of_rows, with_trials};
     use crate::results::rows::tests::row;
+    use crate::results::rows::{Phase, SummaryRow, TrialRow};
+    use crate::topology::Pin;
 
     fn group(n: usize, steps: usize) -> Group {
         Group {
@@ -526,35 +551,55 @@ mod tests {
     #[test]
     fn a_strategys_best_cell_is_the_fastest_over_every_cores_value_contended_last() {
         let rows = study(2.2, 2.4, 3);
-        let g = rows[0].group();
-        let b = strategy_best(&rows, &g, StrategyName::RayonChunks).unwrap();
+        let b = strategy_best(&of_rows(rows.clone()), StrategyName::RayonChunks).unwrap();
         assert_eq!((b.cores, b.chunks, b.mean_s), (2, Some(5), 2.2));
-        let mut contended = rows.clone();
+        let mut contended = rows;
         contended[2].contended = Some(true);
-        let b = strategy_best(&contended, &g, StrategyName::RayonChunks).unwrap();
+        let b = strategy_best(&of_rows(contended), StrategyName::RayonChunks).unwrap();
         assert_eq!((b.cores, b.mean_s), (1, 4.1));
     }
 
+    /// seq and, at 2 cores, rayon-chunks and rayon-iter with these walls per round.
+    fn paired(chunks: &[f64], iter: &[f64]) -> (Vec<SummaryRow>, Vec<TrialRow>) {
+        measured(
+            &[
+                (StrategyName::Seq, 1, None, Pin::None, &[4.0, 4.4, 3.6]),
+                (StrategyName::RayonChunks, 2, Some(5), Pin::None, chunks),
+                (StrategyName::RayonIter, 2, None, Pin::None, iter),
+            ],
+            Phase::Grid,
+        )
+    }
+
     #[test]
-    fn a_machine_best_is_resolved_only_when_the_intervals_are_apart() {
-        // Intervals are ±2 % of the mean: 2.0 and 2.4 are apart, 2.0 and 2.02 overlap.
-        let apart = study(2.0, 2.4, 3);
-        let g = apart[0].group();
-        let b = machine_best(0, &apart, &g);
+    fn a_machine_best_is_resolved_only_where_the_paired_rounds_resolve_it() {
+        let (rows, trials) = paired(&[2.0, 2.2, 1.8], &[2.4, 2.64, 2.16]);
+        let b = machine_best(0, &with_trials(rows, trials));
         assert_eq!(b.best.as_ref().unwrap().0, StrategyName::RayonChunks);
         assert!(
-            matches!(&b.ranking, Ranking::Resolved { next } if next.0 == StrategyName::RayonIter)
+            matches!(&b.ranking, Ranking::Resolved { next, by } if next.0 == StrategyName::RayonIter && (by.value - 1.2).abs() < 1e-12)
         );
-        let close = study(2.0, 2.02, 3);
-        let b = machine_best(0, &close, &g);
+        // Rounds that disagree: not distinguishable.
+        let (rows, trials) = paired(&[2.0, 2.4, 1.6], &[2.1, 2.2, 1.8]);
+        let b = machine_best(0, &with_trials(rows, trials));
         assert!(
             matches!(&b.ranking, Ranking::NotResolved { overlapping } if overlapping.len() == 1)
         );
-        let mut contended = study(2.0, 2.4, 3);
-        for r in &mut contended {
+        // Two rounds: no interval.
+        let (rows, trials) = paired(&[2.0, 2.2], &[2.4, 2.64]);
+        let b = machine_best(0, &with_trials(rows, trials));
+        assert!(matches!(
+            &b.ranking,
+            Ranking::Unknown {
+                why: Unknown::Rounds(2),
+                ..
+            }
+        ));
+        let (mut rows, trials) = paired(&[2.0, 2.2, 1.8], &[2.4, 2.64, 2.16]);
+        for r in &mut rows {
             r.contended = Some(true);
         }
-        let b = machine_best(0, &contended, &g);
+        let b = machine_best(0, &with_trials(rows, trials));
         assert_eq!(
             (b.ranking.clone(), b.contended_left_out),
             (Ranking::AllContended, 2)

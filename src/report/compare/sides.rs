@@ -9,6 +9,7 @@
 use std::path::Path;
 
 use crate::report::load::Sweep;
+use crate::report::view::GroupView;
 use crate::results::meta::Machine;
 use crate::results::rows::SummaryRow;
 
@@ -30,6 +31,8 @@ pub struct Side<'a> {
     pub sweeps: Vec<&'a Sweep>,
     /// The usable and failed cells of all its sweeps, directory by directory.
     pub rows: Vec<SummaryRow>,
+    /// Its groups ([`GroupView::of`] its sweeps).
+    pub views: Vec<GroupView>,
 }
 
 impl Side<'_> {
@@ -72,10 +75,21 @@ pub fn sides(sweeps: &[Sweep], rule: SideRule) -> Vec<Side<'_>> {
                 tag: tag(out.len()),
                 sweeps: vec![s],
                 rows: s.rows.clone(),
+                views: Vec::new(),
             }),
         }
     }
+    for side in &mut out {
+        side.views = GroupView::of(side.sweeps.iter().copied());
+    }
     out
+}
+
+impl Side<'_> {
+    /// The view of group `g`, if the side measured it.
+    pub fn view(&self, g: &crate::report::series::Group) -> Option<&GroupView> {
+        self.views.iter().find(|v| v.group == *g)
+    }
 }
 
 /// Whether `sides` make a comparison rather than one pooled study: more than one machine, or
