@@ -447,7 +447,12 @@ fn the_confirmation_rounds_measure_each_strategys_best_cells_again() {
     // twice as slow as another (out of the running).
     tiny_sweep(
         &dir,
-        &["--confirm-rounds", "3", "--fake-timings", "1.5,1.4,1.3,1.2,1.1,1.6,1.7"],
+        &[
+            "--confirm-rounds",
+            "3",
+            "--fake-timings",
+            "1.5,1.4,1.3,1.2,1.1,1.6,1.7",
+        ],
     );
     let summary = rows(&dir.join("summary.csv"));
     let trials = rows(&dir.join("trials.csv"));

@@ -358,9 +358,8 @@ mod tests {
             .iter()
             .map(|&c| fixtures::trials(&cell(c), &[1.0, 2.0, 3.0]))
             .collect();
-        for round in 0..3 {
-            e.write_trials(&[runs[0][round].clone(), runs[1][round].clone()])
-                .unwrap();
+        for (first, second) in runs[0].iter().zip(&runs[1]) {
+            e.write_trials(&[first.clone(), second.clone()]).unwrap();
         }
         e.write_summaries(&[summary(&cell(1), &runs[0]), summary(&cell(2), &runs[1])])
             .unwrap();
