@@ -40,6 +40,7 @@ pub mod report;
 pub mod results;
 pub mod run;
 pub mod scene;
+pub mod signals;
 pub mod simd;
 pub mod solver;
 pub mod sph;

@@ -45,7 +45,7 @@ fn particle_step_and_trial_counts_beyond_their_ranges_are_refused() {
         "particles must be between 1 and 100000000",
     );
     refused(&["sweep", "--n", "1000000000"], "goes above 100000000");
-    refused(&["simulate", "--steps", "0"], "must be at least 1");
+    refused(&["simulate", "--steps", "0"], "must be between 1 and");
     refused(
         &["simulate", "--steps", "1000000001"],
         "between 1 and 1000000000",

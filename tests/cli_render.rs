@@ -177,9 +177,17 @@ fn a_diverging_run_is_an_error_and_keeps_the_frames_before_it() {
 fn zero_counts_and_bad_sizes_are_refused() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    fails_with_in(d, &["render", "--every", "0"], &["--every", "at least 1"]);
-    fails_with_in(d, &["render", "--steps", "0"], &["--steps", "at least 1"]);
-    fails_with_in(d, &["render", "--n", "0"], &["--n", "at least 1"]);
+    fails_with_in(
+        d,
+        &["render", "--every", "0"],
+        &["--every", "between 1 and"],
+    );
+    fails_with_in(
+        d,
+        &["render", "--steps", "0"],
+        &["--steps", "between 1 and"],
+    );
+    fails_with_in(d, &["render", "--n", "0"], &["--n", "between 1 and"]);
     fails_with_in(d, &["render", "--width", "10"], &["--width"]);
     fails_with_in(d, &["render", "--fps", "0"], &["--fps"]);
     fails_with_in(d, &["render", "--color", "pressure"], &["--color"]);

@@ -231,10 +231,13 @@ fn bad_init_files_give_one_clear_error_with_the_line() {
 
 #[test]
 fn bad_numbers_and_names_are_refused_before_anything_runs() {
-    fails_with(&["simulate", "--n", "0"], &["--n", "at least 1"]);
-    fails_with(&["simulate", "--steps", "0"], &["--steps", "at least 1"]);
-    fails_with(&["simulate", "--cores", "0"], &["--cores", "at least 1"]);
-    fails_with(&["simulate", "--chunks", "0"], &["--chunks", "at least 1"]);
+    fails_with(&["simulate", "--n", "0"], &["--n", "between 1 and"]);
+    fails_with(&["simulate", "--steps", "0"], &["--steps", "between 1 and"]);
+    fails_with(&["simulate", "--cores", "0"], &["--cores", "between 1 and"]);
+    fails_with(
+        &["simulate", "--chunks", "0"],
+        &["--chunks", "between 1 and"],
+    );
     fails_with(&["simulate", "--n", "-5"], &["-5"]);
     fails_with(&["simulate", "--steps", "ten"], &["ten"]);
     fails_with(

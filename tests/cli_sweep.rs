@@ -11,7 +11,7 @@ use std::time::Duration;
 mod common;
 use common::{
     Row, assert_file_holds, assert_holds_all, bench_sph, fails_with, num, poll_until, rows, run,
-    scratch, start, stderr, stdout, sweep_into,
+    scratch, start, stderr, stdout, sweep_into, wait_until,
 };
 
 const TRIAL_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
@@ -704,13 +704,14 @@ fn a_sweep_killed_outright_resumes_without_duplicating_rows() {
     assert_one_row_per_trial(&dir, 2, SLOW_CELLS);
 }
 
-#[test]
-fn ctrl_c_keeps_the_runs_measured_and_exits_with_an_error_naming_resume() {
+/// Sends `signal` (a name `kill` takes) to a running sweep and checks that it stops as
+/// interrupted, keeping every run measured, and that `--resume` finishes it.
+fn a_signal_keeps_the_runs_measured_and_resume_finishes(signal: &str) {
     let (_tmp, dir) = scratch("r");
     let mut child = spawn_until_runs(&dir, 1);
     let still_running = child.try_wait().unwrap().is_none();
     let sent = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([&format!("-{signal}"), &child.id().to_string()])
         .status()
         .is_ok_and(|s| s.success());
     let out = child.wait_with_output().unwrap();
@@ -725,6 +726,48 @@ fn ctrl_c_keeps_the_runs_measured_and_exits_with_an_error_naming_resume() {
     let d = dir.to_str().unwrap();
     let o = run(&["sweep", "--resume", d, "--no-plots"]);
     assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
+    assert_one_row_per_trial(&dir, 2, SLOW_CELLS);
+}
+
+#[test]
+fn ctrl_c_keeps_the_runs_measured_and_exits_with_an_error_naming_resume() {
+    a_signal_keeps_the_runs_measured_and_resume_finishes("INT");
+}
+
+#[test]
+fn sigterm_ends_a_sweep_as_ctrl_c_does_marked_interrupted() {
+    a_signal_keeps_the_runs_measured_and_resume_finishes("TERM");
+}
+
+#[test]
+fn sighup_ends_a_sweep_as_ctrl_c_does_marked_interrupted() {
+    a_signal_keeps_the_runs_measured_and_resume_finishes("HUP");
+}
+
+#[test]
+fn under_nohup_a_closed_terminal_does_not_stop_a_sweep() {
+    let (_tmp, dir) = scratch("r");
+    // `trap '' HUP` ignores SIGHUP as nohup does, and `exec` keeps that for the sweep.
+    let bin = env!("CARGO_BIN_EXE_bench-sph");
+    let mut child = start(
+        Command::new("sh")
+            .args(["-c", "trap '' HUP; exec \"$0\" \"$@\""])
+            .arg(bin)
+            .args(SLOW)
+            .args(["--out", dir.to_str().unwrap()]),
+        Stdio::null(),
+    );
+    let trials = dir.join("trials.csv");
+    wait_until("the sweep never wrote a run", || {
+        trials.exists() || child.try_wait().unwrap().is_some()
+    });
+    let _ = Command::new("kill")
+        .args(["-HUP", &child.id().to_string()])
+        .status();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success(), "{}", common::text(&out.stderr));
+    let meta = std::fs::read_to_string(dir.join("meta.json")).unwrap();
+    assert!(meta.contains("\"status\": \"complete\""), "{meta}");
     assert_one_row_per_trial(&dir, 2, SLOW_CELLS);
 }
 

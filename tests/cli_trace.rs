@@ -348,8 +348,8 @@ fn bad_counts_and_names_are_rejected() {
     let base = ["trace", "--out", "unused-dir", "--strategy"];
     for (rest, needle) in [
         (&["turbo"][..], "unknown strategy 'turbo'"),
-        (&["seq", "--steps", "0"], "at least 1"),
-        (&["seq", "--cores", "0"], "at least 1"),
+        (&["seq", "--steps", "0"], "between 1 and"),
+        (&["seq", "--cores", "0"], "between 1 and"),
         (&["seq", "--compare", "x"], "whole number"),
         (
             &["seq", "--warmup", "1001"],

@@ -2,6 +2,8 @@
 
 use std::io::Write;
 
+use anyhow::Context;
+
 use sph_strategies::StrategyName;
 
 /// Writes one line per strategy: its name, then its description.
@@ -13,7 +15,8 @@ pub fn run(out: &mut impl Write) -> anyhow::Result<()> {
         .unwrap_or(0);
     for s in StrategyName::ALL {
         let info = s.info();
-        writeln!(out, "{:width$}  {}", info.name, info.description)?;
+        writeln!(out, "{:width$}  {}", info.name, info.description)
+            .context("cannot write to standard output")?;
     }
-    Ok(())
+    out.flush().context("cannot write to standard output")
 }

@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+use anyhow::Context;
 use clap::Args;
 
 /// Options of `merge`.
@@ -45,6 +46,7 @@ pub fn run(args: &MergeArgs) -> anyhow::Result<()> {
         merged.trial_rows,
         merged.references,
     );
-    let _ = crate::output::console::line(&text);
-    Ok(())
+    crate::output::console::line(&text).with_context(|| {
+        format!("cannot write to standard output (the merged files in '{dir}' are written)")
+    })
 }

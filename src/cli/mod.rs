@@ -80,9 +80,9 @@ pub enum Command {
     Render(RenderArgs),
     /// Measure every strategy over a cores × chunks grid: trials.csv, summary.csv, meta.json.
     #[command(
-        after_help = "Each cell (strategy, cores, chunks) gets --warmup untimed runs, then --trials timed runs \
-        of the whole simulation from the same initial state; every run's final checksum must equal seq's. \
-        Files are written after every cell; Ctrl-C keeps the finished cells, and --resume DIR continues.\n\n\
+        after_help = "--trials K rounds: in each, every cell (strategy, cores, chunks) of a group and its seq run the \
+        whole simulation once from the same initial state, in a shuffled order; every run's final checksum must \
+        equal seq's. Runs are written as they finish; Ctrl-C, SIGTERM or SIGHUP keep them, and --resume DIR continues.\n\n\
         Examples:\n  \
         bench-sph sweep --cores 1..6 --chunks 10..200          # the paper's study, every strategy\n  \
         bench-sph sweep --cores 1,2 --chunks 10,50 --n 300 --steps 50 --trials 3 --no-plots\n  \
@@ -163,11 +163,12 @@ pub fn run() -> anyhow::Result<()> {
     if let Some(path) = simd {
         crate::simd::choose(path)?;
     }
-    if !matches!(command, Command::Sweep(_)) {
-        // The sweep keeps its finished cells on Ctrl-C; every other command just stops, and
-        // must not leave half-written temporary files behind.
-        crate::output::atomic::remove_temporaries_on_ctrl_c();
-    }
+    // The sweep keeps its finished runs when asked to stop; every other command just stops,
+    // and must not leave half-written temporary files behind.
+    crate::signals::install(match command {
+        Command::Sweep(_) => crate::signals::Stop::BetweenRuns,
+        _ => crate::signals::Stop::Now,
+    });
     match command {
         Command::Simulate(args) => simulate::run(&args),
         Command::Speedup(args) => speedup::run(&args),
@@ -183,19 +184,23 @@ pub fn run() -> anyhow::Result<()> {
     }
 }
 
-/// A whole number of at least 1.
-fn positive(s: &str) -> Result<usize, String> {
-    match s.parse::<usize>() {
-        Ok(0) => Err("must be at least 1".to_owned()),
-        Ok(v) => Ok(v),
-        Err(_) => Err(format!("'{s}' is not a whole number of at least 1")),
-    }
+/// A whole number from `min` to `max`; errors name the quantity `what` and the range, so
+/// that `0` and `-3` are answered with what is allowed.
+fn in_range(s: &str, what: &'static str, min: usize, max: usize) -> Result<usize, String> {
+    let v = s.parse::<usize>().map_err(|_| {
+        format!("'{s}' is not a whole number; {what} must be between {min} and {max}")
+    })?;
+    limits::check(what, v, min, max).map_err(|e| e.to_string())
 }
 
 /// A whole number from 1 to `max`; the error names the quantity `what`.
 fn count(s: &str, what: &'static str, max: usize) -> Result<usize, String> {
-    let v = positive(s)?;
-    limits::check(what, v, 1, max).map_err(|e| e.to_string())
+    in_range(s, what, 1, max)
+}
+
+/// Repetitions of a timed comparison: 1 ..= [`limits::MAX_TRIALS`].
+fn repetitions(s: &str) -> Result<usize, String> {
+    count(s, "repetitions", limits::MAX_TRIALS)
 }
 
 /// A worker-thread count: 1 ..= [`limits::MAX_CORES`].
@@ -221,8 +226,7 @@ fn particles(s: &str) -> Result<usize, String> {
 /// A `wcsph` resolution R = a/dx: within [`RESOLUTIONS`](crate::sph::wcsph::params::RESOLUTIONS).
 fn resolution(s: &str) -> Result<usize, String> {
     let range = crate::sph::wcsph::params::RESOLUTIONS;
-    let v = positive(s)?;
-    limits::check("resolution", v, *range.start(), *range.end()).map_err(|e| e.to_string())
+    in_range(s, "resolution", *range.start(), *range.end())
 }
 
 /// A simulated time in seconds: 0 < t ≤ [`limits::MAX_T_END_S`].
@@ -243,28 +247,17 @@ fn trials(s: &str) -> Result<usize, String> {
 
 /// Confirmation rounds: 0 ..= [`limits::MAX_TRIALS`].
 fn confirm_rounds(s: &str) -> Result<usize, String> {
-    let v = s
-        .parse::<usize>()
-        .map_err(|_| format!("'{s}' is not a whole number of at least 0"))?;
-    limits::check("confirmation rounds", v, 0, limits::MAX_TRIALS).map_err(|e| e.to_string())
+    in_range(s, "confirmation rounds", 0, limits::MAX_TRIALS)
 }
 
 /// Seconds to wait for a quiet machine: 0 ..= [`limits::MAX_WAIT_QUIET_S`].
 fn wait_quiet(s: &str) -> Result<u64, String> {
-    let v = s
-        .parse::<usize>()
-        .map_err(|_| format!("'{s}' is not a whole number of seconds of at least 0"))?;
-    limits::check("--wait-quiet seconds", v, 0, limits::MAX_WAIT_QUIET_S)
-        .map(|v| v as u64)
-        .map_err(|e| e.to_string())
+    in_range(s, "--wait-quiet seconds", 0, limits::MAX_WAIT_QUIET_S).map(|v| v as u64)
 }
 
 /// Warm-up runs per cell: 0 ..= [`limits::MAX_WARMUP`].
 fn warmup(s: &str) -> Result<usize, String> {
-    let v = s
-        .parse::<usize>()
-        .map_err(|_| format!("'{s}' is not a whole number of at least 0"))?;
-    limits::check("warm-ups", v, 0, limits::MAX_WARMUP).map_err(|e| e.to_string())
+    in_range(s, "warm-ups", 0, limits::MAX_WARMUP)
 }
 
 /// The machine's hardware threads (1 when unknown).
@@ -283,11 +276,18 @@ mod tests {
     }
 
     #[test]
-    fn zero_and_negative_counts_are_rejected() {
-        assert!(positive("0").is_err());
-        assert!(positive("-3").is_err());
-        assert!(positive("x").is_err());
-        assert_eq!(positive("12"), Ok(12));
+    fn zero_and_negative_counts_are_rejected_naming_the_range() {
+        assert_eq!(
+            resolution("0"),
+            Err("resolution must be between 4 and 400, not 0".to_owned())
+        );
+        assert!(cores("-3").unwrap_err().contains("between 1 and 1024"));
+        assert!(
+            cores("x")
+                .unwrap_err()
+                .contains("'x' is not a whole number")
+        );
+        assert_eq!(cores("12"), Ok(12));
     }
 
     #[test]

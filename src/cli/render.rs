@@ -50,7 +50,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "SECONDS", value_parser = super::t_end, conflicts_with = "steps")]
     pub t_end: Option<f64>,
     /// One frame every K steps.
-    #[arg(long, value_name = "K", default_value_t = 10, value_parser = super::positive)]
+    #[arg(long, value_name = "K", default_value_t = 10, value_parser = super::steps)]
     pub every: usize,
     /// How the passes run: strategy, worker threads, chunks.
     #[command(flatten)]

@@ -28,6 +28,8 @@ pub struct SceneArgs {
     pub neighbors: NeighborMode,
     /// Seed of the initial jitter.
     pub seed: u64,
+    /// Whether `--seed` was given on the command line (rather than defaulted).
+    pub seed_given: bool,
     /// Initial state from CSV.
     pub init: Option<PathBuf>,
 }
@@ -49,7 +51,7 @@ struct SceneOptions {
     /// Neighbour search.
     #[arg(long, default_value = "all-pairs", value_parser = super::values::neighbors())]
     neighbors: NeighborMode,
-    /// Seed of the initial jitter.
+    /// Seed of the initial jitter (--preset seed and cpp without --init; 0..=2^64-1).
     #[arg(long, default_value_t = 2019)]
     seed: u64,
     /// Initial state from CSV (header row; columns x,y required, vx,vy optional; a dump of
@@ -68,6 +70,7 @@ impl FromArgMatches for SceneArgs {
             resolution: o.resolution,
             neighbors: o.neighbors,
             seed: o.seed,
+            seed_given: matches.value_source("seed") == Some(ValueSource::CommandLine),
             init: o.init,
         })
     }
@@ -141,8 +144,23 @@ impl SceneArgs {
     /// particles (default 1000) jittered with `--seed` (for `wcsph`, at `--resolution`).
     /// Refuses, before allocating the simulation, a run larger than the machine's memory
     /// ([`memory::check`]), an init file dumped with another preset unless `--preset` was
-    /// given, and `--resolution` without `--preset wcsph`.
+    /// given, `--resolution` without `--preset wcsph`, and `--seed` where nothing is jittered.
     pub fn scene(&self) -> anyhow::Result<Scene> {
+        if self.seed_given {
+            if let Some(path) = &self.init {
+                anyhow::bail!(
+                    "--seed has nothing to seed with --init '{}': the file gives every \
+                     particle's position; drop --seed",
+                    path.display()
+                );
+            }
+            if self.preset == Preset::Wcsph {
+                anyhow::bail!(
+                    "--seed has nothing to seed with --preset wcsph: its particles start on a \
+                     lattice without jitter; drop --seed (the jittered presets are seed and cpp)"
+                );
+            }
+        }
         if self.resolution.is_some() && self.preset != Preset::Wcsph {
             anyhow::bail!(
                 "--resolution applies to --preset wcsph only; --preset {} takes --n",

@@ -255,17 +255,24 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     } else {
         Ok(String::new())
     };
-    // Standard output may be gone (`| head`): the sweep's files are complete by now, so
-    // printing failures are ignored and the sweep ends with its status.
+    // Standard output may be gone (`| head`, a full disk): the sweep's files are complete by
+    // now, so the sweep ends with its own status first, then with the failed print (exit 1,
+    // as in every command).
     let mut text = finished.best_text();
     if let Ok(charts) = &charts {
         text.push_str(charts);
         text.push('\n');
     }
     text.push_str(&finished.paths_text());
-    let _ = crate::output::console::line(text.trim_end());
+    let printed = crate::output::console::line(text.trim_end()).with_context(|| {
+        format!(
+            "cannot write to standard output (the sweep's files in '{}' are written)",
+            finished.dir().display()
+        )
+    });
     charts?;
-    finished.outcome()
+    finished.outcome()?;
+    printed
 }
 
 /// The one place where a finished sweep's charts are made: `bench-sph report` on the sweep's

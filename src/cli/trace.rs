@@ -48,12 +48,12 @@ pub struct TraceArgs {
     #[arg(long)]
     pub force: bool,
     /// Draw only the last K steps in timeline.png [default: all steps, at most the last 3].
-    #[arg(long, value_name = "K", value_parser = super::positive)]
+    #[arg(long, value_name = "K", value_parser = super::steps)]
     pub timeline_steps: Option<usize>,
     /// Also time REPS untraced and REPS traced runs of the same steps, alternately, and print
     /// the minimum and median wall time of each: the cost of tracing. The files then come
     /// from the last traced run.
-    #[arg(long, value_name = "REPS", value_parser = super::positive)]
+    #[arg(long, value_name = "REPS", value_parser = super::repetitions)]
     pub compare: Option<usize>,
 }
 

@@ -135,12 +135,12 @@ impl From<ColorArg> for ColorBy {
 
 /// Parses a [`Preset`] by its command-line name, listing the presets in `--help`.
 pub(super) fn preset() -> impl TypedValueParser<Value = Preset> {
-    EnumValueParser::<PresetArg>::new().map(Preset::from)
+    NonEmpty(EnumValueParser::<PresetArg>::new().map(Preset::from))
 }
 
 /// Parses a [`NeighborMode`] by its command-line name, listing the modes in `--help`.
 pub(super) fn neighbors() -> impl TypedValueParser<Value = NeighborMode> {
-    EnumValueParser::<NeighborsArg>::new().map(NeighborMode::from)
+    NonEmpty(EnumValueParser::<NeighborsArg>::new().map(NeighborMode::from))
 }
 
 /// Parses a [`SimdPath`] by its command-line name, listing the paths in `--help`.
@@ -155,7 +155,7 @@ pub(super) fn order() -> impl TypedValueParser<Value = SumOrder> {
 
 /// Parses a [`Pin`] by its command-line name, listing the placements in `--help`.
 pub(super) fn pin() -> impl TypedValueParser<Value = Pin> {
-    EnumValueParser::<PinArg>::new().map(Pin::from)
+    NonEmpty(EnumValueParser::<PinArg>::new().map(Pin::from))
 }
 
 /// `sweep --schedule`'s values.
@@ -188,13 +188,54 @@ pub(super) fn color() -> impl TypedValueParser<Value = ColorBy> {
 
 /// Parses a [`StrategyName`] from the registry, listing [`StrategyName::ALL`] in `--help`; an
 /// unknown name is an error that lists the known ones.
-pub(super) fn strategy() -> StrategyParser {
-    StrategyParser
+pub(super) fn strategy() -> impl TypedValueParser<Value = StrategyName> {
+    NonEmpty(StrategyParser)
+}
+
+/// A parser of one name that answers an empty one — an empty item of a comma list
+/// (`--pin spread,,`) or `--pin ''` — by saying so and listing the names, where clap alone
+/// would say that "none was supplied".
+#[derive(Debug, Clone, Copy)]
+pub(super) struct NonEmpty<P>(P);
+
+impl<P: TypedValueParser> TypedValueParser for NonEmpty<P> {
+    type Value = P::Value;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&Arg>,
+        value: &OsStr,
+    ) -> Result<P::Value, clap::Error> {
+        if !value.is_empty() {
+            return self.0.parse_ref(cmd, arg, value);
+        }
+        let option = arg
+            .and_then(Arg::get_long)
+            .map_or_else(|| "an option".to_owned(), |long| format!("--{long}"));
+        let names: Vec<String> = self
+            .0
+            .possible_values()
+            .into_iter()
+            .flatten()
+            .map(|v| v.get_name().to_owned())
+            .collect();
+        let message = format!(
+            "{option} has an empty name (two commas in a row, or one at either end of the \
+             list); give one or more of {}, separated by single commas\n",
+            names.join(", ")
+        );
+        Err(clap::Error::raw(clap::error::ErrorKind::InvalidValue, message).with_cmd(cmd))
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = PossibleValue> + '_>> {
+        self.0.possible_values()
+    }
 }
 
 /// See [`strategy`].
 #[derive(Debug, Clone, Copy)]
-pub(super) struct StrategyParser;
+struct StrategyParser;
 
 impl TypedValueParser for StrategyParser {
     type Value = StrategyName;

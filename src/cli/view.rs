@@ -22,7 +22,7 @@ pub struct ViewArgs {
     #[arg(long, default_value_t = 1000, value_parser = super::particles)]
     pub n: usize,
     /// Steps between two frames on screen.
-    #[arg(long, value_name = "K", default_value_t = 5, value_parser = super::positive)]
+    #[arg(long, value_name = "K", default_value_t = 5, value_parser = super::steps)]
     pub every: usize,
     /// Neighbour search.
     #[arg(long, default_value = "grid", value_parser = super::values::neighbors())]

@@ -1,9 +1,9 @@
 //! Files written whole or not at all: a temporary file `.NAME.PID.tmp` beside the
 //! destination, synced and renamed over it by [`AtomicFile::commit`]. An `AtomicFile` dropped
 //! without a commit (an error, a panic, an early return) removes its temporary file, and the
-//! destination keeps its earlier contents. Commands that are not a sweep (which handles
-//! Ctrl-C itself) call [`remove_temporaries_on_ctrl_c`], so an interrupted run leaves no
-//! temporary file behind either.
+//! destination keeps its earlier contents. A command stopped by a signal removes the
+//! temporary files it was writing ([`remove_live_temporaries`], from [`crate::signals`]), so
+//! an interrupted run leaves none behind either.
 
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
@@ -12,24 +12,19 @@ use std::sync::{Mutex, PoisonError};
 
 use anyhow::Context;
 
-/// The temporary files being written now, for [`remove_temporaries_on_ctrl_c`].
+/// The temporary files being written now, for [`remove_live_temporaries`].
 static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 fn live() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
     LIVE.lock().unwrap_or_else(PoisonError::into_inner)
 }
 
-/// Makes Ctrl-C remove every temporary file being written, then exit with status 130 (the
-/// destinations keep their earlier contents). Harmless to call twice; a process has one
-/// handler.
-pub fn remove_temporaries_on_ctrl_c() {
-    let _ = ctrlc::set_handler(|| {
-        for tmp in live().iter() {
-            let _ = std::fs::remove_file(tmp);
-        }
-        super::console::warn("\nCtrl-C: stopped; nothing was written");
-        std::process::exit(130);
-    });
+/// Removes every temporary file being written now: for a command stopped by a signal
+/// ([`crate::signals`]), whose destinations then keep their earlier contents.
+pub fn remove_live_temporaries() {
+    for tmp in live().iter() {
+        let _ = std::fs::remove_file(tmp);
+    }
 }
 
 /// The suffix of every temporary file (see [`is_temporary`]).

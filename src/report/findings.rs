@@ -137,7 +137,10 @@ pub enum Order {
 
 /// `a` against `b`, by their runs paired by round (see [`Order`]).
 pub fn order(a: &Best, b: &Best) -> Order {
-    let Some(r) = b.runs.ratio(&a.runs) else {
+    // A strategy the confirmation left out (it lost by more than twice in the grid) has only
+    // grid runs: it pairs with the other's runs of the grid's rounds.
+    let paired = b.runs.ratio(&a.runs).or_else(|| b.grid().ratio(a.grid()));
+    let Some(r) = paired else {
         return Order::Unknown(Unknown::Unpaired);
     };
     match r.interval {

@@ -327,6 +327,10 @@ pub struct Best {
     pub confirmed: bool,
     /// Its runs, by round: what comparisons pair.
     pub runs: Runs,
+    /// Where `runs` are the confirmation's: the same cell's runs in the grid's rounds, which
+    /// pair with a strategy the confirmation left out (more than twice the fastest cell's
+    /// time: the grid settled that it lost).
+    pub grid_runs: Option<Runs>,
 }
 
 impl Best {
@@ -349,7 +353,14 @@ impl Best {
             contended: r.contended == Some(true),
             confirmed: r.phase == crate::results::rows::Phase::Confirm,
             runs,
+            grid_runs: None,
         })
+    }
+
+    /// Its runs in the grid's rounds: [`Best::grid_runs`], or its own runs where they are the
+    /// grid's.
+    pub fn grid(&self) -> &Runs {
+        self.grid_runs.as_ref().unwrap_or(&self.runs)
     }
 
     /// The series it belongs to.

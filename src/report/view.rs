@@ -205,9 +205,13 @@ impl GroupView {
             .find(|r| r.is_reference() && r.is_usable())
     }
 
-    /// `row`'s numbers with its runs.
+    /// `row`'s numbers with its runs (and, for a confirmation row, its cell's grid runs).
     pub fn best(&self, row: &SummaryRow) -> Option<Best> {
-        Best::of(row, self.runs(row))
+        let mut best = Best::of(row, self.runs(row))?;
+        if row.phase == Phase::Confirm {
+            best.grid_runs = self.runs.get(&(row.key(), Phase::Grid)).cloned();
+        }
+        Some(best)
     }
 
     /// The best cell of the series `key` at each core count it was measured at, by cores
@@ -394,6 +398,46 @@ pub(crate) mod tests {
         let r = up.runs.ratio(&b.runs).unwrap();
         assert!((r.value - 0.5).abs() < 1e-12 && r.resolved(), "{r:?}");
         assert_eq!(v.reference().unwrap().phase, Phase::Confirm);
+    }
+
+    #[test]
+    fn a_strategy_the_confirmation_left_out_is_ordered_by_the_grids_rounds() {
+        use StrategyName::{RayonChunks, RayonSpawn, Seq};
+        let none = Pin::None;
+        let (mut rows, mut trials) = measured(
+            &[
+                (Seq, 1, None, none, &SEQ),
+                (RayonChunks, 2, Some(10), none, &[2.0, 2.2, 1.8]),
+                (RayonSpawn, 2, None, none, &[5.0, 5.5, 4.5]),
+            ],
+            Phase::Grid,
+        );
+        // rayon-spawn took more than twice the fastest cell's time: not confirmed.
+        let (c_rows, c_trials) = measured(
+            &[
+                (Seq, 1, None, none, &SEQ),
+                (RayonChunks, 2, Some(10), none, &[2.0, 2.1, 1.9]),
+            ],
+            Phase::Confirm,
+        );
+        rows.extend(c_rows);
+        trials.extend(c_trials);
+        let v = with_trials(rows, trials);
+        let chunks = &v.best_per_cores(SeriesKey::unpinned(RayonChunks))[0];
+        let spawn = &v.best_per_cores(SeriesKey::unpinned(RayonSpawn))[0];
+        assert!(chunks.confirmed && !spawn.confirmed);
+        assert_eq!(
+            spawn.runs.ratio(&chunks.runs),
+            None,
+            "other phases never pair"
+        );
+        // In the grid's rounds rayon-spawn took 2.5 times as long, round by round.
+        match crate::report::findings::order(chunks, spawn) {
+            crate::report::findings::Order::AFaster(r) => {
+                assert!((r.value - 2.5).abs() < 1e-9, "{r:?}");
+            }
+            other => panic!("{other:?}"),
+        }
     }
 
     #[test]

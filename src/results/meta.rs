@@ -31,7 +31,7 @@ pub enum SweepStatus {
     Running,
     /// Every planned cell has a summary row.
     Complete,
-    /// Stopped by Ctrl-C; `--resume` continues it.
+    /// Stopped by Ctrl-C, SIGTERM, SIGHUP or a closed standard output; `--resume` continues it.
     Interrupted,
     /// A merge of shards with cells missing (`bench-sph merge --allow-partial`): resume or run
     /// the missing shards and merge again.

@@ -19,6 +19,11 @@ pub fn duration(seconds: f64) -> String {
     if !seconds.is_finite() {
         return "unknown".to_owned();
     }
+    // Nothing (an estimate with nothing left to run: an empty float sum is -0.0) or a
+    // negative rounding error reads as nothing, never as "-0.00 ms".
+    if seconds <= 0.0 {
+        return "0 ms".to_owned();
+    }
     if seconds < 0.001 {
         return format!("{:.2} ms", seconds * 1000.0);
     }
@@ -436,6 +441,8 @@ mod tests {
         assert_eq!(duration(200.0), "3 min 20 s");
         assert_eq!(duration(3900.0), "1 h 05 min");
         assert_eq!(duration(f64::NAN), "unknown");
+        assert_eq!(duration(-0.0), "0 ms", "an empty sum of floats is -0.0");
+        assert_eq!(duration(std::iter::empty::<f64>().sum()), "0 ms");
     }
 
     #[test]

@@ -130,9 +130,9 @@ const BUSY_CHECK: Duration = Duration::from_millis(300);
 // Over ~60 lines on purpose: the sweep's steps in the order they print (open, plan, busy check,
 // estimate, measure, conclude), each a call; what is left is handing values between them.
 pub fn run(request: Request) -> anyhow::Result<Finished> {
-    // From the start: a Ctrl-C during the plan or the estimate also ends the sweep as
-    // interrupted (after the estimate), never as a killed "running" one.
-    runner::install_ctrlc_handler();
+    // From the start: Ctrl-C, SIGTERM or SIGHUP during the plan or the estimate also ends the
+    // sweep as interrupted (after the estimate), never as a killed "running" one.
+    crate::signals::install(crate::signals::Stop::BetweenRuns);
     let machine = Machine::detect();
     let hardware_threads = machine.hardware_threads;
     let session = Session::start(request.command_line.clone(), machine);

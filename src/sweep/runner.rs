@@ -12,14 +12,14 @@
 //! fails, the phase stops and its other cells are written as failed.
 //!
 //! A run's trial row is written (and flushed) when its contention window closes, about every
-//! second; a phase's summary rows are written together once its last round is done. Ctrl-C
-//! sets a flag that is checked before every run: the runs already measured are written, the
-//! run in progress is discarded, and the sweep stops with an error naming `--resume`, which
-//! continues the round it was in. A second Ctrl-C exits at once.
+//! second; a phase's summary rows are written together once its last round is done. Ctrl-C,
+//! SIGTERM or SIGHUP ([`crate::signals`]) sets a flag that is checked before every run: the
+//! runs already measured are written, the run in progress is discarded, and the sweep stops
+//! with an error naming `--resume`, which continues the round it was in. A second signal
+//! exits at once.
 
 use std::collections::{HashMap, HashSet};
 use std::io::Write;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
@@ -39,28 +39,11 @@ use crate::results::params::SweepParams;
 use crate::results::rows::{Phase, Status, SummaryRow, TrialRow};
 use crate::results::summarize::{CellContext, summary_row};
 
-/// Set by Ctrl-C; checked before every run and every cell.
-static INTERRUPTED: AtomicBool = AtomicBool::new(false);
-
-/// Whether the sweep must stop: Ctrl-C was pressed, or standard output was closed (the
-/// reader of `bench-sph sweep | head` went away), which ends the sweep the same way.
+/// Whether the sweep must stop, checked before every run and every cell: Ctrl-C, SIGTERM or
+/// SIGHUP arrived ([`crate::signals`]), or standard output was closed (the reader of
+/// `bench-sph sweep | head` went away), which ends the sweep the same way.
 pub fn interrupted() -> bool {
-    INTERRUPTED.load(Ordering::SeqCst) || crate::output::console::closed()
-}
-
-/// Makes Ctrl-C stop the sweep between runs (a second Ctrl-C exits at once). Harmless to
-/// call twice: a process has one handler.
-pub fn install_ctrlc_handler() {
-    let _ = ctrlc::set_handler(|| {
-        if INTERRUPTED.swap(true, Ordering::SeqCst) {
-            crate::output::console::warn("\nCtrl-C again: quitting now; finished cells are saved");
-            std::process::exit(130);
-        }
-        crate::output::console::warn(
-            "\nCtrl-C: stopping after the current run; the cell in progress is discarded \
-             (Ctrl-C again to quit at once)",
-        );
-    });
+    crate::signals::requested() || crate::output::console::closed()
 }
 
 /// What earlier sessions left of the sweep (from `--resume`'s repair).
