@@ -12,7 +12,7 @@
 # --json/--dump on three strategies and from an --init file, render to a GIF and to PNG
 # frames, list, two errors. Left out of the diff: what a run measures (simulate's wall and CPU
 # times; the sweeps' are fake), dates, the commit in build lines, the sweep's time estimate and
-# its lock file's PID. Exit status 0 when the trees are identical.
+# its lock files' PIDs. Exit status 0 when the trees are identical.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BASE="${1:-HEAD~1}"
@@ -60,7 +60,9 @@ outputs() {
     "$bin" list > list.txt
     { "$bin" simulate --n 0; echo "rc=$?"; } > err1.txt 2>&1
     { "$bin" simulate --n 100 --steps 200000000000; echo "rc=$?"; } > err2.txt 2>&1
-    rm -f sw1/sweep.lock sw2/sweep.lock sw3/sweep.lock results
+    rm -f results
+    # Lock files hold a PID (older versions: sweep.lock; now bench-sph.lock).
+    find . \( -name sweep.lock -o -name bench-sph.lock \) -delete
     # What a run measures, when it ran and which build ran it.
     find . -name meta.json -exec sed -i -E \
         's/"(started|finished)[a-z_]*": "[^"]*"/"\1": "X"/g; s/"(git_commit|git_dirty)": [^,]*/"\1": X/g' {} +

@@ -79,11 +79,7 @@ fn png_frames_are_written_one_per_frame_with_the_set_size() {
     );
     let size = reported_size(&out);
     let shots = dir.path().join("shots/run1");
-    let mut names: Vec<String> = std::fs::read_dir(&shots)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().into_string().unwrap())
-        .collect();
-    names.sort();
+    let names = names(&shots);
     assert_eq!(
         names,
         ["frame_00000.png", "frame_00001.png", "frame_00002.png"]

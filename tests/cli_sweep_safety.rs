@@ -128,9 +128,10 @@ fn long_sweep(dir: &Path) -> Child {
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    let lock = dir.join("sweep.lock");
+    let lock = dir.join("bench-sph.lock");
+    let holder = format!("sweep {}", child.id());
     wait_until("the sweep never took its lock", || {
-        std::fs::read_to_string(&lock).is_ok_and(|s| s.trim() == child.id().to_string())
+        std::fs::read_to_string(&lock).is_ok_and(|s| s.trim() == holder)
     });
     child
 }
@@ -149,7 +150,7 @@ fn a_second_sweep_on_a_directory_in_use_is_refused_naming_the_holders_pid() {
         no_panic(&o);
         let err = text(&o.stderr);
         assert!(
-            err.contains("in use by another bench-sph sweep") && err.contains(&pid),
+            err.contains(&format!("is in use by bench-sph sweep (PID {pid})")),
             "{err}"
         );
     }
@@ -181,8 +182,10 @@ fn two_sweeps_racing_for_the_same_new_directory_leave_one_winner_and_a_clear_ref
         let loser = outs.iter().find(|o| !o.status.success()).unwrap();
         no_panic(loser);
         let err = text(&loser.stderr);
+        // Refused while the winner holds the directory, or, once it is done, for its results.
         assert!(
-            err.starts_with("Error: results directory")
+            (err.starts_with(&format!("Error: '{}' is in use by", dir.display()))
+                || err.starts_with("Error: results directory"))
                 && err.contains(dir.to_str().unwrap())
                 && err.lines().count() == 1,
             "{err}"

@@ -18,7 +18,9 @@ pub struct MergeArgs {
     /// marked partial, and its report says so.
     #[arg(long)]
     pub allow_partial: bool,
-    /// Replace an earlier sweep's or merge's results in --out.
+    /// Replace an earlier sweep's or merge's results in --out (the files its record,
+    /// bench-sph-files.json, gives to them, and the report drawn there); other files stay
+    /// untouched.
     #[arg(long)]
     pub force: bool,
 }

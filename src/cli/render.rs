@@ -73,7 +73,7 @@ pub struct RenderArgs {
     #[arg(long, value_name = "DIR")]
     pub frames: Option<PathBuf>,
     /// With --frames: write into a folder that holds files render did not write (they are
-    /// left as they are; only frame files are replaced).
+    /// left as they are; only the frames the folder's record gives to render are replaced).
     #[arg(long, requires = "frames")]
     pub force: bool,
 }

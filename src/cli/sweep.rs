@@ -121,8 +121,9 @@ pub struct SweepArgs {
     /// kept, unfinished ones run (again).
     #[arg(long, value_name = "DIR")]
     pub resume: Option<PathBuf>,
-    /// Replace the results files (trials.csv, summary.csv, meta.json) of an existing --out
-    /// directory.
+    /// Replace the results of an earlier sweep or merge in --out (the files its record,
+    /// bench-sph-files.json, gives to them, and the report drawn there); other files stay
+    /// untouched.
     #[arg(long)]
     pub force: bool,
     /// Thread placements to measure, comma-separated: none (the operating system decides),
@@ -283,7 +284,8 @@ fn charts(dir: &Path, no_plots: bool) -> anyhow::Result<String> {
         return Ok("Charts: skipped (--no-plots).".to_owned());
     }
     // The sweep has claimed its directory already (foreign files stay only where its own
-    // --force allowed them): the report writes beside them, never over them.
+    // --force allowed them) and still holds its lock, which the report shares: the report
+    // writes beside those files, never over them, and records its own as the report's.
     let written =
         crate::report::generate(&[dir.to_path_buf()], dir, &[], true).with_context(|| {
             format!(

@@ -13,6 +13,7 @@ use crate::checksum::checksum_hex;
 use crate::output::atomic::AtomicFile;
 use crate::output::claim::{self, Claimed, Owner};
 use crate::output::console;
+use crate::output::record::Command;
 use crate::simd::SimdPath;
 use crate::solver::Simulation;
 use crate::topology::Pin;
@@ -102,7 +103,8 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
         neighbors: args.scene.neighbors,
     }
     .check()?;
-    let (claimed, paths) = claim_out(args)?;
+    // Claimed (and locked) before anything runs, and held until the files are written.
+    let (mut claimed, paths) = claim_out(args)?;
     let config = trace_config(args, scene.fluid(), cores);
     let fresh = || scene.clone().simulate(args.scene.neighbors);
     let (sim, run, comparison) = record(args, &strategy_config, fresh)?;
@@ -127,6 +129,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
         simd: sim.simd(),
         pin: args.parallel.pin,
     };
+    claimed.record(&FILES)?;
     write_files(&paths, &run, &stats, &meta)?;
     let removed = claimed.remove_stale(&paths)?;
 
@@ -145,22 +148,27 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
     print(&lines, &claimed)
 }
 
+/// The files of a trace directory, in the order written.
+const FILES: [&str; 4] = [
+    files::TRACE_JSON,
+    files::TIMELINE_PNG,
+    files::STATS_CSV,
+    files::META_JSON,
+];
+
 /// Claims `--out` for the trace and checks that its four files may be written there.
 fn claim_out(args: &TraceArgs) -> anyhow::Result<(Claimed, [PathBuf; 4])> {
     let owner = Owner {
-        command: TOOL,
+        command: Command::Trace,
         option: "--out",
-        owns: &files::owns,
-        tolerates: &claim::nothing,
+        replaces: &[],
+        tolerates: &[],
+        tolerates_unrecorded: &claim::nothing,
+        writes: &FILES,
     };
     let claimed = claim::claim(&args.out, &owner, args.force)?;
-    let path = |name| claimed.check_writable(name);
-    let paths = [
-        path(files::TRACE_JSON)?,
-        path(files::TIMELINE_PNG)?,
-        path(files::STATS_CSV)?,
-        path(files::META_JSON)?,
-    ];
+    let path = |i: usize| claimed.check_writable(FILES[i]);
+    let paths = [path(0)?, path(1)?, path(2)?, path(3)?];
     Ok((claimed, paths))
 }
 

@@ -10,6 +10,7 @@ use clap::Args;
 use crate::output::atomic::AtomicFile;
 use crate::output::claim::{self, Claimed, Owner};
 use crate::output::console;
+use crate::output::record::Command;
 use crate::validate::export::{self, COLUMN_HEIGHT_CSV, SURGE_FRONT_CSV, VALIDATION_PNG};
 use crate::validate::{self, Validation, chart, summary};
 
@@ -39,9 +40,11 @@ pub struct ValidateArgs {
 /// (renamed into place only once all three are complete), prints, and returns an error naming
 /// the failed verdicts, if any.
 pub fn run(args: &ValidateArgs) -> anyhow::Result<()> {
-    let (claimed, paths) = claim_out(args)?;
+    // Claimed (and locked) before anything runs, and held until the files are written.
+    let (mut claimed, paths) = claim_out(args)?;
     let config = args.parallel.config()?;
     let v = validate::validate(args.resolution, args.parallel.strategy, &config)?;
+    claimed.record(&FILES)?;
     write_files(&paths, &v)?;
     claimed.remove_stale(&paths)?;
 
@@ -74,21 +77,22 @@ pub fn run(args: &ValidateArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The files validate writes, in order.
+const FILES: [&str; 3] = [SURGE_FRONT_CSV, COLUMN_HEIGHT_CSV, VALIDATION_PNG];
+
 /// Claims `--out` for validate and checks that its three files may be written there.
 fn claim_out(args: &ValidateArgs) -> anyhow::Result<(Claimed, [PathBuf; 3])> {
     let owner = Owner {
-        command: "bench-sph validate",
+        command: Command::Validate,
         option: "--out",
-        owns: &export::owns,
-        tolerates: &claim::nothing,
+        replaces: &[],
+        tolerates: &[],
+        tolerates_unrecorded: &claim::nothing,
+        writes: &FILES,
     };
     let claimed = claim::claim(&args.out, &owner, args.force)?;
-    let path = |name| claimed.check_writable(name);
-    let paths = [
-        path(SURGE_FRONT_CSV)?,
-        path(COLUMN_HEIGHT_CSV)?,
-        path(VALIDATION_PNG)?,
-    ];
+    let path = |i: usize| claimed.check_writable(FILES[i]);
+    let paths = [path(0)?, path(1)?, path(2)?];
     Ok((claimed, paths))
 }
 

@@ -1,7 +1,9 @@
-//! Reading an initial state from CSV and writing a final state to CSV, and where a command's
-//! output file goes.
+//! Reading an initial state from CSV and writing a final state to CSV, where a command's
+//! output file goes, and the one way every file of a results, trace or output directory is
+//! read ([`capped`]: regular files only, at most a cap per kind).
 
 pub mod bounded;
+pub mod capped;
 pub mod dump_csv;
 pub mod init_csv;
 pub mod sink;

@@ -1,13 +1,14 @@
 //! `bench-sph merge`: one results directory from the shards of a sweep (`sweep --shard I/K`),
 //! which a batch scheduler ran on identical nodes.
 //!
-//! The pipeline: each shard directory is locked (no sweep may write it meanwhile) and read,
-//! keeping its believed cells ([`crate::results::validate::cell`]); [`check`] refuses shards of
+//! The pipeline: the shards are checked to be distinct directories; each is read under a
+//! shared, read-only lock (a sweep writing it refuses the merge; the merge never writes into a
+//! shard, so shards on a read-only mount merge) keeping its believed cells ([`crate::results::validate::cell`]); [`check`] refuses shards of
 //! different plans, builds or machines and repeated shards; [`assemble`] puts the whole plan
 //! together, one row per cell, each keeping its own shard's speedup (`reference_shard`); a
 //! cell no shard has is an error unless `--allow-partial`, which marks the merge `partial`.
-//! The output directory is claimed like a new sweep's and written file by file through
-//! temporary names: `summary.csv`, `trials.csv`, `references.csv` (every shard's `seq` rows)
+//! The output directory is claimed like a new sweep's (locked, and recorded as the merge's:
+//! [`crate::output::record`]) and written file by file through temporary names: `summary.csv`, `trials.csv`, `references.csv` (every shard's `seq` rows)
 //! and `meta.json` (the plan's parameters without the shard, every shard's sessions, and
 //! `merge`: where each cell came from, what is missing, what was warned about).
 
@@ -19,12 +20,13 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 
 use crate::output::console::plural;
+use crate::output::lock;
+use crate::output::record::Command;
 use crate::results::load::{believed, read_summary, read_trials};
 use crate::results::meta::{Merge, MergedShard, Meta, SweepStatus};
 use crate::results::rows::{SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow};
-use crate::results::{LOCK_FILE, META_FILE, REFERENCES_FILE, SUMMARY_FILE, TRIALS_FILE};
+use crate::results::{META_FILE, REFERENCES_FILE, SUMMARY_FILE, TRIALS_FILE};
 use crate::sweep::export::to_csv;
-use crate::sweep::lock::{self, DirLock};
 use crate::sweep::plan::Plan;
 use assemble::Part;
 
@@ -58,17 +60,17 @@ pub struct Merged {
     pub warnings: Vec<String>,
 }
 
-/// A shard directory read under its lock.
+/// A shard directory, read.
 struct Read {
     dir: PathBuf,
     meta: Meta,
     rows: Vec<SummaryRow>,
     trials: Vec<TrialRow>,
-    _lock: Option<DirLock>,
 }
 
 /// Merges `request.dirs` into `request.out` (see the module docs).
 pub fn run(request: &Request) -> anyhow::Result<Merged> {
+    refuse_repeated_inputs(&request.dirs)?;
     refuse_output_among_inputs(request)?;
     let read = request
         .dirs
@@ -119,9 +121,10 @@ pub fn run(request: &Request) -> anyhow::Result<Merged> {
         ));
     }
     let meta = merged_meta(&read, &shards, &params, &whole, &merged, &warnings);
-    let lock = crate::sweep::dir::open_new(&request.out, request.force)?;
+    let mut claimed = crate::sweep::dir::open_new(&request.out, request.force, Command::Merge)?;
+    claimed.record(&[TRIALS_FILE, SUMMARY_FILE, REFERENCES_FILE, META_FILE])?;
     write_all(&request.out, &merged, &meta)?;
-    drop(lock);
+    drop(claimed);
     Ok(Merged {
         dir: request.out.clone(),
         fingerprint: params.fingerprint(),
@@ -130,6 +133,26 @@ pub fn run(request: &Request) -> anyhow::Result<Merged> {
         references: merged.references.len(),
         warnings,
     })
+}
+
+/// The same directory twice (under any path) would count its cells twice: refused before
+/// anything is read.
+fn refuse_repeated_inputs(dirs: &[PathBuf]) -> anyhow::Result<()> {
+    let mut seen: Vec<(PathBuf, &Path)> = Vec::new();
+    for d in dirs {
+        let canonical = d
+            .canonicalize()
+            .with_context(|| format!("cannot read the shard directory '{}'", d.display()))?;
+        if let Some((_, first)) = seen.iter().find(|(c, _)| *c == canonical) {
+            bail!(
+                "'{}' is given twice (also as '{}'): each shard directory once",
+                d.display(),
+                first.display()
+            );
+        }
+        seen.push((canonical, d));
+    }
+    Ok(())
 }
 
 /// `--out` must not be one of the shards: `--force` would replace a shard's results.
@@ -149,20 +172,17 @@ fn refuse_output_among_inputs(request: &Request) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Reads a shard directory under its lock: `meta.json`, and the cells of `summary.csv` whose
-/// trials in `trials.csv` bear them out (others are left out: they count as missing).
+/// Reads a shard directory under a shared lock (read-only: see [`lock::for_reading`]):
+/// `meta.json`, and the cells of `summary.csv` whose trials in `trials.csv` bear them out
+/// (others are left out: they count as missing).
 fn read_shard(dir: &Path) -> anyhow::Result<Read> {
-    if !dir.join(META_FILE).is_file() {
+    let _reading = lock::for_reading(dir).context("cannot merge now")?;
+    if std::fs::symlink_metadata(dir.join(META_FILE)).is_err() {
         bail!(
             "'{}' is not a results directory of bench-sph sweep (no {META_FILE})",
             dir.display()
         );
     }
-    // A sweep always leaves its lock file; never create one in a directory that has none.
-    let lock = match dir.join(LOCK_FILE).is_file() {
-        true => Some(lock::acquire(dir)?),
-        false => None,
-    };
     let meta = Meta::read(&dir.join(META_FILE))?;
     let (summary, _) = read_summary(&dir.join(SUMMARY_FILE))
         .with_context(|| format!("cannot merge '{}'", dir.display()))?;
@@ -174,7 +194,6 @@ fn read_shard(dir: &Path) -> anyhow::Result<Read> {
         meta,
         rows: believed.rows,
         trials: believed.trials,
-        _lock: lock,
     })
 }
 

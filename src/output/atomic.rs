@@ -70,19 +70,22 @@ impl AtomicFile {
         &self.dest
     }
 
-    /// Flushes, syncs and renames the file over its destination.
+    /// Flushes, syncs and renames the file over its destination. On an error (a full disk,
+    /// a directory in the destination's place) the temporary file is removed and the
+    /// destination keeps what it had.
     pub fn commit(mut self) -> anyhow::Result<()> {
         let out = self.out.take().expect("an AtomicFile is committed once");
         let context = || format!("cannot write '{}'", self.dest.display());
-        let file = out
+        let renamed = out
             .into_inner()
             .map_err(|e| e.into_error())
-            .with_context(context)?;
-        file.sync_all().with_context(context)?;
-        drop(file);
-        std::fs::rename(&self.tmp, &self.dest).with_context(context)?;
+            .and_then(|file| file.sync_all())
+            .and_then(|()| std::fs::rename(&self.tmp, &self.dest));
+        if renamed.is_err() {
+            let _ = std::fs::remove_file(&self.tmp);
+        }
         forget_live(&self.tmp);
-        Ok(())
+        renamed.with_context(context)
     }
 }
 
@@ -157,6 +160,17 @@ mod tests {
         drop(f);
         assert_eq!(std::fs::read_to_string(&dest).unwrap(), "old");
         assert_eq!(names(dir.path()), ["out.csv"]);
+    }
+
+    #[test]
+    fn a_commit_over_a_directory_fails_and_leaves_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let dest = dir.path().join("chart.png");
+        std::fs::create_dir(&dest).unwrap();
+        let err = format!("{:#}", write(&dest, b"png").unwrap_err());
+        assert!(err.contains("cannot write"), "{err}");
+        assert_eq!(names(dir.path()), ["chart.png"]);
+        assert!(dest.is_dir());
     }
 
     #[test]

@@ -1,52 +1,94 @@
-//! Which files in an output directory a command may replace.
+//! Which files in an output directory a command may replace: those the directory's record
+//! ([`super::record`]) gives to it, and no other.
 //!
-//! Every command that writes a directory (`sweep --out`, `trace --out`, `render --frames`,
-//! `report --out`) claims it first with [`claim`]:
-//! - a missing directory is created; an empty one is used;
-//! - a directory holding only the command's **own** earlier output (as the command
-//!   recognises it: [`Owner::owns`]) is reused, and after writing, [`Claimed::remove_stale`]
-//!   deletes the earlier files this run did not write again (old frames, old charts);
-//! - a directory holding anything else is refused, naming what it holds, unless `--force`;
-//!   with `--force` the foreign entries stay untouched, and writing a file whose name belongs
-//!   to a foreign file is still an error ([`Claimed::check_writable`]): `--force` replaces
-//!   only the command's own files.
+//! Every command that writes a directory (`sweep --out`, `merge --out`, `report --out`,
+//! `trace --out`, `render --frames`, `validate --out`) claims it first with [`claim`]:
+//! - a missing directory is created, and the directory is locked for as long as the command
+//!   writes ([`super::lock`]): a second writer, of any command, is refused naming the first;
+//! - its entries are sorted by the record: the command's **own** files (the record names the
+//!   command, or one the command replaces: [`Owner::replaces`]), files it leaves alone
+//!   ([`Owner::tolerates`]: a sweep's results beside its report, say), and everything else —
+//!   every file the record does not name, whatever its name, size or contents, and the files
+//!   of other commands — which is **foreign**;
+//! - a directory holding foreign entries is refused, naming them, unless `--force`; with
+//!   `--force` they stay untouched, and writing over one is still an error
+//!   ([`Claimed::check_writable`]): `--force` replaces only the command's own files. A
+//!   directory without a record (written by an older bench-sph, or by hand) has nothing of
+//!   the command's own: it is refused unless `--force`, which then writes beside everything;
+//! - the command records each file before creating it ([`Claimed::record`]), and afterwards
+//!   removes its own recorded files that this run did not write again
+//!   ([`Claimed::remove_stale`]: old frames, old charts).
 //!
-//! Entries that [`Owner::tolerates`] (the report's input sweeps in its own directory, say)
-//! are neither replaced nor refused. Temporary files of [`super::atomic`] are ignored.
+//! The record, the lock files and [`super::atomic`]'s temporary files are never counted.
 
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
 use super::atomic::is_temporary;
+use super::lock::{self, DirLock, LEGACY_LOCK_FILE, LOCK_FILE};
+use super::record::{self, Command, RECORD_FILE, Record};
 
-/// How a command recognises its own output.
+/// A command, and what it may do with a directory's entries.
 pub struct Owner<'a> {
-    /// The command, as the user typed it, e.g. `bench-sph trace`.
-    pub command: &'a str,
+    /// The command.
+    pub command: Command,
     /// The option that names the directory, e.g. `--out`.
     pub option: &'a str,
-    /// Whether a top-level entry of the directory is this command's earlier output.
-    pub owns: &'a dyn Fn(&Path) -> bool,
-    /// Whether an entry that is not the command's own may stay beside its output.
-    pub tolerates: &'a dyn Fn(&Path) -> bool,
+    /// Other commands whose recorded files this one replaces with `--force` (a new sweep
+    /// replaces an earlier sweep's or merge's results and the report drawn there).
+    pub replaces: &'a [Command],
+    /// Commands whose recorded files stay beside this command's output, neither replaced nor
+    /// refused (a report in a sweep's directory leaves the sweep's files alone).
+    pub tolerates: &'a [Command],
+    /// Whether an entry the record does not name may stay beside the output, neither
+    /// replaced nor refused (a trace directory inside a sweep's; the report's own input files).
+    pub tolerates_unrecorded: &'a dyn Fn(&Path) -> bool,
+    /// The files the command will write, where known before it starts: each is checked
+    /// ([`Claimed::check_writable`]) before anything is created, the lock file included.
+    pub writes: &'a [&'a str],
 }
 
-/// Tolerates nothing: for [`Owner::tolerates`].
+/// Tolerates nothing: for [`Owner::tolerates_unrecorded`].
 pub fn nothing(_: &Path) -> bool {
     false
 }
 
-/// A directory a command may write into.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Claimed {
-    dir: PathBuf,
-    command: String,
-    earlier: Vec<PathBuf>,
-    foreign: Vec<PathBuf>,
+/// An entry a command may not replace.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Foreign {
+    /// Its name in the directory.
+    pub name: String,
+    /// The command the record says wrote it; `None` when the record does not name it.
+    pub writer: Option<Command>,
+    /// Whether it is a directory.
+    pub is_dir: bool,
 }
 
-/// Claims `dir` for `owner`; see the module docs.
+/// A directory a command holds and may write into.
+#[derive(Debug, Clone)]
+pub struct Claimed {
+    dir: PathBuf,
+    command: Command,
+    /// What the directory held when it was claimed.
+    survey: Survey,
+    /// Names the command may write: its earlier files and those it has recorded since.
+    mine: HashSet<String>,
+    lock: DirLock,
+}
+
+/// What a directory holds, for an [`Owner`]: its own recorded files (or those of commands it
+/// replaces) with their writers, the entries it may not replace, and whether there was a
+/// record at all.
+#[derive(Debug, Clone)]
+struct Survey {
+    earlier: Vec<(String, Command)>,
+    foreign: Vec<Foreign>,
+    had_record: bool,
+}
+
+/// Locks and claims `dir` for `owner`; see the module docs.
 pub fn claim(dir: &Path, owner: &Owner<'_>, force: bool) -> anyhow::Result<Claimed> {
     if dir.exists() && !dir.is_dir() {
         bail!(
@@ -57,65 +99,167 @@ pub fn claim(dir: &Path, owner: &Owner<'_>, force: bool) -> anyhow::Result<Claim
     }
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create directory '{}'", dir.display()))?;
-    let mut earlier = Vec::new();
-    let mut foreign = Vec::new();
-    for path in entries(dir)? {
-        if (owner.owns)(&path) {
-            earlier.push(path);
-        } else if !(owner.tolerates)(&path) {
-            foreign.push(path);
+    let check = |survey: &Survey| -> anyhow::Result<()> {
+        refuse_foreign(dir, owner, survey, force)?;
+        for name in owner.writes {
+            writable(dir, owner.command, survey, &survey.mine(), name)?;
         }
+        Ok(())
+    };
+    if std::fs::symlink_metadata(dir.join(LOCK_FILE)).is_err() {
+        // Not a directory bench-sph writes yet: refuse before creating a lock file in it, so
+        // that a refused command leaves nothing behind. (The lock file is never deleted.)
+        check(&survey(dir, owner)?)?;
     }
-    if !foreign.is_empty() && !force {
-        bail!(
-            "{} '{}' holds files that {} did not write ({}); choose a new or empty directory, \
-             or pass --force to write beside them (only {}'s own files are replaced)",
-            owner.option,
-            dir.display(),
-            owner.command,
-            list(&foreign),
-            owner.command
-        );
-    }
+    let lock = lock::acquire(dir, owner.command)?;
+    // Again under the lock, which makes it authoritative.
+    let survey = survey(dir, owner)?;
+    check(&survey)?;
     Ok(Claimed {
         dir: dir.to_path_buf(),
-        command: owner.command.to_owned(),
-        earlier,
-        foreign,
+        command: owner.command,
+        mine: survey.mine(),
+        survey,
+        lock,
     })
 }
 
-/// The entries of `dir`, sorted, without temporary files.
-fn entries(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
-    let read = std::fs::read_dir(dir)
-        .with_context(|| format!("cannot read directory '{}'", dir.display()))?;
-    let mut out = Vec::new();
-    for entry in read {
-        let entry = entry.with_context(|| format!("cannot read directory '{}'", dir.display()))?;
-        if !is_temporary(&entry.file_name().to_string_lossy()) {
-            out.push(entry.path());
-        }
+impl Survey {
+    /// The names of the earlier files.
+    fn mine(&self) -> HashSet<String> {
+        self.earlier.iter().map(|(n, _)| n.clone()).collect()
     }
-    out.sort();
-    Ok(out)
 }
 
-/// Up to three names, then how many more.
-fn list(paths: &[PathBuf]) -> String {
-    let mut names: Vec<String> = paths
+/// `dir/name`, unless something `command` may not replace is there: a directory, or a file
+/// the record does not give to it (`mine`, the names it may write).
+fn writable(
+    dir: &Path,
+    command: Command,
+    survey: &Survey,
+    mine: &HashSet<String>,
+    name: &str,
+) -> anyhow::Result<PathBuf> {
+    let path = dir.join(name);
+    let meta = match std::fs::symlink_metadata(&path) {
+        Ok(meta) => meta,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(path),
+        Err(e) => return Err(e).with_context(|| format!("cannot write '{}'", path.display())),
+    };
+    if meta.is_file() && mine.contains(name) {
+        return Ok(path);
+    }
+    if meta.is_dir() {
+        bail!(
+            "cannot write '{}': a directory of that name is in the way (nothing was written; \
+             move it, or write elsewhere)",
+            path.display()
+        );
+    }
+    let why = match survey.foreign.iter().find(|f| f.name == name) {
+        Some(Foreign {
+            writer: Some(c), ..
+        }) => format!("the record says {c} wrote it"),
+        _ => format!("no record in '{}' says it did", dir.display()),
+    };
+    bail!(
+        "cannot write '{}': it exists and was not written by {command} ({why}); --force \
+         replaces only that command's own files: move it away, or write elsewhere",
+        path.display()
+    )
+}
+
+/// Whether a directory entry is bench-sph's own bookkeeping, never counted: the record, the
+/// lock files, temporary files.
+pub fn is_bookkeeping(name: &str) -> bool {
+    name == RECORD_FILE || name == LOCK_FILE || name == LEGACY_LOCK_FILE || is_temporary(name)
+}
+
+fn survey(dir: &Path, owner: &Owner<'_>) -> anyhow::Result<Survey> {
+    let record = Record::read(dir)?;
+    let read = std::fs::read_dir(dir)
+        .with_context(|| format!("cannot read directory '{}'", dir.display()))?;
+    let mut names = Vec::new();
+    for entry in read {
+        let entry = entry.with_context(|| format!("cannot read directory '{}'", dir.display()))?;
+        names.push(entry.file_name().to_string_lossy().into_owned());
+    }
+    names.sort();
+    let mut survey = Survey {
+        earlier: Vec::new(),
+        foreign: Vec::new(),
+        had_record: record.is_some(),
+    };
+    for name in names.into_iter().filter(|n| !is_bookkeeping(n)) {
+        let path = dir.join(&name);
+        let Ok(meta) = std::fs::symlink_metadata(&path) else {
+            continue; // Gone since it was listed.
+        };
+        let writer = record.as_ref().and_then(|r| r.writer(&name));
+        match writer {
+            // Only a plain file is still the one the command wrote (a link or a directory in
+            // its place is someone else's).
+            Some(c) if (c == owner.command || owner.replaces.contains(&c)) && meta.is_file() => {
+                survey.earlier.push((name, c));
+                continue;
+            }
+            Some(c) if owner.tolerates.contains(&c) => continue,
+            None if (owner.tolerates_unrecorded)(&path) => continue,
+            _ => {}
+        }
+        survey.foreign.push(Foreign {
+            name,
+            writer,
+            is_dir: path.is_dir(),
+        });
+    }
+    Ok(survey)
+}
+
+fn refuse_foreign(
+    dir: &Path,
+    owner: &Owner<'_>,
+    survey: &Survey,
+    force: bool,
+) -> anyhow::Result<()> {
+    if survey.foreign.is_empty() || force {
+        return Ok(());
+    }
+    let no_record = match survey.had_record {
+        true => String::new(),
+        false => format!(
+            "; it has no {RECORD_FILE}, bench-sph's record of the files it wrote, so none of \
+             them counts as bench-sph's"
+        ),
+    };
+    bail!(
+        "{} '{}' holds files that {} did not write ({}); choose a new or empty directory, or \
+         pass --force to write beside them (they stay untouched: --force replaces only {}'s \
+         own files){no_record}",
+        owner.option,
+        dir.display(),
+        owner.command,
+        list(&survey.foreign),
+        owner.command
+    )
+}
+
+/// Up to three names (a directory with a `/`, another command's file with its writer), then
+/// how many more.
+fn list(foreign: &[Foreign]) -> String {
+    let mut names: Vec<String> = foreign
         .iter()
         .take(3)
-        .map(|p| {
-            let name = p.file_name().unwrap_or_default().to_string_lossy();
-            if p.is_dir() {
-                format!("'{name}/'")
-            } else {
-                format!("'{name}'")
+        .map(|f| {
+            let slash = if f.is_dir { "/" } else { "" };
+            match f.writer {
+                Some(c) => format!("'{}{slash}' of {c}", f.name),
+                None => format!("'{}{slash}'", f.name),
             }
         })
         .collect();
-    if paths.len() > 3 {
-        names.push(format!("and {} more", paths.len() - 3));
+    if foreign.len() > 3 {
+        names.push(format!("and {} more", foreign.len() - 3));
     }
     names.join(", ")
 }
@@ -126,54 +270,88 @@ impl Claimed {
         &self.dir
     }
 
-    /// The command's own files that were there before this run.
-    pub fn earlier(&self) -> &[PathBuf] {
-        &self.earlier
+    /// The directory's lock, to hold beyond this claim.
+    pub fn lock(&self) -> DirLock {
+        self.lock.clone()
     }
 
-    /// Entries that were not the command's own (non-empty only with `--force`).
-    pub fn foreign(&self) -> &[PathBuf] {
-        &self.foreign
+    /// The command's own recorded files (or those of commands it replaces) that were there
+    /// when it claimed the directory, with the command that wrote each.
+    pub fn earlier(&self) -> &[(String, Command)] {
+        &self.survey.earlier
     }
 
-    /// Whether the directory held nothing but tolerated entries.
-    pub fn was_empty(&self) -> bool {
-        self.earlier.is_empty() && self.foreign.is_empty()
+    /// Entries it may not replace (non-empty only with `--force`).
+    pub fn foreign(&self) -> &[Foreign] {
+        &self.survey.foreign
     }
 
-    /// `dir/name`, unless that names a file the command did not write.
+    /// Whether the directory had a record of bench-sph's files when it was claimed.
+    pub fn had_record(&self) -> bool {
+        self.survey.had_record
+    }
+
+    /// `dir/name`, unless something the command may not replace is there: a directory, or a
+    /// file the record does not give to the command (or to one it replaces).
     pub fn check_writable(&self, name: &str) -> anyhow::Result<PathBuf> {
-        let path = self.dir.join(name);
-        if self.foreign.contains(&path) {
-            bail!(
-                "cannot write '{}': it exists and was not written by {} (--force replaces \
-                 only that command's own files)",
-                path.display(),
-                self.command
-            );
-        }
-        Ok(path)
+        writable(&self.dir, self.command, &self.survey, &self.mine, name)
     }
 
-    /// Removes the command's earlier files that this run did not write (`written`), and
-    /// returns them.
-    pub fn remove_stale(&self, written: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
+    /// Records that the command writes `names` (call it before creating them).
+    pub fn record<S: AsRef<str>>(&mut self, names: &[S]) -> anyhow::Result<()> {
+        record::add(&self.dir, self.command, names)?;
+        self.mine
+            .extend(names.iter().map(|n| n.as_ref().to_owned()));
+        Ok(())
+    }
+
+    /// Removes every earlier file ([`Claimed::earlier`]: the command's own and those of the
+    /// commands it replaces) and takes it out of the record; returns them.
+    pub fn remove_earlier(&mut self) -> anyhow::Result<Vec<PathBuf>> {
+        let names: Vec<String> = self.survey.earlier.iter().map(|(n, _)| n.clone()).collect();
+        let removed = self.remove_files(&names)?;
+        self.survey.earlier.clear();
+        Ok(removed)
+    }
+
+    /// Removes the command's own recorded files that this run did not write (`written`), and
+    /// returns them. A name the record gives to the command whose file is gone, or is no
+    /// longer a plain file (left alone), leaves the record too.
+    pub fn remove_stale(&mut self, written: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
+        let written: HashSet<&std::ffi::OsStr> =
+            written.iter().filter_map(|p| p.file_name()).collect();
+        let record = Record::read(&self.dir)?.unwrap_or_default();
+        let stale: Vec<String> = record
+            .files
+            .iter()
+            .filter(|&(name, &c)| {
+                c == self.command && !written.contains(std::ffi::OsStr::new(name))
+            })
+            .map(|(name, _)| name.clone())
+            .collect();
+        self.remove_files(&stale)
+    }
+
+    /// Removes those of `names` that are plain files, forgets all of them, returns the
+    /// removed files.
+    fn remove_files(&mut self, names: &[String]) -> anyhow::Result<Vec<PathBuf>> {
         let mut removed = Vec::new();
-        for path in self.earlier.iter().filter(|p| !written.contains(p)) {
-            let result = if path.is_dir() {
-                std::fs::remove_dir_all(path)
-            } else {
-                std::fs::remove_file(path)
-            };
-            match result {
-                Ok(()) => removed.push(path.clone()),
+        for name in names {
+            let path = self.dir.join(name);
+            if !std::fs::symlink_metadata(&path).is_ok_and(|m| m.is_file()) {
+                continue;
+            }
+            match std::fs::remove_file(&path) {
+                Ok(()) => removed.push(path),
                 Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
                 Err(e) => {
-                    return Err(e).with_context(|| {
-                        format!("cannot remove the stale file '{}'", path.display())
-                    });
+                    return Err(e).with_context(|| format!("cannot remove '{}'", path.display()));
                 }
             }
+        }
+        record::remove(&self.dir, names)?;
+        for name in names {
+            self.mine.remove(name);
         }
         Ok(removed)
     }
@@ -183,68 +361,111 @@ impl Claimed {
 mod tests {
     use super::*;
 
-    fn csv_is_mine(p: &Path) -> bool {
-        p.extension().is_some_and(|e| e == "csv")
-    }
+    const TEST: Command = Command::Validate;
 
-    fn owner<'a>(owns: &'a dyn Fn(&Path) -> bool) -> Owner<'a> {
+    fn owner() -> Owner<'static> {
         Owner {
-            command: "bench-sph test",
+            command: TEST,
             option: "--out",
-            owns,
-            tolerates: &nothing,
+            replaces: &[],
+            tolerates: &[Command::Sweep],
+            tolerates_unrecorded: &nothing,
+            writes: &[],
         }
     }
 
-    #[test]
-    fn a_missing_directory_is_created_and_an_empty_one_used() {
-        let tmp = tempfile::tempdir().unwrap();
-        let dir = tmp.path().join("a/b");
-        let c = claim(&dir, &owner(&csv_is_mine), false).unwrap();
-        assert!(dir.is_dir() && c.was_empty());
+    fn write(dir: &Path, name: &str) {
+        std::fs::write(dir.join(name), name).unwrap();
     }
 
     #[test]
-    fn a_directory_with_foreign_files_is_refused_naming_them() {
+    fn a_missing_directory_is_created_locked_and_empty() {
         let tmp = tempfile::tempdir().unwrap();
-        std::fs::write(tmp.path().join("meta.json"), "{}").unwrap();
-        std::fs::write(tmp.path().join("x.csv"), "").unwrap();
-        let err = claim(tmp.path(), &owner(&csv_is_mine), false).unwrap_err();
-        let msg = err.to_string();
+        let dir = tmp.path().join("a/b");
+        let c = claim(&dir, &owner(), false).unwrap();
+        assert!(dir.is_dir() && c.earlier().is_empty() && c.foreign().is_empty());
+        assert!(dir.join(LOCK_FILE).is_file());
+    }
+
+    #[test]
+    fn files_without_a_record_are_foreign_whatever_their_name_and_a_refusal_leaves_nothing() {
+        let tmp = tempfile::tempdir().unwrap();
+        write(tmp.path(), "surge_front.csv");
+        let err = claim(tmp.path(), &owner(), false).unwrap_err().to_string();
         assert!(
-            msg.contains("'meta.json'") && !msg.contains("x.csv"),
-            "{msg}"
+            err.contains("'surge_front.csv'") && err.contains("--force"),
+            "{err}"
         );
-        assert!(msg.contains("--force"), "{msg}");
+        assert!(err.contains("has no bench-sph-files.json"), "{err}");
+        assert!(!tmp.path().join(LOCK_FILE).exists(), "nothing is created");
     }
 
     #[test]
     fn force_writes_beside_foreign_files_but_never_over_them() {
         let tmp = tempfile::tempdir().unwrap();
-        std::fs::write(tmp.path().join("meta.json"), "{}").unwrap();
-        let c = claim(tmp.path(), &owner(&csv_is_mine), true).unwrap();
-        assert!(c.check_writable("stats.csv").is_ok());
-        let err = c.check_writable("meta.json").unwrap_err().to_string();
-        assert!(err.contains("was not written by bench-sph test"), "{err}");
-        c.remove_stale(&[]).unwrap();
+        write(tmp.path(), "a.csv");
+        let mut c = claim(tmp.path(), &owner(), true).unwrap();
+        assert!(c.check_writable("b.csv").is_ok());
+        let err = c.check_writable("a.csv").unwrap_err().to_string();
         assert!(
-            tmp.path().join("meta.json").exists(),
-            "a foreign file is never removed"
+            err.contains("was not written by bench-sph validate (no record"),
+            "{err}"
+        );
+        c.remove_stale(&[]).unwrap();
+        assert!(tmp.path().join("a.csv").exists(), "a foreign file stays");
+    }
+
+    #[test]
+    fn recorded_files_are_own_tolerated_or_foreign_by_their_writer() {
+        let tmp = tempfile::tempdir().unwrap();
+        for name in ["mine.csv", "sweeps.csv", "traces.csv"] {
+            write(tmp.path(), name);
+        }
+        record::add(tmp.path(), TEST, &["mine.csv"]).unwrap();
+        record::add(tmp.path(), Command::Sweep, &["sweeps.csv"]).unwrap();
+        record::add(tmp.path(), Command::Trace, &["traces.csv"]).unwrap();
+        let err = claim(tmp.path(), &owner(), false).unwrap_err().to_string();
+        assert!(
+            err.contains("('traces.csv' of bench-sph trace)"),
+            "only the trace's file is foreign: {err}"
+        );
+        let c = claim(tmp.path(), &owner(), true).unwrap();
+        assert_eq!(c.earlier(), [("mine.csv".to_owned(), TEST)]);
+        assert!(c.check_writable("mine.csv").is_ok());
+        let err = c.check_writable("sweeps.csv").unwrap_err().to_string();
+        assert!(
+            err.contains("was not written by bench-sph validate"),
+            "{err}"
         );
     }
 
     #[test]
-    fn own_files_not_written_again_are_removed_as_stale() {
+    fn own_files_not_written_again_are_removed_and_forgotten() {
         let tmp = tempfile::tempdir().unwrap();
-        for name in ["a.csv", "b.csv"] {
-            std::fs::write(tmp.path().join(name), "").unwrap();
+        for name in ["a.csv", "b.csv", ".a.csv.99.tmp"] {
+            write(tmp.path(), name);
         }
-        std::fs::write(tmp.path().join(".a.csv.99.tmp"), "").unwrap();
-        let c = claim(tmp.path(), &owner(&csv_is_mine), false).unwrap();
+        record::add(tmp.path(), TEST, &["a.csv", "b.csv", "never-written.csv"]).unwrap();
+        let mut c = claim(tmp.path(), &owner(), false).unwrap();
         assert_eq!(c.earlier().len(), 2, "temporary files are not counted");
         let removed = c.remove_stale(&[tmp.path().join("a.csv")]).unwrap();
         assert_eq!(removed, [tmp.path().join("b.csv")]);
         assert!(tmp.path().join("a.csv").exists());
+        let record = Record::read(tmp.path()).unwrap().unwrap();
+        assert_eq!(record.files.keys().collect::<Vec<_>>(), ["a.csv"]);
+    }
+
+    #[test]
+    fn a_directory_in_place_of_a_file_is_never_replaced_even_if_recorded() {
+        let tmp = tempfile::tempdir().unwrap();
+        std::fs::create_dir(tmp.path().join("chart.png")).unwrap();
+        record::add(tmp.path(), TEST, &["chart.png"]).unwrap();
+        let c = claim(tmp.path(), &owner(), true).unwrap();
+        let err = c.check_writable("chart.png").unwrap_err().to_string();
+        assert!(
+            err.contains("a directory of that name is in the way"),
+            "{err}"
+        );
     }
 
     #[test]
@@ -252,9 +473,7 @@ mod tests {
         let tmp = tempfile::tempdir().unwrap();
         let file = tmp.path().join("f");
         std::fs::write(&file, "").unwrap();
-        let err = claim(&file, &owner(&csv_is_mine), true)
-            .unwrap_err()
-            .to_string();
+        let err = claim(&file, &owner(), true).unwrap_err().to_string();
         assert!(err.contains("is not a directory"), "{err}");
     }
 }

@@ -1,7 +1,13 @@
 //! PNG frames out: one file per frame, `frame_00000.png`, `frame_00001.png`, … in a folder
 //! (the numbering `ffmpeg -i frame_%05d.png` reads). Each frame is written whole (temporary
-//! file, then rename), and the folder is claimed ([`crate::output::claim`]): files named like
-//! frames are this command's own, anything else makes it refuse the folder unless `--force`.
+//! file, then rename), and the folder is claimed ([`crate::output::claim`]) and held for the
+//! whole render: the frames its record gives to render are this command's own, anything else
+//! makes it refuse the folder unless `--force`, which writes beside it and never over it.
+//!
+//! Frames are recorded ahead in batches that double (16, then as many again as are written):
+//! the record covers every frame before it is written, and is rewritten a logarithmic number
+//! of times, not once per frame. Names recorded but never written leave the record at
+//! [`PngFrames::finish`].
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -10,7 +16,11 @@ use anyhow::Context;
 
 use crate::output::atomic;
 use crate::output::claim::{self, Claimed, Owner};
+use crate::output::record::Command;
 use crate::render::image::Image;
+
+/// The first batch of frames recorded ahead.
+const FIRST_BATCH: usize = 16;
 
 /// Encodes `image` as an 8-bit RGB PNG on `out`.
 pub fn write_png<W: Write>(out: W, image: &Image) -> Result<(), png::EncodingError> {
@@ -27,20 +37,13 @@ fn frame_name(index: usize) -> String {
     format!("frame_{index:05}.png")
 }
 
-/// Whether `path` is a frame file as [`frame_name`] names them: render's own output.
-fn is_frame(path: &Path) -> bool {
-    let name = path.file_name().unwrap_or_default().to_string_lossy();
-    let digits = name
-        .strip_prefix("frame_")
-        .and_then(|rest| rest.strip_suffix(".png"));
-    digits.is_some_and(|d| d.len() >= 5 && d.bytes().all(|b| b.is_ascii_digit())) && path.is_file()
-}
-
 /// Numbered PNG files in one claimed folder.
 #[derive(Debug)]
 pub struct PngFrames {
     claimed: Claimed,
     written: Vec<PathBuf>,
+    /// Frames `0..recorded` are in the folder's record.
+    recorded: usize,
 }
 
 impl PngFrames {
@@ -49,14 +52,17 @@ impl PngFrames {
     /// folder holding anything else is refused unless `force`, which writes beside it.
     pub fn create(dir: &Path, force: bool) -> anyhow::Result<PngFrames> {
         let owner = Owner {
-            command: "bench-sph render",
+            command: Command::Render,
             option: "--frames",
-            owns: &is_frame,
-            tolerates: &claim::nothing,
+            replaces: &[],
+            tolerates: &[],
+            tolerates_unrecorded: &claim::nothing,
+            writes: &[],
         };
         Ok(PngFrames {
             claimed: claim::claim(dir, &owner, force)?,
             written: Vec::new(),
+            recorded: 0,
         })
     }
 
@@ -67,9 +73,11 @@ impl PngFrames {
 
     /// Writes the next frame and returns its path.
     pub fn push(&mut self, image: &Image) -> anyhow::Result<PathBuf> {
-        let path = self
-            .claimed
-            .check_writable(&frame_name(self.written.len()))?;
+        let index = self.written.len();
+        let path = self.claimed.check_writable(&frame_name(index))?;
+        if index >= self.recorded {
+            self.record_ahead(index)?;
+        }
         let mut bytes = Vec::new();
         write_png(&mut bytes, image)
             .with_context(|| format!("cannot write frame '{}'", path.display()))?;
@@ -78,13 +86,28 @@ impl PngFrames {
         Ok(path)
     }
 
+    /// Records frames from `first` on, as many as have been written (at least
+    /// [`FIRST_BATCH`]), stopping before a name that may not be written (its frame then
+    /// fails when it comes).
+    fn record_ahead(&mut self, first: usize) -> anyhow::Result<()> {
+        let batch = first.max(FIRST_BATCH);
+        let names: Vec<String> = (first..first + batch)
+            .map(frame_name)
+            .take_while(|name| self.claimed.check_writable(name).is_ok())
+            .collect();
+        self.claimed.record(&names)?;
+        self.recorded = first + names.len();
+        Ok(())
+    }
+
     /// Frames written so far.
     pub fn written(&self) -> usize {
         self.written.len()
     }
 
-    /// Removes the frames of an earlier render that this one did not write again.
-    pub fn finish(self) -> anyhow::Result<()> {
+    /// Removes the frames of an earlier render that this one did not write again, and
+    /// takes the frames recorded ahead but not written out of the record.
+    pub fn finish(mut self) -> anyhow::Result<()> {
         self.claimed.remove_stale(&self.written).map(drop)
     }
 }
@@ -129,29 +152,37 @@ mod tests {
 #[cfg(test)]
 mod claim_tests {
     use super::*;
+    use crate::output::record::Record;
 
     #[test]
-    fn only_files_named_like_frames_are_renders_own() {
+    fn frames_are_recorded_ahead_and_those_not_written_are_forgotten() {
         let dir = tempfile::tempdir().unwrap();
-        for name in [
-            "frame_00003.png",
-            "frame_123456.png",
-            "frame_3.png",
-            "frame_0000x.png",
-        ] {
-            std::fs::write(dir.path().join(name), "").unwrap();
+        let mut frames = PngFrames::create(dir.path(), false).unwrap();
+        let image = Image::filled(2, 2, [1, 2, 3]);
+        for _ in 0..20 {
+            frames.push(&image).unwrap();
         }
-        std::fs::create_dir(dir.path().join("frame_00004.png")).unwrap();
-        let own: Vec<bool> = [
-            "frame_00003.png",
-            "frame_123456.png",
-            "frame_3.png",
-            "frame_0000x.png",
-            "frame_00004.png",
-        ]
-        .iter()
-        .map(|n| is_frame(&dir.path().join(n)))
-        .collect();
-        assert_eq!(own, [true, true, false, false, false]);
+        let record = Record::read(dir.path()).unwrap().unwrap();
+        assert_eq!(record.files.len(), 32, "16, then 16 more at frame 16");
+        frames.finish().unwrap();
+        let record = Record::read(dir.path()).unwrap().unwrap();
+        assert_eq!(record.files.len(), 20);
+        assert_eq!(record.writer("frame_00019.png"), Some(Command::Render));
+    }
+
+    #[test]
+    fn a_users_file_named_like_a_frame_is_never_replaced() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("frame_00001.png"), "mine").unwrap();
+        assert!(PngFrames::create(dir.path(), false).is_err());
+        let mut frames = PngFrames::create(dir.path(), true).unwrap();
+        let image = Image::filled(2, 2, [1, 2, 3]);
+        frames.push(&image).unwrap();
+        let err = frames.push(&image).unwrap_err().to_string();
+        assert!(err.contains("was not written by bench-sph render"), "{err}");
+        assert_eq!(
+            std::fs::read_to_string(dir.path().join("frame_00001.png")).unwrap(),
+            "mine"
+        );
     }
 }

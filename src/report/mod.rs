@@ -54,27 +54,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::bail;
 
+use crate::output::claim::{self, Claimed, Owner};
+use crate::output::record::Command;
+pub use crate::results::REPORT_FILE;
 use crate::results::load;
-pub use crate::results::{REPORT_FILE, is_report_file};
 use plan::ChartKind;
-
-/// Whether an entry of a report's directory may stay beside the report: a sweep's own files
-/// (the report is often drawn into the sweep's directory) and any directory (traces; the
-/// report never writes into subdirectories).
-fn tolerated(path: &Path) -> bool {
-    use crate::results::{LOCK_FILE, META_FILE, REFERENCES_FILE, SUMMARY_FILE, TRIALS_FILE};
-    path.is_dir()
-        || path.file_name().and_then(|n| n.to_str()).is_some_and(|n| {
-            [
-                TRIALS_FILE,
-                SUMMARY_FILE,
-                META_FILE,
-                LOCK_FILE,
-                REFERENCES_FILE,
-            ]
-            .contains(&n)
-        })
-}
 
 /// Reads the sweeps in `results_dirs`, draws every chart that applies into `out_dir`
 /// (claimed first: see [`crate::output::claim`]; `force` writes beside foreign files),
@@ -104,6 +88,10 @@ pub fn generate(
 /// as always; several sides (several machines, or `--compare`) make a comparison of machines
 /// ([`compare`]), whose charts are named `compare-…` and which embeds no trace (traces
 /// belong to one machine's full report).
+///
+/// Every file the report will write (charts, copied timelines, REPORT.md) is planned and
+/// checked first: a name taken by a directory, or by a file the directory's record does not
+/// give to the report, stops it before anything is written.
 pub fn generate_with(
     results_dirs: &[PathBuf],
     out_dir: &Path,
@@ -134,108 +122,151 @@ pub fn generate_with(
     if comparison {
         refuse_comparison_into_an_input(results_dirs, out_dir)?;
     }
-    let owns = |p: &Path| p.is_file() && is_report_file(p);
-    let owner = crate::output::claim::Owner {
-        command: "bench-sph report",
-        option: "--out",
-        owns: &owns,
-        tolerates: &tolerated,
-    };
-    let claimed = crate::output::claim::claim(out_dir, &owner, force)?;
-    claimed.check_writable(REPORT_FILE)?;
-
-    let mut written = Vec::new();
-    let text = if comparison {
+    // The plan: every file to write, checked before any is written.
+    let drawing = if comparison {
         if !trace_dirs.is_empty() {
             crate::output::console::warn(
                 "warning: --trace is not used when machines are compared: traces belong to \
                  one machine's full report",
             );
         }
-        compared(&sweeps, &sides, rule, &claimed, &mut written)?
+        Drawing::Compared(compare::plan::plan(&sides))
     } else {
-        let traces = (results_dirs, out_dir, trace_dirs);
-        // One study: one side, whose views are the study's.
-        pooled(&sweeps, &sides[0].views, traces, &claimed, &mut written)?
+        let views = &sides[0].views;
+        Drawing::Pooled {
+            planned: plan::plan(views, |g| markdown::topology_of(&sweeps, g)),
+            traces: find_traces(results_dirs, out_dir, trace_dirs)?,
+        }
+    };
+    let mut files = drawing.files();
+    files.push(REPORT_FILE.to_owned());
+    let mut claimed = claim_out(results_dirs, out_dir, &files, force)?;
+    let paths = files
+        .iter()
+        .map(|f| claimed.check_writable(f))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    claimed.record(&files)?;
+
+    // Then the drawing, file by file (each whole or not at all), and the text.
+    let text = match &drawing {
+        Drawing::Compared(planned) => {
+            for chart in planned.compared.iter().flat_map(|c| &c.charts) {
+                let path = out_dir.join(&chart.file);
+                charts::compare::draw(&path, &chart.title, &chart.subtitle, &chart.lines)?;
+            }
+            compare::markdown::render(&compare::markdown::Input {
+                sweeps: &sweeps,
+                sides: &sides,
+                rule,
+                plan: planned,
+            })
+        }
+        Drawing::Pooled { planned, traces } => {
+            for chart in &planned.charts {
+                draw(&out_dir.join(&chart.file), chart)?;
+            }
+            for copy in traces.iter().filter_map(|(_, copy)| copy.as_ref()) {
+                traces::copy(copy, &out_dir.join(&copy.file))?;
+            }
+            let traces: Vec<traces::TraceDir> = traces.iter().map(|(t, _)| t.clone()).collect();
+            markdown::render(&markdown::Input {
+                sweeps: &sweeps,
+                views: &sides[0].views,
+                charts: &planned.charts,
+                skipped: &planned.skipped,
+                traces: &traces,
+            })
+        }
     };
     let report = out_dir.join(REPORT_FILE);
     crate::output::atomic::write(&report, text.as_bytes())?;
-    written.push(report);
-    claimed.remove_stale(&written)?;
-    Ok(written)
+    claimed.remove_stale(&paths)?;
+    Ok(paths)
 }
 
-/// One study (one machine's directories, whose groups are `views`): draws its charts into
-/// `claimed` (adding them to `written`), embeds the traces found from `(results_dirs,
-/// out_dir, trace_dirs)` (see [`embed_traces`]), and returns REPORT.md's text.
-fn pooled(
-    sweeps: &[load::Sweep],
-    views: &[view::GroupView],
-    (results_dirs, out_dir, trace_dirs): (&[PathBuf], &Path, &[PathBuf]),
-    claimed: &crate::output::claim::Claimed,
-    written: &mut Vec<PathBuf>,
-) -> anyhow::Result<String> {
-    let planned = plan::plan(views, |g| markdown::topology_of(sweeps, g));
-    for chart in &planned.charts {
-        let path = claimed.check_writable(&chart.file)?;
-        draw(&path, chart)?;
-        written.push(path);
+/// What a report draws: one study's charts and traces, or a comparison's charts.
+enum Drawing {
+    /// One study (one machine's directories): its charts, and the traces it embeds with the
+    /// timelines to copy.
+    Pooled {
+        planned: plan::ReportPlan,
+        traces: Vec<(traces::TraceDir, Option<traces::TimelineCopy>)>,
+    },
+    /// A comparison of machines.
+    Compared(compare::plan::ComparePlan),
+}
+
+impl Drawing {
+    /// The files it writes into the report's directory, in the order it writes them.
+    fn files(&self) -> Vec<String> {
+        match self {
+            Drawing::Pooled { planned, traces } => planned
+                .charts
+                .iter()
+                .map(|c| c.file.clone())
+                .chain(
+                    traces
+                        .iter()
+                        .filter_map(|(_, c)| c.as_ref().map(|c| c.file.clone())),
+                )
+                .collect(),
+            Drawing::Compared(planned) => planned
+                .compared
+                .iter()
+                .flat_map(|c| &c.charts)
+                .map(|c| c.file.clone())
+                .collect(),
+        }
     }
-    let traces = embed_traces(results_dirs, out_dir, trace_dirs, written)?;
-    Ok(markdown::render(&markdown::Input {
-        sweeps,
-        views,
-        charts: &planned.charts,
-        skipped: &planned.skipped,
-        traces: &traces,
-    }))
 }
 
-/// A comparison of `sides`: draws its charts into `claimed` (adding them to `written`) and
-/// returns REPORT.md's text.
-fn compared(
-    sweeps: &[load::Sweep],
-    sides: &[compare::sides::Side<'_>],
-    rule: compare::SideRule,
-    claimed: &crate::output::claim::Claimed,
-    written: &mut Vec<PathBuf>,
-) -> anyhow::Result<String> {
-    let planned = compare::plan::plan(sides);
-    for chart in planned.compared.iter().flat_map(|c| &c.charts) {
-        let path = claimed.check_writable(&chart.file)?;
-        charts::compare::draw(&path, &chart.title, &chart.subtitle, &chart.lines)?;
-        written.push(path);
-    }
-    Ok(compare::markdown::render(&compare::markdown::Input {
-        sweeps,
-        sides,
-        rule,
-        plan: &planned,
-    }))
+/// Locks and claims the report's directory, where it will write `files`. It leaves alone the
+/// results of a sweep or merge recorded there, subdirectories (traces: the report never
+/// writes into one), and, when it is one of the results directories read, that directory's
+/// own files — the report's input, which an older version left without a record.
+fn claim_out(
+    results_dirs: &[PathBuf],
+    out_dir: &Path,
+    files: &[String],
+    force: bool,
+) -> anyhow::Result<Claimed> {
+    let out = out_dir.canonicalize().ok();
+    let is_input = out.is_some() && results_dirs.iter().any(|d| d.canonicalize().ok() == out);
+    let tolerated = |path: &Path| {
+        use crate::results::{META_FILE, REFERENCES_FILE, SUMMARY_FILE, TRIALS_FILE};
+        path.is_dir()
+            || is_input
+                && path.file_name().and_then(|n| n.to_str()).is_some_and(|n| {
+                    [TRIALS_FILE, SUMMARY_FILE, META_FILE, REFERENCES_FILE].contains(&n)
+                })
+    };
+    let writes: Vec<&str> = files.iter().map(String::as_str).collect();
+    let owner = Owner {
+        command: Command::Report,
+        option: "--out",
+        replaces: &[],
+        tolerates: &[Command::Sweep, Command::Merge],
+        tolerates_unrecorded: &tolerated,
+        writes: &writes,
+    };
+    claim::claim(out_dir, &owner, force)
 }
 
-/// The traces found under the results directories and `out_dir` or named in `trace_dirs`;
-/// their timelines are copied into `out_dir` where needed (and added to `written`).
-fn embed_traces(
+/// The traces found under the results directories and `out_dir` or named in `trace_dirs`,
+/// each read and validated, with the timeline to copy into `out_dir` where it lies outside.
+fn find_traces(
     results_dirs: &[PathBuf],
     out_dir: &Path,
     trace_dirs: &[PathBuf],
-    written: &mut Vec<PathBuf>,
-) -> anyhow::Result<Vec<traces::TraceDir>> {
+) -> anyhow::Result<Vec<(traces::TraceDir, Option<traces::TimelineCopy>)>> {
     let mut roots = results_dirs.to_vec();
     roots.push(out_dir.to_path_buf());
     let found = traces::find(&roots, trace_dirs)?;
     let mut copied = Vec::new();
-    let traces = found
+    found
         .iter()
         .map(|d| traces::read(d, out_dir, &mut copied))
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    for t in &traces {
-        if !t.image.contains('/') {
-            written.push(out_dir.join(&t.image));
-        }
-    }
-    Ok(traces)
+        .collect()
 }
 
 /// A comparison of machines belongs to none of them: written into one of the results

@@ -17,8 +17,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use serde::Deserialize;
 
-use crate::output::sniff::{self, PNG_SIGNATURE};
-use crate::output::{atomic, console};
+use crate::io::capped;
+use crate::output::{atomic, console, sniff};
 use crate::trace::files::{self, META_JSON};
 use crate::trace::stats::{CSV_HEADER, idle_workers_note};
 
@@ -114,7 +114,7 @@ pub fn find(roots: &[PathBuf], explicit: &[PathBuf]) -> anyhow::Result<Vec<PathB
             );
         }
         if let Err(why) = check(dir) {
-            bail!("--trace '{}' is not a valid trace: {why}", dir.display());
+            bail!("--trace '{}' is not a valid trace: {why:#}", dir.display());
         }
         found.insert(canonical(dir));
     }
@@ -128,7 +128,7 @@ pub fn find(roots: &[PathBuf], explicit: &[PathBuf]) -> anyhow::Result<Vec<PathB
                 found.insert(dir.clone());
             }
             Err(why) => console::warn(&format!(
-                "warning: skipping trace directory '{}': {why}",
+                "warning: skipping trace directory '{}': {why:#}",
                 dir.display()
             )),
         }
@@ -165,7 +165,7 @@ fn walk(dir: &Path, depth: usize, found: &mut BTreeSet<PathBuf>) {
 /// phrase that follows "not a valid trace: ".
 fn check(dir: &Path) -> anyhow::Result<Checked> {
     let stats = check_stats(&dir.join(STATS))?;
-    if !sniff::starts_with(&dir.join(TIMELINE), &PNG_SIGNATURE) {
+    if !sniff::is_png(&dir.join(TIMELINE), capped::TIMELINE_PNG)? {
         bail!("{TIMELINE} is not a PNG image");
     }
     let title = check_meta(&dir.join(META_JSON))?;
@@ -173,7 +173,7 @@ fn check(dir: &Path) -> anyhow::Result<Checked> {
 }
 
 fn check_stats(path: &Path) -> anyhow::Result<Vec<StatsRow>> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {STATS}"))?;
+    let text = capped::read_to_string(path, capped::TRACE_STATS_CSV)?;
     if text.lines().next() != Some(CSV_HEADER) {
         bail!("{STATS} does not have the trace's columns ({CSV_HEADER})");
     }
@@ -217,7 +217,8 @@ fn check_stats(path: &Path) -> anyhow::Result<Vec<StatsRow>> {
 
 /// The title, from a trace's `meta.json`.
 fn check_meta(path: &Path) -> anyhow::Result<String> {
-    let text = std::fs::read_to_string(path).with_context(|| format!("no readable {META_JSON}"))?;
+    let text = capped::read_to_string(path, capped::TRACE_META_JSON)
+        .with_context(|| format!("no readable {META_JSON}"))?;
     let value: serde_json::Value =
         serde_json::from_str(&text).with_context(|| format!("{META_JSON} is not JSON"))?;
     if !files::is_trace_meta(&text) {
@@ -234,19 +235,33 @@ fn check_meta(path: &Path) -> anyhow::Result<String> {
     Ok(meta_title(&meta))
 }
 
+/// A trace's timeline to copy into the report's directory.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TimelineCopy {
+    /// The trace's `timeline.png`.
+    pub source: PathBuf,
+    /// The copy's name in the report's directory.
+    pub file: String,
+}
+
 /// Reads a valid trace directory; its timeline is linked relative to `out_dir` when it lies
-/// inside it, and otherwise copied (atomically) into `out_dir` as
+/// inside it, and otherwise is to be copied ([`copy`]) into `out_dir` as
 /// `[trace-]<name>-timeline.png` — with `-2`, `-3`, … when an earlier trace of this report
 /// (`copied`) took that name, so two traces with the same directory name never share a copy.
-pub fn read(dir: &Path, out_dir: &Path, copied: &mut Vec<String>) -> anyhow::Result<TraceDir> {
+/// Writes nothing: the report checks every name it will write first.
+pub fn read(
+    dir: &Path,
+    out_dir: &Path,
+    copied: &mut Vec<String>,
+) -> anyhow::Result<(TraceDir, Option<TimelineCopy>)> {
     let Checked { title, stats } =
         check(dir).with_context(|| format!("'{}' is not a valid trace", dir.display()))?;
     let name = dir
         .file_name()
         .map_or_else(|| "trace".to_owned(), |n| n.to_string_lossy().into_owned());
     let out = canonical(out_dir);
-    let image = match canonical(dir).strip_prefix(&out) {
-        Ok(rel) => link(&rel.join(TIMELINE)),
+    let (image, copy) = match canonical(dir).strip_prefix(&out) {
+        Ok(rel) => (link(&rel.join(TIMELINE)), None),
         Err(_) => {
             let stem = if name.starts_with("trace") {
                 name.clone()
@@ -260,19 +275,26 @@ pub fn read(dir: &Path, out_dir: &Path, copied: &mut Vec<String>) -> anyhow::Res
                 file = format!("{stem}-{k}-timeline.png");
             }
             copied.push(file.clone());
-            let source = dir.join(TIMELINE);
-            let bytes = std::fs::read(&source)
-                .with_context(|| format!("cannot read '{}'", source.display()))?;
-            atomic::write(&out_dir.join(&file), &bytes)?;
-            file
+            let copy = TimelineCopy {
+                source: dir.join(TIMELINE),
+                file: file.clone(),
+            };
+            (file, Some(copy))
         }
     };
-    Ok(TraceDir {
+    let trace = TraceDir {
         dir: dir.to_path_buf(),
         title,
         stats,
         image,
-    })
+    };
+    Ok((trace, copy))
+}
+
+/// Copies a timeline to `dest` (whole or not at all).
+pub fn copy(copy: &TimelineCopy, dest: &Path) -> anyhow::Result<()> {
+    let bytes = capped::read(&copy.source, capped::TIMELINE_PNG)?;
+    atomic::write(dest, &bytes)
 }
 
 /// A relative path with `/` separators, for Markdown.
@@ -403,6 +425,7 @@ fn reading(total: &StatsRow) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::output::sniff::PNG_SIGNATURE;
 
     const STATS_TEXT: &str = "kind,name,threads,kernel_calls,busy_ms,span_ms,idle_pct,imbalance\n\
          worker,0,1,3,0.5,1.0,50.0,\nworker,1,1,2,0.3,1.0,70.0,\n\
@@ -433,7 +456,7 @@ mod tests {
             let dir = tempfile::tempdir().unwrap();
             let t = dir.path().join(parent).join("tr");
             fake_trace(&t);
-            names.push(read(&t, out.path(), &mut copied).unwrap().image);
+            names.push(read(&t, out.path(), &mut copied).unwrap().0.image);
         }
         assert_eq!(names, ["trace-tr-timeline.png", "trace-tr-2-timeline.png"]);
     }
@@ -445,8 +468,12 @@ mod tests {
         std::fs::create_dir_all(root.path().join("empty")).unwrap();
         let found = find(&[root.path().to_path_buf()], &[]).unwrap();
         assert_eq!(found.len(), 1);
-        let t = read(&found[0], root.path(), &mut Vec::new()).unwrap();
+        let (t, copy) = read(&found[0], root.path(), &mut Vec::new()).unwrap();
         assert_eq!(t.image, "traces/trace-a/timeline.png");
+        assert_eq!(
+            copy, None,
+            "a trace inside the report is linked, not copied"
+        );
         assert_eq!(
             t.title,
             "rayon-chunks, 2 cores, 45 chunks, N = 1000, 3 steps (seed, all-pairs)"
@@ -461,8 +488,14 @@ mod tests {
         let a = tempfile::tempdir().unwrap();
         let out = tempfile::tempdir().unwrap();
         fake_trace(&a.path().join("t1"));
-        let t = read(&a.path().join("t1"), out.path(), &mut Vec::new()).unwrap();
+        let (t, copy) = read(&a.path().join("t1"), out.path(), &mut Vec::new()).unwrap();
         assert_eq!(t.image, "trace-t1-timeline.png");
+        let copy = copy.unwrap();
+        assert!(
+            !out.path().join("trace-t1-timeline.png").exists(),
+            "read writes nothing"
+        );
+        super::copy(&copy, &out.path().join(&copy.file)).unwrap();
         assert!(out.path().join("trace-t1-timeline.png").is_file());
         let err = find(&[], &[a.path().to_path_buf()]).unwrap_err();
         assert!(
@@ -562,7 +595,7 @@ mod tests {
     fn a_trace_on_one_of_two_workers_says_so_instead_of_explaining_the_idle_share() {
         let tmp = tempfile::tempdir().unwrap();
         fake_trace(tmp.path());
-        let mut t = read(tmp.path(), tmp.path(), &mut Vec::new()).unwrap();
+        let (mut t, _) = read(tmp.path(), tmp.path(), &mut Vec::new()).unwrap();
         t.stats[0].kernel_calls = 5;
         t.stats[1].kernel_calls = 0;
         let md = markdown(&[t]);

@@ -29,6 +29,7 @@ use super::rows::{
     is_older_trial_header,
 };
 use super::validate;
+use crate::io::capped;
 
 /// One sweep's results.
 #[derive(Debug, Clone)]
@@ -104,13 +105,18 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
             dir.join(SUMMARY_FILE).display()
         );
     }
-    let trials_path = dir.join(TRIALS_FILE);
-    let trials = if trials_path.is_file() {
-        let (rows, bad) = read_trials(&trials_path)?;
-        dropped.extend(bad);
-        Some(rows)
-    } else {
-        None
+    let trials = match read_csv_if_exists(
+        &dir.join(TRIALS_FILE),
+        capped::TRIALS_CSV,
+        &TRIAL_COLUMNS,
+        is_older_trial_header,
+        "trial",
+    )? {
+        Some((rows, bad)) => {
+            dropped.extend(bad);
+            Some(rows)
+        }
+        None => None,
     };
     let believed = believed(summary, trials);
     dropped.extend(believed.dropped);
@@ -185,29 +191,54 @@ pub fn believed(summary: Vec<SummaryRow>, trials: Option<Vec<TrialRow>>) -> Beli
 /// Reads a `summary.csv` (this version's columns or the first release's): its rows, and a
 /// note for each line that is not one.
 pub fn read_summary(path: &Path) -> anyhow::Result<(Vec<SummaryRow>, Vec<String>)> {
-    read_csv(path, &SUMMARY_COLUMNS, is_older_summary_header, "summary")
+    read_csv(
+        path,
+        capped::SUMMARY_CSV,
+        &SUMMARY_COLUMNS,
+        is_older_summary_header,
+        "summary",
+    )
 }
 
 /// Reads a `trials.csv` (this version's columns or the first release's), as
 /// [`read_summary`].
 pub fn read_trials(path: &Path) -> anyhow::Result<(Vec<TrialRow>, Vec<String>)> {
-    read_csv(path, &TRIAL_COLUMNS, is_older_trial_header, "trial")
+    read_csv(
+        path,
+        capped::TRIALS_CSV,
+        &TRIAL_COLUMNS,
+        is_older_trial_header,
+        "trial",
+    )
 }
 
-/// The rows of a results CSV whose header is `columns` or one that `older` accepts (an earlier
-/// version's file), and a note naming each line that is not a row.
+/// The rows and notes of [`read_csv`]; a missing file is an error.
 fn read_csv<R: serde::de::DeserializeOwned>(
     path: &Path,
+    kind: capped::Kind,
     columns: &[&str],
     older: fn(&[&str]) -> bool,
     what: &str,
 ) -> anyhow::Result<(Vec<R>, Vec<String>)> {
-    let mut reader = csv::Reader::from_path(path)
-        .with_context(|| format!("cannot read '{}'", path.display()))?;
-    let header = reader
-        .headers()
-        .with_context(|| format!("cannot read '{}'", path.display()))?
-        .clone();
+    read_csv_if_exists(path, kind, columns, older, what)?
+        .with_context(|| format!("cannot read '{}': no such file", path.display()))
+}
+
+/// The rows of a results CSV (read as a `kind`: a regular file within its cap, see
+/// [`capped`]) whose header is `columns` or one that `older` accepts (an earlier version's
+/// file), and a note naming each line that is not a row; `None` when there is no such file.
+fn read_csv_if_exists<R: serde::de::DeserializeOwned>(
+    path: &Path,
+    kind: capped::Kind,
+    columns: &[&str],
+    older: fn(&[&str]) -> bool,
+    what: &str,
+) -> anyhow::Result<Option<(Vec<R>, Vec<String>)>> {
+    let Some(file) = capped::open_if_exists(path, kind)? else {
+        return Ok(None);
+    };
+    let mut reader = csv::Reader::from_reader(file);
+    let header = reader.headers().map_err(|e| csv_error(e, path))?.clone();
     let found: Vec<&str> = header.iter().collect();
     if found != columns && !older(&found) {
         bail!(
@@ -222,6 +253,8 @@ fn read_csv<R: serde::de::DeserializeOwned>(
     for (i, row) in reader.deserialize::<R>().enumerate() {
         match row {
             Ok(row) => rows.push(row),
+            // Reading stopped (the cap, a failing disk): not a row to leave out.
+            Err(e) if e.is_io_error() => return Err(csv_error(e, path)),
             Err(_) => bad.push(format!(
                 "'{}' line {}: not a bench-sph {what} row (cut off, or garbled)",
                 path.display(),
@@ -229,7 +262,19 @@ fn read_csv<R: serde::de::DeserializeOwned>(
             )),
         }
     }
-    Ok((rows, bad))
+    Ok(Some((rows, bad)))
+}
+
+/// A CSV error of reading `path`: the cap's refusal where that is what stopped it.
+fn csv_error(err: csv::Error, path: &Path) -> anyhow::Error {
+    let context = || format!("cannot read '{}'", path.display());
+    if !err.is_io_error() {
+        return anyhow::Error::new(err).context(context());
+    }
+    match err.into_kind() {
+        csv::ErrorKind::Io(e) => capped::io_error(e, path),
+        other => anyhow::anyhow!("{other:?}").context(context()),
+    }
 }
 
 #[cfg(test)]

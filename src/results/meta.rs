@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 use super::params::SweepParams;
 use super::shard::Shard;
 use super::stats::CONFIDENCE;
+use crate::io::capped;
 use crate::topology::Topology;
 
 /// The version of bench-sph that wrote the file.
@@ -320,11 +321,10 @@ impl Meta {
         self.status = status;
     }
 
-    /// Reads `path`.
+    /// Reads `path` (a regular file of at most [`capped::META_JSON`]'s cap).
     pub fn read(path: &Path) -> anyhow::Result<Meta> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read '{}'", path.display()))?;
-        serde_json::from_str(&text)
+        let bytes = capped::read(path, capped::META_JSON)?;
+        serde_json::from_slice(&bytes)
             .with_context(|| format!("'{}' is not a bench-sph sweep's meta.json", path.display()))
     }
 
@@ -336,12 +336,15 @@ impl Meta {
         crate::output::atomic::write(path, text.as_bytes())
     }
 
-    /// Whether `path` is a sweep's `meta.json` (by its `tool` field).
-    pub fn is_sweep_meta(path: &Path) -> bool {
-        std::fs::read_to_string(path)
-            .ok()
-            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
-            .is_some_and(|v| v["tool"] == "bench-sph sweep")
+    /// Whether `path` is a sweep's `meta.json` (by its `tool` field): false for a missing
+    /// file or another tool's JSON; an error for a file that cannot be read (not a regular
+    /// file, beyond the cap).
+    pub fn is_sweep_meta(path: &Path) -> anyhow::Result<bool> {
+        let Some(bytes) = capped::read_if_exists(path, capped::META_JSON)? else {
+            return Ok(false);
+        };
+        Ok(serde_json::from_slice::<serde_json::Value>(&bytes)
+            .is_ok_and(|v| v["tool"] == "bench-sph sweep"))
     }
 }
 

@@ -15,7 +15,9 @@
 //!   (|t − median| > 3 MAD), oversubscribed, the common checksum, status and reason;
 //! - `meta.json`: machine, build, times, command lines and every parameter;
 //! - in a merge of shards, `references.csv`: every shard's `seq` rows;
-//! - `sweep.lock` while a sweep runs, and the report drawn from it (`REPORT.md`, charts).
+//! - the report drawn from it (`REPORT.md`, charts), and bench-sph's bookkeeping: the record
+//!   of the files it wrote there (`bench-sph-files.json`, [`crate::output::record`]) and the
+//!   lock file (`bench-sph.lock`, [`crate::output::lock`]).
 
 pub mod files;
 pub mod intervals;
@@ -30,6 +32,4 @@ pub mod stats;
 pub mod summarize;
 pub mod validate;
 
-pub use files::{
-    LOCK_FILE, META_FILE, REFERENCES_FILE, REPORT_FILE, SUMMARY_FILE, TRIALS_FILE, is_report_file,
-};
+pub use files::{META_FILE, REFERENCES_FILE, REPORT_FILE, SUMMARY_FILE, TRIALS_FILE};

@@ -1,24 +1,28 @@
-//! The results directory of a sweep: choosing it, locking it, and what may already be in it.
+//! The results directory of a sweep (or of a merge of shards): choosing it, locking it, and
+//! what may already be in it.
 //!
-//! A new sweep's directory must be new or empty, or hold only a sweep's own earlier output
-//! (`trials.csv`, `summary.csv`, its `meta.json`, `sweep.lock`, a merge's `references.csv`, and the report the sweep drew:
-//! `REPORT.md` and chart PNGs); that earlier output is replaced only with `--force`, and then
-//! all of it, so no REPORT.md or chart of the old data stays beside the new. Trace directories
-//! inside are left alone. Anything else is refused (see [`crate::output::claim`]).
+//! A new sweep's (or merge's) directory must be new or empty, or hold only the results of an
+//! earlier sweep or merge and the report drawn there — as the directory's record says
+//! ([`crate::output::record`]), never as names suggest. That earlier output is replaced only
+//! with `--force`, and then all of it, so no REPORT.md or chart of the old data stays beside
+//! the new. Trace directories inside are left alone. Anything else is refused unless
+//! `--force`, which writes beside it and never replaces it (see [`crate::output::claim`]).
 //!
-//! Before looking inside, the sweep takes the directory's lock ([`super::lock`]), so of two
-//! sweeps started on the same directory at the same moment, the loser is always refused with
-//! a message about that directory.
+//! Before it changes anything, the command holds the directory's lock
+//! ([`crate::output::lock`]), so of two commands started on one directory at the same moment,
+//! the loser is always refused with a message about that directory and its holder.
 
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
-use super::lock::{self, DirLock, LOCK_FILE};
 use super::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
-use crate::output::claim::{self, Owner};
-use crate::results::REFERENCES_FILE;
+use crate::output::claim::{self, Claimed, Owner};
+use crate::output::lock::{self, DirLock, LOCK_FILE};
+use crate::output::record::{self, Command, Record};
 use crate::results::meta::Meta;
+use crate::results::{REFERENCES_FILE, REPORT_FILE};
 
 /// The default results directory: `results/<UTC timestamp>`, or with `-2`, `-3`, … when a
 /// sweep started in the same second took that name. Created here, exclusively.
@@ -49,112 +53,136 @@ pub fn new_default() -> anyhow::Result<PathBuf> {
     )
 }
 
-/// Locks `dir` for a new sweep and makes it ready: refuses foreign files (unless `force`)
-/// and a sweep's earlier output (unless `force`, which removes it). Returns the held lock.
-pub fn open_new(dir: &Path, force: bool) -> anyhow::Result<DirLock> {
+/// Locks and claims `dir` for a new sweep or merge (`command`): refuses foreign files (unless
+/// `force`, which leaves them untouched) and earlier results (unless `force`, which removes
+/// them and the report drawn there). Returns the claimed directory, still locked.
+pub fn open_new(dir: &Path, force: bool, command: Command) -> anyhow::Result<Claimed> {
     if dir.exists() && !dir.is_dir() {
         bail!("--out '{}' exists and is not a directory", dir.display());
     }
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create results directory '{}'", dir.display()))?;
-    if !dir.join(LOCK_FILE).exists() {
-        // Not a sweep's directory yet: refuse before creating a lock file in it, so that a
-        // refused sweep leaves nothing behind. (The lock file is never deleted: see `lock`.)
-        check_contents(dir, force, false)?;
+    // Every file of the results, and the report, must be writable before anything is.
+    let mut writes = vec![TRIALS_FILE, SUMMARY_FILE, META_FILE, REPORT_FILE];
+    if command == Command::Merge {
+        writes.push(REFERENCES_FILE);
     }
-    let held = lock::acquire(dir)?;
-    // Again under the lock, which makes it authoritative.
-    check_contents(dir, force, true)?;
-    Ok(held)
-}
-
-/// Refuses foreign files (unless `force`) and a sweep's earlier output (unless `force`; with
-/// `remove`, then removes it).
-fn check_contents(dir: &Path, force: bool, remove: bool) -> anyhow::Result<()> {
     let owner = Owner {
-        command: "bench-sph sweep",
+        command,
         option: "--out",
-        owns: &owned,
-        tolerates: &is_trace_dir,
+        replaces: &[Command::Sweep, Command::Merge, Command::Report],
+        tolerates: &[],
+        tolerates_unrecorded: &is_trace_dir,
+        writes: &writes,
     };
-    let claimed = claim::claim(dir, &owner, force)?;
-    for name in [
-        TRIALS_FILE,
-        SUMMARY_FILE,
-        META_FILE,
-        REFERENCES_FILE,
-        crate::results::REPORT_FILE,
-    ] {
-        claimed.check_writable(name)?;
-    }
-    let earlier: Vec<&PathBuf> = claimed
-        .earlier()
-        .iter()
-        .filter(|p| !p.ends_with(LOCK_FILE))
-        .collect();
-    if !earlier.is_empty() {
+    let mut claimed = claim::claim(dir, &owner, force)?;
+    if !claimed.earlier().is_empty() {
         if !force {
-            bail!(
-                "results directory '{}' already holds a sweep's results; continue that sweep \
-                 with `--resume {}`, or replace them (and their report) with `--force`",
-                dir.display(),
-                dir.display()
-            );
+            bail!(already_holds(dir, command, claimed.earlier()));
         }
-        for path in earlier.into_iter().filter(|_| remove) {
-            std::fs::remove_file(path)
-                .with_context(|| format!("cannot replace '{}'", path.display()))?;
-        }
+        claimed.remove_earlier()?;
     }
-    Ok(())
+    Ok(claimed)
 }
 
-/// Locks an existing sweep's directory for `--resume`. Where a lock file exists, the lock is
-/// taken first, so a sweep that has just started there (locked, `meta.json` not yet written)
-/// is reported as the holder; a lock file is never created in a directory that is not a
-/// sweep's.
+/// Why a directory with earlier results is refused, and what to do: what the record says is
+/// there (a sweep's results, a merge's output, cut short or not, or only a report).
+fn already_holds(dir: &Path, command: Command, earlier: &[(String, Command)]) -> String {
+    let d = dir.display();
+    let writers: BTreeSet<Command> = earlier.iter().map(|&(_, c)| c).collect();
+    let whole = earlier.iter().any(|(n, _)| n == META_FILE);
+    let (what, theirs) = if writers.contains(&Command::Merge) {
+        let cut = match whole {
+            true => "",
+            false => " that was cut short (it has no meta.json)",
+        };
+        (
+            format!("the output of a bench-sph merge{cut}"),
+            Command::Merge,
+        )
+    } else if writers.contains(&Command::Sweep) {
+        let cut = match whole {
+            true => "",
+            false => " (cut short before its meta.json)",
+        };
+        (format!("a sweep's results{cut}"), Command::Sweep)
+    } else {
+        (
+            "a report drawn by bench-sph report".to_owned(),
+            Command::Report,
+        )
+    };
+    let advice = match (command, theirs) {
+        (Command::Sweep, Command::Sweep) if whole => format!(
+            "continue that sweep with `--resume {d}`, or replace them (and their report) with \
+             `--force`"
+        ),
+        (Command::Merge, Command::Merge) => format!(
+            "run the merge again with --force to replace it (and its report), or delete '{d}'"
+        ),
+        _ => format!(
+            "pass --force to replace it (and the report drawn there) with this {}'s, or \
+             choose another directory",
+            command.name()
+        ),
+    };
+    format!("results directory '{d}' already holds {what}; {advice}")
+}
+
+/// Locks an existing sweep's directory for `--resume`. What is not a sweep's results is
+/// refused before a lock file is created there, and again under the lock. A sweep written
+/// before bench-sph kept records is given one: resuming it says its files are the sweep's.
 pub fn open_existing(dir: &Path) -> anyhow::Result<DirLock> {
-    let meta = dir.join(META_FILE);
     if !dir.is_dir() {
         bail!("cannot resume '{}': no such directory", dir.display());
     }
-    let held = if dir.join(LOCK_FILE).is_file() {
-        Some(lock::acquire(dir)?)
-    } else {
-        None
-    };
-    if !Meta::is_sweep_meta(&meta) {
-        bail!(
-            "cannot resume '{}': it has no sweep's {META_FILE}, so it is not a sweep's results \
-             directory",
-            dir.display()
-        );
+    if std::fs::symlink_metadata(dir.join(LOCK_FILE)).is_err() {
+        resumable(dir)?;
     }
-    match held {
-        Some(lock) => Ok(lock),
-        None => lock::acquire(dir),
+    let held = lock::acquire(dir, Command::Sweep)?;
+    let record = resumable(dir)?.unwrap_or_default();
+    let mut unrecorded = Vec::new();
+    for name in [TRIALS_FILE, SUMMARY_FILE, META_FILE] {
+        match record.writer(name) {
+            None => unrecorded.push(name),
+            Some(Command::Sweep) => {}
+            Some(other) => bail!(
+                "cannot resume '{}': its {name} was written by {other}, not by a sweep",
+                dir.display()
+            ),
+        }
     }
+    record::add(dir, Command::Sweep, &unrecorded)?;
+    Ok(held)
 }
 
-/// Whether a top-level entry of a results directory is a sweep's own output.
-fn owned(path: &Path) -> bool {
-    let Some(name) = path.file_name().and_then(|n| n.to_str()) else {
-        return false;
-    };
-    if !path.is_file() {
-        return false;
-    }
-    match name {
-        // By contents too: a hand-written trials.csv is not ours to replace (an empty one,
-        // left by a sweep killed as it started, holds nothing to lose).
-        TRIALS_FILE | SUMMARY_FILE | REFERENCES_FILE => {
-            std::fs::metadata(path).is_ok_and(|m| m.len() == 0)
-                || crate::output::sniff::starts_with(path, b"strategy,neighbors,preset,n,steps,")
+/// `dir`'s record, if `dir` holds a sweep's results to resume; the error says what it holds
+/// instead (a merge's output, whole or cut short, or nothing of a sweep's).
+fn resumable(dir: &Path) -> anyhow::Result<Option<Record>> {
+    let d = dir.display();
+    let record = Record::read(dir)?;
+    let meta = dir.join(META_FILE);
+    let merged = record.as_ref().is_some_and(|r| r.has(Command::Merge));
+    if !Meta::is_sweep_meta(&meta)? {
+        if merged {
+            bail!(
+                "cannot resume '{d}': it holds the output of a bench-sph merge that was cut \
+                 short (it has no meta.json), not a sweep; run the merge again with --force to \
+                 replace it, or delete '{d}'"
+            );
         }
-        LOCK_FILE => true,
-        META_FILE => Meta::is_sweep_meta(path),
-        _ => crate::results::is_report_file(path),
+        bail!(
+            "cannot resume '{d}': it has no sweep's {META_FILE}, so it is not a sweep's results \
+             directory"
+        );
     }
+    if merged || Meta::read(&meta)?.merge.is_some() {
+        bail!(
+            "'{d}' is a merge of shards, not a sweep to resume: resume or run the shards that \
+             are missing (`bench-sph sweep --resume SHARD_DIR`) and merge again"
+        );
+    }
+    Ok(record)
 }
 
 /// Trace directories may sit inside a results directory (the report embeds them).

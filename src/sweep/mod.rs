@@ -20,7 +20,6 @@ mod coverage;
 pub mod dir;
 pub mod export;
 pub mod input;
-pub mod lock;
 pub mod params;
 pub mod plan;
 pub mod range;
@@ -41,11 +40,12 @@ use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::output::console::plural;
+use crate::output::lock::DirLock;
+use crate::output::record::Command;
 use crate::results::key::{Cell, Group};
 use crate::results::meta::{Machine, Meta, Session, SweepStatus};
 use crate::results::rows::{Phase, Status, SummaryRow, TrialRow};
 use crate::results::shard::Shard;
-use lock::DirLock;
 use params::SweepParams;
 use plan::{LabelStyle, Plan};
 use range::{Axis, compact};
@@ -525,7 +525,9 @@ fn start_new(
         Some(dir) => dir.to_path_buf(),
         None => dir::new_default()?,
     };
-    let lock = dir::open_new(&dir, force)?;
+    let mut claimed = dir::open_new(&dir, force, Command::Sweep)?;
+    claimed.record(&[TRIALS_FILE, SUMMARY_FILE, META_FILE])?;
+    let lock = claimed.lock();
     let plan = Plan::new(params);
     let meta = Meta::new(params.clone(), plan.cells.len(), session);
     meta.write(&dir.join(META_FILE))?;

@@ -26,6 +26,7 @@ use anyhow::Context;
 
 use super::export::to_csv;
 use super::plan::Cell;
+use crate::io::capped;
 use crate::results::key::Group;
 use crate::results::rows::{
     Phase, SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow, is_older_summary_header,
@@ -281,17 +282,13 @@ pub fn load_and_repair(
     check_cell: CheckCell<'_>,
     check_run: CheckRun<'_>,
 ) -> anyhow::Result<Repaired> {
-    let read = |name: &str| -> anyhow::Result<Vec<u8>> {
-        let path = dir.join(name);
-        match std::fs::read(&path) {
-            Ok(bytes) => Ok(bytes),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Vec::new()),
-            Err(e) => Err(e).with_context(|| format!("cannot read '{}'", path.display())),
-        }
+    // Regular files within their caps only (see `capped`); a missing one is empty.
+    let read = |name: &str, kind| -> anyhow::Result<Vec<u8>> {
+        Ok(capped::read_if_exists(&dir.join(name), kind)?.unwrap_or_default())
     };
     let repaired = repair(
-        &read("trials.csv")?,
-        &read("summary.csv")?,
+        &read("trials.csv", capped::TRIALS_CSV)?,
+        &read("summary.csv", capped::SUMMARY_CSV)?,
         check_cell,
         check_run,
     )

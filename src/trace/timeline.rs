@@ -28,7 +28,7 @@ use crate::plot::font;
 use crate::solver::Pass;
 
 /// Width of the image in pixels.
-pub const WIDTH: u32 = crate::results::files::TIMELINE_WIDTH;
+pub const WIDTH: u32 = 1600;
 const HEADER_PX: u32 = 84;
 const TOP_PX: u32 = 40;
 const ROW_PX: u32 = 56;

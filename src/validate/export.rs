@@ -1,4 +1,4 @@
-//! The validation's CSV files, and how `validate --out` recognises its own files.
+//! The validation's CSV files.
 //!
 //! - `surge_front.csv`: `t_s,T,Z`, one row per sample;
 //! - `column_height.csv`: `t_s,tau,H`, one row per sample;
@@ -7,13 +7,11 @@
 //! Numbers are written in the shortest form that parses back to the same bits.
 
 use std::io::Write;
-use std::path::Path;
 
 use anyhow::Context;
 use serde::Serialize;
 
 use super::probe::{Sample, Scales};
-use crate::output::sniff::{PNG_SIGNATURE, starts_with};
 
 /// The front's samples.
 pub const SURGE_FRONT_CSV: &str = "surge_front.csv";
@@ -80,21 +78,6 @@ fn write_rows(rows: impl Iterator<Item = impl Serialize>, out: impl Write) -> cs
     w.flush().map_err(csv::Error::from)
 }
 
-/// Whether `path` is a file an earlier `validate` wrote, judged by name and content: the two
-/// CSVs by their headers, the chart by its PNG signature.
-pub fn owns(path: &Path) -> bool {
-    if !path.is_file() {
-        return false;
-    }
-    let header = |h: &str| starts_with(path, format!("{h}\n").as_bytes());
-    match path.file_name().and_then(|n| n.to_str()) {
-        Some(SURGE_FRONT_CSV) => header(SURGE_FRONT_HEADER),
-        Some(COLUMN_HEIGHT_CSV) => header(COLUMN_HEIGHT_HEADER),
-        Some(VALIDATION_PNG) => starts_with(path, &PNG_SIGNATURE),
-        _ => false,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -141,18 +124,5 @@ mod tests {
             String::from_utf8(out).unwrap(),
             format!("t_s,tau,H\n0.0,0.0,0.975\n0.25,{tau},0.5\n")
         );
-    }
-
-    #[test]
-    fn only_files_with_validate_s_names_and_contents_are_owned() {
-        let tmp = tempfile::tempdir().unwrap();
-        let p = |name: &str| tmp.path().join(name);
-        std::fs::write(p(SURGE_FRONT_CSV), "t_s,T,Z\n0.0,0.0,0.95\n").unwrap();
-        std::fs::write(p(COLUMN_HEIGHT_CSV), "x,y\n").unwrap();
-        std::fs::write(p(VALIDATION_PNG), PNG_SIGNATURE).unwrap();
-        std::fs::write(p("notes.txt"), "").unwrap();
-        assert!(owns(&p(SURGE_FRONT_CSV)) && owns(&p(VALIDATION_PNG)));
-        assert!(!owns(&p(COLUMN_HEIGHT_CSV)) && !owns(&p("notes.txt")));
-        assert!(!owns(&p("missing.csv")));
     }
 }

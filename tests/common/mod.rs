@@ -181,14 +181,57 @@ pub fn assert_file_holds(path: &Path, text: &str) {
     assert_eq!(held, text, "{}", path.display());
 }
 
-/// The names of the entries of `dir`, sorted.
+/// bench-sph's bookkeeping in a directory it writes: the lock file and the record of the files
+/// it wrote.
+pub const BOOKKEEPING: [&str; 2] = ["bench-sph.lock", "bench-sph-files.json"];
+
+/// The names of the entries of `dir`, sorted, without bench-sph's [`BOOKKEEPING`].
 pub fn names(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| !BOOKKEEPING.contains(&n.as_str()))
         .collect();
     v.sort();
     v
+}
+
+/// `dir`'s record of the files bench-sph wrote there: file name → command (`sweep`,
+/// `report`, …); empty without a record.
+pub fn record(dir: &Path) -> HashMap<String, String> {
+    let Ok(text) = std::fs::read_to_string(dir.join("bench-sph-files.json")) else {
+        return HashMap::new();
+    };
+    let value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    value["files"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .map(|(k, v)| (k.clone(), v.as_str().unwrap().to_owned()))
+        .collect()
+}
+
+/// Runs `cmd` to the end with its streams captured, but for a minute at most: a command that
+/// has not finished by then (waiting on a FIFO, reading an endless device) is killed and the
+/// test fails. A bound on a hang, not a timing.
+pub fn output_within_a_minute(mut cmd: Command) -> Output {
+    let child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("binary starts");
+    let pid = child.id();
+    let (done, finished) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = done.send(child.wait_with_output());
+    });
+    match finished.recv_timeout(Duration::from_secs(60)) {
+        Ok(output) => output.expect("binary runs"),
+        Err(_) => {
+            let _ = Command::new("kill").args(["-9", &pid.to_string()]).status();
+            panic!("{cmd:?} did not finish within a minute (killed): it hung on its input")
+        }
+    }
 }
 
 /// A PNG's (width, height) in pixels, decoding the whole image; fails the test if it does not

@@ -24,11 +24,10 @@ use super::series::{Line, Point, SmtBand};
 use crate::plot::font;
 use crate::topology::Pin;
 
-/// Width of every chart, pixels (the results directory's schema knows it: a chart is
-/// recognised by its size).
-pub const WIDTH: u32 = crate::results::files::CHART_WIDTH;
+/// Width of every chart, pixels.
+pub const WIDTH: u32 = 1000;
 /// Height of every chart, pixels.
-pub const HEIGHT: u32 = crate::results::files::CHART_HEIGHT;
+pub const HEIGHT: u32 = 650;
 /// Width of the legend panel on the right, pixels.
 const LEGEND_PX: u32 = 250;
 /// Height of the title band, pixels.
