@@ -14,8 +14,9 @@ pub struct MergeArgs {
     /// The merged results directory (new or empty, unless --force).
     #[arg(long, value_name = "DIR", required = true)]
     pub out: PathBuf,
-    /// Merge even when cells are missing (a shard not given or unfinished): the merge is then
-    /// marked partial, and its report says so.
+    /// Merge even when cells are missing (a shard not given or unfinished, rows left out) or a
+    /// shard's seq is unusable (its cells are then merged without a speedup): the merge is
+    /// then marked partial, and its report says so.
     #[arg(long)]
     pub allow_partial: bool,
     /// Replace an earlier sweep's or merge's results in --out (the files its record,

@@ -93,8 +93,10 @@ pub enum Command {
     Sweep(SweepArgs),
     /// Merge the shard directories of `sweep --shard I/K` into one results directory.
     #[command(
-        after_help = "Refuses shards of different plans, builds or machines (that is a comparison: \
-        `bench-sph report A B`), a shard given twice, and missing cells unless --allow-partial. Each cell \
+        after_help = "Refuses shards of different plans, splits, builds or machines (that is a comparison: \
+        `bench-sph report A B`), a shard given twice, and missing cells or a shard whose seq is unusable \
+        unless --allow-partial. Checks every row as `bench-sph report` does, and against the shard's plan, \
+        naming each row it leaves out and why. Each cell \
         keeps the speedup its own shard measured against its own seq (column reference_shard); every \
         shard's seq rows go to references.csv, and the merge warns when they disagree beyond their \
         95 % intervals.\n\n\

@@ -246,7 +246,15 @@ impl SweepArgs {
 /// cli → run → export.
 pub fn run(args: &SweepArgs) -> anyhow::Result<()> {
     let finished = crate::sweep::run(args.request()?)?;
-    let charts = if let Some(shard) = finished.shard() {
+    let charts = if let Some(shard) = finished.shard()
+        && shard.count == 1
+    {
+        Ok(format!(
+            "Charts: not drawn for a shard: shard {shard} holds the whole plan; `bench-sph \
+             merge {} --out DIR` and `bench-sph report DIR` draw them.",
+            finished.dir().display()
+        ))
+    } else if let Some(shard) = finished.shard() {
         Ok(format!(
             "Charts: not drawn for shard {shard} alone: once every shard is done, \
              `bench-sph merge SHARD_DIR... --out DIR` and `bench-sph report DIR`."

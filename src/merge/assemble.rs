@@ -5,6 +5,11 @@
 //! lowest-numbered shard (the cell set is then exactly the unsharded plan's), and
 //! `references.csv` keeps every shard's. Each row keeps the speedup its own shard computed
 //! against its own `seq` (`reference_shard`), so no speedup divides times from two nodes.
+//!
+//! A shard whose `seq` cell of a group was left out as unusable ([`Unreferenced`]) has no
+//! denominator for its other cells of that group: the merge refuses it unless
+//! `--allow-partial`, and then those cells keep their times but lose their speedup and
+//! efficiency, and `references.csv` holds that shard's `seq` as a failed row saying why.
 
 use std::collections::{HashMap, HashSet};
 
@@ -12,8 +17,10 @@ use anyhow::bail;
 
 use crate::report::numbers::sig;
 use crate::results::key::{Cell, Group, LabelStyle};
-use crate::results::rows::{SummaryRow, TrialRow};
+use crate::results::load::Dropped;
+use crate::results::rows::{Phase, SummaryRow, TrialRow};
 use crate::results::shard::Shard;
+use crate::results::summarize::{CellContext, summary_row};
 use crate::sweep::plan::Plan;
 
 /// One shard's believed cells.
@@ -27,6 +34,39 @@ pub struct Part {
     pub rows: Vec<SummaryRow>,
     /// Their trial rows.
     pub trials: Vec<TrialRow>,
+    /// Its cells left out as unusable, each with why.
+    pub dropped: Vec<Dropped>,
+}
+
+/// A group of a shard whose `seq` reference cell was left out (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Unreferenced {
+    /// The shard.
+    pub shard: Shard,
+    /// Its directory, as given.
+    pub dir: String,
+    /// The group.
+    pub group: Group,
+    /// Why its `seq` cell is unusable.
+    pub why: String,
+    /// The shard's other cells of the group, in the merge without a speedup.
+    pub cells: Vec<Cell>,
+}
+
+impl Unreferenced {
+    /// One line saying what happened (without what to do, which depends on the caller).
+    pub fn describe(&self) -> String {
+        format!(
+            "'{}' (shard {}): its seq reference of {} is unusable ({}), so its {} of that \
+             group {} no speedup",
+            self.dir,
+            self.shard,
+            self.group.label(LabelStyle::Sweep),
+            self.why,
+            crate::output::console::plural(self.cells.len(), "other cell", "other cells"),
+            if self.cells.len() == 1 { "has" } else { "have" }
+        )
+    }
 }
 
 /// The merged study.
@@ -44,6 +84,9 @@ pub struct Assembled {
     pub cells_from: HashMap<usize, usize>,
     /// One line per group whose shards' `seq` means disagree beyond their intervals.
     pub disagreements: Vec<String>,
+    /// The shards' groups whose `seq` was left out: their cells are in `summary` without a
+    /// speedup, and the `seq` in `references` as a failed row.
+    pub unreferenced: Vec<Unreferenced>,
 }
 
 /// The merge of `parts` (shards of `whole`, already checked to be of one plan, build and
@@ -72,16 +115,26 @@ pub fn assemble(whole: &Plan, parts: &[Part]) -> anyhow::Result<Assembled> {
             }
             if row.reference_shard != Some(part.shard.index) {
                 bail!(
-                    "'{}': the row of {} has reference_shard {:?}, not {}: was summary.csv \
-                     edited?",
+                    "'{}': the row of {} has reference_shard {}, not {}: was summary.csv \
+                     edited? Restore it, or run the shard again",
                     part.dir,
                     row.key().label_with_group(),
-                    row.reference_shard,
+                    row.reference_shard
+                        .map_or_else(|| "empty".to_owned(), |s| s.to_string()),
                     part.shard.index
                 );
             }
         }
     }
+    let unreferenced: Vec<Unreferenced> = sorted
+        .iter()
+        .flat_map(|part| whole.groups.iter().filter_map(|g| without_its_seq(part, g)))
+        .collect();
+    let without_seq = |part: &Part, group: &Group| {
+        unreferenced
+            .iter()
+            .any(|u| u.shard == part.shard && u.group == *group)
+    };
     let row_of = |part: &Part, cell: &Cell| part.rows.iter().find(|r| r.key() == *cell).cloned();
     let mut out = Assembled {
         summary: Vec::new(),
@@ -90,6 +143,7 @@ pub fn assemble(whole: &Plan, parts: &[Part]) -> anyhow::Result<Assembled> {
         missing: Vec::new(),
         cells_from: HashMap::new(),
         disagreements: Vec::new(),
+        unreferenced: Vec::new(),
     };
     for cell in &whole.cells {
         let candidates: Vec<(&Part, SummaryRow)> = sorted
@@ -97,8 +151,16 @@ pub fn assemble(whole: &Plan, parts: &[Part]) -> anyhow::Result<Assembled> {
             .filter_map(|p| row_of(p, cell).map(|r| (*p, r)))
             .collect();
         if cell.is_reference() {
-            out.references
-                .extend(candidates.iter().map(|(_, r)| r.clone()));
+            for part in &sorted {
+                match candidates.iter().find(|(p, _)| p.shard == part.shard) {
+                    Some((_, row)) => out.references.push(row.clone()),
+                    None if without_seq(part, &cell.group) => {
+                        out.references
+                            .push(failed_reference(part, cell, &unreferenced));
+                    }
+                    None => {}
+                }
+            }
             if let Some(line) = disagreement(&cell.group, &candidates) {
                 out.disagreements.push(line);
             }
@@ -106,6 +168,14 @@ pub fn assemble(whole: &Plan, parts: &[Part]) -> anyhow::Result<Assembled> {
         // Outside the references, at most one shard can hold a cell (checked above).
         match candidates.first() {
             Some((part, row)) => {
+                let mut row = row.clone();
+                if without_seq(part, &cell.group) {
+                    // No denominator: never a speedup against another node's seq.
+                    row.speedup = None;
+                    row.efficiency = None;
+                    row.speedup_ci_low = None;
+                    row.speedup_ci_high = None;
+                }
                 *out.cells_from.entry(part.shard.index).or_default() += 1;
                 let mut trials: Vec<TrialRow> = part
                     .trials
@@ -115,12 +185,57 @@ pub fn assemble(whole: &Plan, parts: &[Part]) -> anyhow::Result<Assembled> {
                     .collect();
                 trials.sort_by_key(|t| t.trial);
                 out.trials.extend(trials);
-                out.summary.push(row.clone());
+                out.summary.push(row);
             }
             None => out.missing.push(*cell),
         }
     }
+    out.unreferenced = unreferenced;
     Ok(out)
+}
+
+/// The group `group` of `part`, if the part holds cells of it but no usable `seq` cell.
+fn without_its_seq(part: &Part, group: &Group) -> Option<Unreferenced> {
+    let of_group = || part.rows.iter().filter(|r| r.group() == *group);
+    if of_group().any(|r| r.is_reference()) {
+        return None;
+    }
+    let cells: Vec<Cell> = of_group().map(SummaryRow::key).collect();
+    if cells.is_empty() {
+        return None;
+    }
+    let seq = Cell::reference(*group);
+    let why = part
+        .dropped
+        .iter()
+        .find(|d| d.cell == seq && d.phase == Phase::Grid)
+        .map_or_else(
+            || "its row in summary.csv is missing or unreadable".to_owned(),
+            |d| d.why.clone(),
+        );
+    Some(Unreferenced {
+        shard: part.shard,
+        dir: part.dir.clone(),
+        group: *group,
+        why,
+        cells,
+    })
+}
+
+/// The row `references.csv` holds for `part`'s unusable `seq` cell `seq`: failed, no numbers,
+/// the reason saying why.
+fn failed_reference(part: &Part, seq: &Cell, unreferenced: &[Unreferenced]) -> SummaryRow {
+    let why = unreferenced
+        .iter()
+        .find(|u| u.shard == part.shard && u.group == seq.group)
+        .map_or("", |u| u.why.as_str());
+    let ctx = CellContext {
+        hardware_threads: 1,
+        shard: Some(part.shard.index),
+        smt: None,
+    };
+    let reason = format!("left out by bench-sph merge: {why}");
+    summary_row(seq, Phase::Grid, &[], None, Some(&reason), &ctx)
 }
 
 /// A warning when two shards' `seq` means of `group` have disjoint 95 % intervals: the nodes
@@ -219,6 +334,7 @@ mod tests {
             dir: format!("shard-{index}"),
             rows,
             trials,
+            dropped: Vec::new(),
         }
     }
 
@@ -250,6 +366,53 @@ mod tests {
             line.contains("shard 1: 4.00 s [3.92–4.08]") && line.contains("shard 3: 5.00 s"),
             "{line}"
         );
+    }
+
+    #[test]
+    fn a_shard_without_its_seq_keeps_its_cells_without_a_speedup_and_a_failed_reference() {
+        let whole = Plan::new(&params());
+        let mut parts: Vec<Part> = (1..=3).map(|i| part(&whole, i, 3, 4.0)).collect();
+        let seq = parts[2].rows.remove(0);
+        assert!(seq.is_reference());
+        parts[2].dropped.push(Dropped {
+            cell: seq.key(),
+            phase: Phase::Grid,
+            why: "trial 1: wall_s = NaN is not a positive time".to_owned(),
+        });
+        let merged = assemble(&whole, &parts).unwrap();
+        assert!(merged.missing.is_empty());
+        assert_eq!(merged.unreferenced.len(), 1);
+        let u = &merged.unreferenced[0];
+        assert_eq!((u.shard.index, u.cells.len()), (3, parts[2].rows.len()));
+        assert!(
+            u.describe().contains("is unusable (trial 1: wall_s = NaN"),
+            "{u:?}"
+        );
+        for r in merged
+            .summary
+            .iter()
+            .filter(|r| r.reference_shard == Some(3))
+        {
+            assert_eq!(
+                (r.speedup, r.efficiency, r.speedup_ci_low),
+                (None, None, None)
+            );
+            assert!(r.mean_s.is_some());
+        }
+        let refs: Vec<(Option<usize>, Status)> = merged
+            .references
+            .iter()
+            .map(|r| (r.reference_shard, r.status))
+            .collect();
+        assert_eq!(
+            refs,
+            [
+                (Some(1), Status::Ok),
+                (Some(2), Status::Ok),
+                (Some(3), Status::Failed)
+            ]
+        );
+        assert!(merged.references[2].reason.contains("wall_s = NaN"));
     }
 
     #[test]

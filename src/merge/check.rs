@@ -1,12 +1,16 @@
 //! The refusals of `bench-sph merge`, as pure functions of the shards' `meta.json`: only the
-//! shards of one plan, measured by one build on one kind of machine, merge.
+//! shards of one plan, written by a sweep and measured by one build on one kind of machine,
+//! merge; and the check of each shard's cells against its plan ([`against_plan`]).
 
 use std::collections::HashMap;
 
 use anyhow::bail;
 
-use crate::results::meta::Meta;
+use crate::results::meta::{Meta, SWEEP_TOOL};
+use crate::results::params::SweepParams;
+use crate::results::rows::{Phase, Status, SummaryRow, TrialRow};
 use crate::results::shard::Shard;
+use crate::sweep::plan::Plan;
 
 /// A shard directory's `meta.json`, with where it was read from.
 #[derive(Debug, Clone)]
@@ -24,8 +28,15 @@ pub fn shards(parts: &[ShardMeta<'_>]) -> anyhow::Result<Vec<Shard>> {
         bail!("no shard directory given");
     };
     let mut shards = Vec::new();
-    let mut seen: HashMap<usize, &str> = HashMap::new();
     for p in parts {
+        if p.meta.tool != SWEEP_TOOL {
+            bail!(
+                "'{}' was written by `{}`, not by `{SWEEP_TOOL}` (its meta.json's tool): only \
+                 the directories of `bench-sph sweep --shard I/K` merge",
+                p.dir,
+                p.meta.tool
+            );
+        }
         if p.meta.merge.is_some() {
             bail!(
                 "'{}' is already a merge of shards: merge the shard directories themselves",
@@ -39,26 +50,37 @@ pub fn shards(parts: &[ShardMeta<'_>]) -> anyhow::Result<Vec<Shard>> {
                 p.dir
             );
         };
-        if let Some(other) = seen.insert(shard.index, &p.dir) {
-            bail!(
-                "shard {shard} is given twice ('{other}' and '{}'): each cell must count once",
-                p.dir
-            );
-        }
         shards.push(shard);
     }
     let first_shard = shards[0];
     for (p, s) in parts.iter().zip(&shards) {
         if s.count != first_shard.count {
             bail!(
-                "'{}' is shard {s} but '{}' is shard {first_shard}: shards of different splits \
-                 of a plan do not merge",
+                "'{}' (shard {s}) and '{}' (shard {first_shard}) are shards of different splits \
+                 ({} of {} and {} of {}): merge the shards of one split, all run with the same \
+                 `--shard I/{}`",
                 p.dir,
-                first.dir
+                first.dir,
+                s.index,
+                s.count,
+                first_shard.index,
+                first_shard.count,
+                first_shard.count
+            );
+        }
+    }
+    let mut seen: HashMap<usize, &str> = HashMap::new();
+    for (p, s) in parts.iter().zip(&shards) {
+        if let Some(other) = seen.insert(s.index, &p.dir) {
+            bail!(
+                "shard {s} is given twice ('{other}' and '{}'): each cell must count once; give \
+                 each shard's directory once",
+                p.dir
             );
         }
     }
     same_plan(parts)?;
+    planned_cells(parts)?;
     same_build(parts)?;
     same_machine(parts)?;
     Ok(shards)
@@ -85,6 +107,64 @@ fn same_plan(parts: &[ShardMeta<'_>]) -> anyhow::Result<()> {
                 p.dir,
                 first.dir
             );
+        }
+    }
+    Ok(())
+}
+
+/// Every shard's `planned_cells` is the number of cells its parameters plan.
+fn planned_cells(parts: &[ShardMeta<'_>]) -> anyhow::Result<()> {
+    for p in parts {
+        let planned = Plan::new(&p.meta.params).cells.len();
+        if p.meta.planned_cells != planned {
+            bail!(
+                "'{}': its meta.json says planned_cells = {} but its parameters plan {}: was \
+                 it edited? Restore it, or run the shard again",
+                p.dir,
+                p.meta.planned_cells,
+                crate::output::console::plural(planned, "cell", "cells")
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Why a shard's cell (its summary row and its trial rows, in trial order) does not have the
+/// numbers of trials and rounds its plan (`params`) gives it, or `Ok`: an ok cell ran every
+/// round of the grid, a failed one at most that many, and every run names a round of the
+/// plan. (Confirmation rows are refused whole by [`super::assemble`].)
+pub fn against_plan(
+    row: &SummaryRow,
+    trials: &[TrialRow],
+    params: &SweepParams,
+) -> Result<(), String> {
+    let rounds = params.trials;
+    if row.phase != Phase::Grid {
+        return Ok(());
+    }
+    let plural = |k| crate::output::console::plural(k, "trial", "trials");
+    if row.status == Status::Ok && row.trials != rounds {
+        return Err(format!(
+            "an ok cell of {}, but its plan runs {} (--trials {rounds})",
+            plural(row.trials),
+            crate::output::console::plural(rounds, "round", "rounds")
+        ));
+    }
+    if row.trials > rounds {
+        return Err(format!(
+            "{}, but its plan runs {} (--trials {rounds})",
+            plural(row.trials),
+            crate::output::console::plural(rounds, "round", "rounds")
+        ));
+    }
+    for t in trials {
+        if let Some(r) = t.round
+            && !(1..=rounds).contains(&r)
+        {
+            return Err(format!(
+                "trial {}: round {r} is not one of its plan's rounds 1 to {rounds}",
+                t.trial
+            ));
         }
     }
     Ok(())

@@ -3,12 +3,18 @@
 //!
 //! The pipeline: the shards are checked to be distinct directories; each is read under a
 //! shared, read-only lock (a sweep writing it refuses the merge; the merge never writes into a
-//! shard, so shards on a read-only mount merge) keeping its believed cells ([`crate::results::validate::cell`]); [`check`] refuses shards of
-//! different plans, builds or machines and repeated shards; [`assemble`] puts the whole plan
-//! together, one row per cell, each keeping its own shard's speedup (`reference_shard`); a
-//! cell no shard has is an error unless `--allow-partial`, which marks the merge `partial`.
+//! shard, so shards on a read-only mount merge), keeping its believed cells: those
+//! `bench-sph report` believes ([`crate::results::validate::cell`]) whose trials and rounds
+//! are also those of the shard's plan ([`check::against_plan`]); every row left out is named
+//! with why, on standard error and in the merge's `meta.json` (so in its report). [`check`]
+//! refuses directories that a sweep did not write, shards of different plans, splits, builds
+//! or machines, repeated shards and an edited `planned_cells`; [`assemble`] puts the whole
+//! plan together, one row per cell, each keeping its own shard's speedup (`reference_shard`).
+//! A cell no shard has, or a shard's `seq` reference left out (its cells would have no
+//! denominator), is an error unless `--allow-partial`, which marks the merge `partial`.
 //! The output directory is claimed like a new sweep's (locked, and recorded as the merge's:
-//! [`crate::output::record`]) and written file by file through temporary names: `summary.csv`, `trials.csv`, `references.csv` (every shard's `seq` rows)
+//! [`crate::output::record`]) and written file by file through temporary names: `summary.csv`,
+//! `trials.csv`, `references.csv` (every shard's `seq` rows)
 //! and `meta.json` (the plan's parameters without the shard, every shard's sessions, and
 //! `merge`: where each cell came from, what is missing, what was warned about).
 
@@ -22,7 +28,7 @@ use anyhow::{Context, bail};
 use crate::output::console::plural;
 use crate::output::lock;
 use crate::output::record::Command;
-use crate::results::load::{believed, read_summary, read_trials};
+use crate::results::load::{Dropped, believed_with, read_summary, read_trials};
 use crate::results::meta::{Merge, MergedShard, Meta, SweepStatus};
 use crate::results::rows::{SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow};
 use crate::results::{META_FILE, REFERENCES_FILE, SUMMARY_FILE, TRIALS_FILE};
@@ -56,7 +62,8 @@ pub struct Merged {
     pub trial_rows: usize,
     /// `seq` rows in `references.csv`.
     pub references: usize,
-    /// Lines to show as warnings.
+    /// Lines to show as warnings: every row left out of a shard and why, then what else the
+    /// merge found (also in `meta.json`'s `merge.warnings`).
     pub warnings: Vec<String>,
 }
 
@@ -66,6 +73,11 @@ struct Read {
     meta: Meta,
     rows: Vec<SummaryRow>,
     trials: Vec<TrialRow>,
+    /// Its cells left out, each with why.
+    dropped: Vec<Dropped>,
+    /// One line per row or line left out (unreadable lines, cells not believed, trial rows
+    /// of no summary row), naming the directory.
+    left_out: Vec<String>,
 }
 
 /// Merges `request.dirs` into `request.out` (see the module docs).
@@ -98,19 +110,41 @@ pub fn run(request: &Request) -> anyhow::Result<Merged> {
             dir: r.dir.display().to_string(),
             rows: r.rows.clone(),
             trials: r.trials.clone(),
+            dropped: r.dropped.clone(),
         })
         .collect();
     let merged = assemble::assemble(&whole, &parts)?;
-    if !merged.missing.is_empty() && !request.allow_partial {
-        bail!(missing_text(&whole, &read, &shards, &merged.missing));
+    let left_out: Vec<String> = read.iter().flat_map(|r| r.left_out.clone()).collect();
+    if !request.allow_partial {
+        if !merged.unreferenced.is_empty() {
+            bail!(unreferenced_text(&merged.unreferenced, &left_out));
+        }
+        if !merged.missing.is_empty() {
+            bail!(missing_text(
+                &whole,
+                &read,
+                &shards,
+                &merged.missing,
+                &left_out
+            ));
+        }
     }
-    let mut warnings = merged.disagreements.clone();
+    let mut warnings: Vec<String> = left_out
+        .iter()
+        .map(|l| format!("left out of the merge: {l}"))
+        .collect();
+    warnings.extend(merged.disagreements.iter().cloned());
+    for u in &merged.unreferenced {
+        warnings.push(format!(
+            "{} (--allow-partial: they keep their times; references.csv holds that seq as a \
+             failed row saying why)",
+            u.describe()
+        ));
+    }
     if !merged.missing.is_empty() {
         warnings.push(format!(
-            "the merge is partial: {} of the plan's {} missing (--allow-partial); its report \
-             says so",
-            plural(merged.missing.len(), "cell is", "cells are"),
-            whole.cells.len()
+            "the merge is partial: {} (--allow-partial); its report says so",
+            missing_count(merged.missing.len(), whole.cells.len())
         ));
     }
     if read.iter().any(|r| r.meta.git_dirty) {
@@ -184,17 +218,56 @@ fn read_shard(dir: &Path) -> anyhow::Result<Read> {
         );
     }
     let meta = Meta::read(&dir.join(META_FILE))?;
-    let (summary, _) = read_summary(&dir.join(SUMMARY_FILE))
+    let (summary, bad_summary) = read_summary(&dir.join(SUMMARY_FILE))
         .with_context(|| format!("cannot merge '{}'", dir.display()))?;
-    let (trials, _) = read_trials(&dir.join(TRIALS_FILE))
+    let (trials, bad_trials) = read_trials(&dir.join(TRIALS_FILE))
         .with_context(|| format!("cannot merge '{}'", dir.display()))?;
-    let believed = believed(summary, Some(trials));
+    let params = &meta.params;
+    let believed = believed_with(summary, Some(trials), &|row, trials| {
+        check::against_plan(row, trials, params)
+    });
+    let named = |d: &Dropped| format!("'{}': {d}", dir.display());
+    let left_out = bad_summary
+        .into_iter()
+        .chain(bad_trials)
+        .chain(believed.dropped.iter().map(named))
+        .chain(believed.without_summary.iter().map(named))
+        .collect();
     Ok(Read {
         dir: dir.to_path_buf(),
         meta,
         rows: believed.rows,
         trials: believed.trials,
+        dropped: believed.dropped,
+        left_out,
     })
+}
+
+/// The rows left out of the shards, one per line (under an error's first line), or nothing.
+fn left_out_text(left_out: &[String]) -> String {
+    if left_out.is_empty() {
+        return String::new();
+    }
+    let lines: String = left_out.iter().map(|l| format!("\n  - {l}")).collect();
+    format!(
+        "\n{} left out of the shards, as `bench-sph report` would leave {} out:{lines}",
+        plural(left_out.len(), "row or line was", "rows or lines were"),
+        if left_out.len() == 1 { "it" } else { "them" }
+    )
+}
+
+/// Why a merge without `--allow-partial` is refused when a shard's `seq` reference was left
+/// out.
+fn unreferenced_text(unreferenced: &[assemble::Unreferenced], left_out: &[String]) -> String {
+    let each: Vec<String> = unreferenced.iter().map(|u| u.describe()).collect();
+    format!(
+        "{}. Resume or run that shard again (`bench-sph sweep --resume {}` measures what it \
+         drops), then merge again; or merge with --allow-partial to keep those cells without a \
+         speedup (the study is then marked partial){}",
+        each.join("; "),
+        unreferenced[0].dir,
+        left_out_text(left_out)
+    )
 }
 
 /// Why a merge without `--allow-partial` is refused: how many cells are missing, and which
@@ -204,6 +277,7 @@ fn missing_text(
     read: &[Read],
     shards: &[crate::results::shard::Shard],
     missing: &[crate::results::key::Cell],
+    left_out: &[String],
 ) -> String {
     let count = shards[0].count;
     let mut causes = Vec::new();
@@ -218,21 +292,36 @@ fn missing_text(
         if r.meta.status != SweepStatus::Complete {
             causes.push(format!(
                 "shard {s} is {} (`bench-sph sweep --resume {}`)",
-                format!("{:?}", r.meta.status).to_lowercase(),
+                r.meta.status.as_str(),
                 r.dir.display()
             ));
         }
     }
+    if !left_out.is_empty() {
+        causes.push(
+            "rows of the shards left out (listed below; `bench-sph sweep --resume SHARD_DIR` \
+             measures them again)"
+                .to_owned(),
+        );
+    }
     format!(
-        "{} of the plan's {} missing (the first: {}){}; merge with --allow-partial to merge \
-         what there is (the study is then marked partial)",
-        plural(missing.len(), "cell is", "cells are"),
-        whole.cells.len(),
+        "{} (the first: {}){}; merge with --allow-partial to merge what there is (the study is \
+         then marked partial){}",
+        missing_count(missing.len(), whole.cells.len()),
         missing[0].label_with_group(),
         match causes.is_empty() {
             true => String::new(),
             false => format!(": {}", causes.join("; ")),
-        }
+        },
+        left_out_text(left_out)
+    )
+}
+
+/// `1 of the plan's 7 cells is missing`.
+fn missing_count(missing: usize, planned: usize) -> String {
+    format!(
+        "{missing} of the plan's {planned} cells {} missing",
+        if missing == 1 { "is" } else { "are" }
     )
 }
 
@@ -249,7 +338,7 @@ fn merged_meta(
     let mut order: Vec<usize> = (0..read.len()).collect();
     order.sort_by_key(|&i| shards[i].index);
     let first = &read[order[0]].meta;
-    let complete = merged.missing.is_empty();
+    let complete = merged.missing.is_empty() && merged.unreferenced.is_empty();
     Meta {
         params: params.clone(),
         planned_cells: whole.cells.len(),
@@ -287,6 +376,11 @@ fn merged_meta(
                 .missing
                 .iter()
                 .map(|c| c.label_with_group())
+                .collect(),
+            without_reference: merged
+                .unreferenced
+                .iter()
+                .flat_map(|u| u.cells.iter().map(|c| c.label_with_group()))
                 .collect(),
             warnings: warnings.to_vec(),
         }),

@@ -82,6 +82,9 @@ pub enum Withheld {
     Design(Design),
     /// Its cells ran this many rounds, fewer than [`MIN_ROUNDS`].
     Rounds(usize),
+    /// Its directory has no `trials.csv`: its statistics could not be checked against the
+    /// runs, and no runs pair.
+    Unchecked,
 }
 
 /// The verdict at one core count, with what its sentence needs.
@@ -169,6 +172,9 @@ pub fn speedup(b: &Best) -> Option<Ratio> {
 
 /// The findings for the group of `view`.
 pub fn findings(view: &GroupView) -> Vec<Finding> {
+    if view.unchecked {
+        return vec![Finding::Withheld(Withheld::Unchecked)];
+    }
     if !view.design.pairs() {
         return vec![Finding::Withheld(Withheld::Design(view.design))];
     }
@@ -495,6 +501,11 @@ impl Withheld {
             Withheld::Design(_) => "Findings withheld: this sweep ran each cell's runs back to \
                 back (`--schedule cells`), so runs of one round are minutes apart and pairing \
                 them does not cancel the machine's drift. The tables show what was measured."
+                .to_owned(),
+            Withheld::Unchecked => "Findings withheld: this group's directory has no \
+                trials.csv, so its statistics could not be checked against the runs (summary.csv \
+                alone is taken on trust) and no two cells' runs can be paired. The tables show \
+                what summary.csv says."
                 .to_owned(),
             Withheld::Rounds(k) => format!(
                 "No finding: these cells ran {}, and an interval, so a finding, needs \

@@ -136,18 +136,32 @@ pub(super) fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
             .filter(|&p| !s.rows.iter().any(|r| r.strategy == p))
             .map(StrategyName::as_str)
             .collect();
+        let unreferenced = s
+            .meta
+            .merge
+            .as_ref()
+            .map_or(0, |m| m.without_reference.len());
         let _ = writeln!(
             md,
-            "> ⚠ **Partial study**: `{}` is {} — {} of {} planned cells measured{}. Its \
+            "> ⚠ **Partial study**: `{}` is {} — {} of {} planned cells measured{}{}. Its \
              findings cover only what was measured; {}.\n",
             s.dir.display(),
-            format!("{:?}", s.meta.status).to_lowercase(),
+            s.meta.status.as_str(),
             measured,
             s.meta.planned_cells,
             if never.is_empty() {
                 String::new()
             } else {
                 format!("; never measured: {}", never.join(", "))
+            },
+            if unreferenced == 0 {
+                String::new()
+            } else {
+                format!(
+                    "; {} without a speedup, {} shard's `seq` reference left out as unusable",
+                    crate::output::console::plural(unreferenced, "cell", "cells"),
+                    if unreferenced == 1 { "its" } else { "their" }
+                )
             },
             match &s.meta.merge {
                 Some(_) =>
@@ -161,11 +175,41 @@ pub(super) fn banners(md: &mut String, sweeps: &[Sweep], rows: &[SummaryRow]) {
     }
     contended_banner(md, rows);
     dropped_banner(md, sweeps);
+    unchecked_banner(md, sweeps);
 }
+
+/// The banner over directories without `trials.csv`, whose statistics were not checked.
+fn unchecked_banner(md: &mut String, sweeps: &[Sweep]) {
+    for s in sweeps.iter().filter(|s| s.without_trials) {
+        let _ = writeln!(
+            md,
+            "> ⚠ **Statistics not checked**: `{}` has no trials.csv, so the statistics in its \
+             summary.csv could not be checked against the runs: they are taken on trust (only \
+             impossible numbers are refused), and its findings are withheld. {}\n",
+            s.dir.display(),
+            UNCHECKED_ADVICE
+        );
+    }
+}
+
+/// What to do about a directory without `trials.csv` (banner and warning alike).
+pub(super) const UNCHECKED_ADVICE: &str =
+    "Report the directory with the trials.csv its sweep wrote to check them.";
 
 /// The banner over one shard of a sharded sweep, and the line under a merge of shards.
 fn shard_banner(md: &mut String, s: &Sweep) {
-    if let Some(shard) = s.meta.params.shard {
+    if let Some(shard) = s.meta.params.shard
+        && shard.count == 1
+    {
+        let _ = writeln!(
+            md,
+            "> ⚠ **One shard**: `{}` is shard 1/1 of plan {}, a split into one part: it holds \
+             every cell of the plan, but as a shard it ran no confirmation rounds (a sweep \
+             without `--shard` runs them).\n",
+            s.dir.display(),
+            s.meta.plan_fingerprint.as_deref().unwrap_or("unknown")
+        );
+    } else if let Some(shard) = s.meta.params.shard {
         let _ = writeln!(
             md,
             "> ⚠ **One shard**: `{}` is shard {shard} of a sharded sweep (plan {}): it holds \
@@ -181,10 +225,16 @@ fn shard_banner(md: &mut String, s: &Sweep) {
             md,
             "`{}` is a merge of shards {} (plan {}): each cell's speedup divides by the `seq` \
              of the shard that measured it (`reference_shard` in summary.csv; every shard's \
-             `seq` is in references.csv).{}\n",
+             `seq` is in references.csv{}).{}\n",
             s.dir.display(),
             shards.join(", "),
             s.meta.plan_fingerprint.as_deref().unwrap_or("unknown"),
+            if merge.without_reference.is_empty() {
+                ""
+            } else {
+                ", an unusable one as a failed row saying why, and the cells that needed it \
+                 have no speedup"
+            },
             merge
                 .warnings
                 .iter()
@@ -416,7 +466,7 @@ fn machine_fields() -> [(&'static str, Field); 12] {
                 .clone()
                 .unwrap_or_else(|| "—".to_owned())
         }),
-        ("status", |s| format!("{:?}", s.meta.status).to_lowercase()),
+        ("status", |s| s.meta.status.as_str().to_owned()),
         ("sessions", |s| s.meta.sessions.len().to_string()),
         ("command line", |s| {
             let mut c = s.meta.command_line.join(" ");
@@ -751,7 +801,7 @@ fn failed(md: &mut String, rows: &[SummaryRow]) {
     if bad.is_empty() {
         let _ = writeln!(
             md,
-            "None: every cell reproduced its group's `seq` checksum.\n"
+            "No cell failed: every cell reproduced its group's `seq` checksum.\n"
         );
         return;
     }

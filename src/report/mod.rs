@@ -181,6 +181,16 @@ pub fn generate_with(
     let report = out_dir.join(REPORT_FILE);
     crate::output::atomic::write(&report, text.as_bytes())?;
     claimed.remove_stale(&paths)?;
+    // Said once the report is written (a refused report has nothing to qualify).
+    for s in sweeps.iter().filter(|s| s.without_trials) {
+        crate::output::console::warn(&format!(
+            "warning: '{}' has no trials.csv: the statistics in its summary.csv could not be \
+             checked against the runs (they are taken on trust) and its findings are withheld. \
+             {}",
+            s.dir.display(),
+            markdown::UNCHECKED_ADVICE
+        ));
+    }
     Ok(paths)
 }
 

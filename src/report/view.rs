@@ -108,6 +108,9 @@ pub struct GroupView {
     pub rounds: (usize, usize),
     /// Whether its sweep is one shard or a merge of shards (neither has confirmation rounds).
     pub sharded: bool,
+    /// Whether some of its rows come from a directory without `trials.csv`, whose statistics
+    /// could not be checked against the runs ([`Sweep::without_trials`]).
+    pub unchecked: bool,
     /// Each cell's runs per phase.
     runs: HashMap<(Cell, Phase), Runs>,
 }
@@ -139,6 +142,7 @@ impl GroupView {
                     shard: r.reference_shard,
                     paired: design.pairs(),
                 };
+                out[at].unchecked |= s.without_trials;
                 out[at].add(r.clone(), batch, &of_cell);
             }
         }
@@ -153,6 +157,7 @@ impl GroupView {
             confirmed: Vec::new(),
             rounds: (meta.params.trials, meta.params.confirm_rounds),
             sharded: meta.merge.is_some() || meta.params.shard.is_some(),
+            unchecked: false,
             runs: HashMap::new(),
         }
     }

@@ -49,6 +49,10 @@ pub struct Sweep {
     pub trials: Vec<TrialRow>,
     /// Cells left out, each with why.
     pub dropped: Vec<String>,
+    /// Whether the directory has no `trials.csv`: its summary statistics could not be checked
+    /// against its runs (only [`validate::summary_alone`]), so the report takes them on trust
+    /// and says so.
+    pub without_trials: bool,
 }
 
 /// Reads every directory of `dirs`, refusing a directory given twice (under any path).
@@ -118,8 +122,9 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
         }
         None => None,
     };
+    let without_trials = trials.is_none();
     let believed = believed(summary, trials);
-    dropped.extend(believed.dropped);
+    dropped.extend(believed.dropped.iter().map(ToString::to_string));
     let (confirmed, rows): (Vec<SummaryRow>, Vec<SummaryRow>) = believed
         .rows
         .into_iter()
@@ -139,6 +144,7 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
         confirmed,
         trials: believed.trials,
         dropped,
+        without_trials,
     })
 }
 
@@ -150,13 +156,47 @@ pub struct Believed {
     /// Their trial rows, cell by cell, in trial order (empty without a `trials.csv`).
     pub trials: Vec<TrialRow>,
     /// Each row left out, with why.
-    pub dropped: Vec<String>,
+    pub dropped: Vec<Dropped>,
+    /// Cells with trial rows but no summary row, with how many (an unfinished cell's runs, or
+    /// a summary row deleted): not an error in a sweep, which may be unfinished.
+    pub without_summary: Vec<Dropped>,
 }
+
+/// A summary row left out ([`believed`]): its cell, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dropped {
+    /// The row's cell.
+    pub cell: Cell,
+    /// The row's phase.
+    pub phase: Phase,
+    /// Why it cannot be believed.
+    pub why: String,
+}
+
+impl std::fmt::Display for Dropped {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.cell.label_with_group(), self.why)
+    }
+}
+
+/// A caller's own check of a cell that passed [`believed`]'s (its summary row and its trial
+/// rows, in trial order).
+pub type CheckCell<'a> = &'a dyn Fn(&SummaryRow, &[TrialRow]) -> Result<(), String>;
 
 /// The cells of `summary` that pass the checks: a cell's first row only, and its statistics
 /// those of its rows in `trials` ([`validate::cell`]) or, without a `trials.csv` (`None`),
 /// possible on their own ([`validate::summary_alone`]).
 pub fn believed(summary: Vec<SummaryRow>, trials: Option<Vec<TrialRow>>) -> Believed {
+    believed_with(summary, trials, &|_, _| Ok(()))
+}
+
+/// [`believed`], each cell also passing `check` (`bench-sph merge`: the cell's numbers of
+/// trials and rounds are its plan's).
+pub fn believed_with(
+    summary: Vec<SummaryRow>,
+    trials: Option<Vec<TrialRow>>,
+    check: CheckCell<'_>,
+) -> Believed {
     let have_trials = trials.is_some();
     let mut by_cell: HashMap<(Cell, Phase), Vec<TrialRow>> = HashMap::new();
     for t in trials.into_iter().flatten() {
@@ -175,16 +215,33 @@ pub fn believed(summary: Vec<SummaryRow>, trials: Option<Vec<TrialRow>>) -> Beli
         } else {
             validate::summary_alone(&row)
         };
-        match checked {
+        match checked.and_then(|()| check(&row, &of_cell)) {
             Ok(()) => {
                 out.trials.extend(of_cell);
                 out.rows.push(row);
             }
-            Err(why) => out
-                .dropped
-                .push(format!("{}: {why}", row.key().label_with_group())),
+            Err(why) => out.dropped.push(Dropped {
+                cell: row.key(),
+                phase: row.phase,
+                why,
+            }),
         }
     }
+    let mut rest: Vec<((Cell, Phase), Vec<TrialRow>)> = by_cell.into_iter().collect();
+    rest.sort_by_key(|((cell, phase), _)| (cell.label_with_group(), *phase));
+    out.without_summary = rest
+        .into_iter()
+        .map(|((cell, phase), trials)| Dropped {
+            cell,
+            phase,
+            why: format!(
+                "summary.csv has no row of it, though trials.csv holds {} of its {} phase \
+                 (the row was deleted or edited, or the cell never finished)",
+                crate::output::console::plural(trials.len(), "trial row", "trial rows"),
+                phase.as_str()
+            ),
+        })
+        .collect();
     out
 }
 
@@ -255,10 +312,11 @@ fn read_csv_if_exists<R: serde::de::DeserializeOwned>(
             Ok(row) => rows.push(row),
             // Reading stopped (the cap, a failing disk): not a row to leave out.
             Err(e) if e.is_io_error() => return Err(csv_error(e, path)),
-            Err(_) => bad.push(format!(
-                "'{}' line {}: not a bench-sph {what} row (cut off, or garbled)",
+            Err(e) => bad.push(format!(
+                "'{}' line {}: not a bench-sph {what} row ({})",
                 path.display(),
-                i + 2
+                i + 2,
+                validate::unreadable(&e, columns)
             )),
         }
     }

@@ -39,6 +39,21 @@ pub enum SweepStatus {
     Partial,
 }
 
+impl SweepStatus {
+    /// The word written in `meta.json`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            SweepStatus::Running => "running",
+            SweepStatus::Complete => "complete",
+            SweepStatus::Interrupted => "interrupted",
+            SweepStatus::Partial => "partial",
+        }
+    }
+}
+
+/// The `tool` a sweep (and a merge of shards) writes in `meta.json`.
+pub const SWEEP_TOOL: &str = "bench-sph sweep";
+
 /// The machine a session ran on.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Machine {
@@ -268,7 +283,12 @@ pub struct Merge {
     pub shards: Vec<MergedShard>,
     /// Cells of the plan that no shard had, by label (empty unless `--allow-partial`).
     pub missing_cells: Vec<String>,
-    /// What the merge warned about (shards whose `seq` means disagree).
+    /// Cells of the plan merged without a speedup, by label: their shard's `seq` reference
+    /// was left out as unusable (`--allow-partial`; absent when none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub without_reference: Vec<String>,
+    /// What the merge warned about: rows of the shards left out and why, shards whose `seq`
+    /// means disagree, shards without a usable `seq`, cells missing.
     pub warnings: Vec<String>,
 }
 
@@ -290,7 +310,7 @@ impl Meta {
     /// The metadata of a new sweep whose first session is `session`.
     pub fn new(params: SweepParams, planned_cells: usize, session: Session) -> Meta {
         Meta {
-            tool: "bench-sph sweep".to_owned(),
+            tool: SWEEP_TOOL.to_owned(),
             version: session.version.clone(),
             git_commit: session.git_commit.clone(),
             git_dirty: session.git_commit.ends_with("-dirty"),
@@ -344,7 +364,7 @@ impl Meta {
             return Ok(false);
         };
         Ok(serde_json::from_slice::<serde_json::Value>(&bytes)
-            .is_ok_and(|v| v["tool"] == "bench-sph sweep"))
+            .is_ok_and(|v| v["tool"] == SWEEP_TOOL))
     }
 }
 

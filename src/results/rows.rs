@@ -150,13 +150,38 @@ impl Phase {
 }
 
 /// Whether a cell's numbers can be used.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Status {
     /// Every run finished and reproduced the group's `seq` checksum.
     Ok,
     /// A run failed or its checksum differed: see `reason`.
     Failed,
+}
+
+impl Status {
+    /// The word written in the CSVs.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Ok => "ok",
+            Status::Failed => "failed",
+        }
+    }
+}
+
+/// Read by hand, so that a word other than `ok` and `failed` is named in the message (the
+/// csv crate does not say which column an enum came from).
+impl<'de> Deserialize<'de> for Status {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Status, D::Error> {
+        let word = String::deserialize(d)?;
+        match word.as_str() {
+            "ok" => Ok(Status::Ok),
+            "failed" => Ok(Status::Failed),
+            other => Err(serde::de::Error::custom(format!(
+                "status '{other}' is neither ok nor failed"
+            ))),
+        }
+    }
 }
 
 /// One row of `trials.csv`: one timed run.

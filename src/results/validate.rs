@@ -26,8 +26,17 @@ pub fn cell(summary: &SummaryRow, trials: &[TrialRow]) -> Result<(), String> {
             trials.len()
         ));
     }
+    numbering(trials)?;
     for t in trials {
         run(t)?;
+        if summary.status == Status::Ok && t.status != Status::Ok {
+            return Err(format!(
+                "trial {} is marked {} ({}) in a cell marked ok",
+                t.trial,
+                t.status.as_str(),
+                reason_or_dash(&t.reason)
+            ));
+        }
         if summary.status == Status::Ok && t.checksum != summary.checksum {
             return Err(format!(
                 "trial {}: checksum {} differs from the cell's {}",
@@ -58,6 +67,51 @@ pub fn cell(summary: &SummaryRow, trials: &[TrialRow]) -> Result<(), String> {
                 show(found),
                 show(want)
             ));
+        }
+    }
+    Ok(())
+}
+
+/// Why a cell's trial rows (sorted by trial number) are not numbered as a sweep numbers them,
+/// or `Ok`: trials 1, 2, … in order, and, where the rows have rounds (every sweep since
+/// rounds), each in a later round than the one before, from round 1.
+pub fn numbering(trials: &[TrialRow]) -> Result<(), String> {
+    if trials.iter().enumerate().any(|(i, t)| t.trial != i + 1) {
+        let numbers: Vec<String> = trials.iter().map(|t| t.trial.to_string()).collect();
+        return Err(format!(
+            "its trials are numbered {}, not 1 to {} (renumbered, repeated or missing rows)",
+            numbers.join(", "),
+            trials.len()
+        ));
+    }
+    let with_rounds = trials.iter().filter(|t| t.round.is_some()).count();
+    if with_rounds != 0 && with_rounds != trials.len() {
+        return Err("some of its trials have a round and others none".to_owned());
+    }
+    let mut before = 0;
+    for t in trials {
+        match (t.round, t.position) {
+            (None, _) => {}
+            (Some(r), Some(p)) if r > before && p >= 1 => before = r,
+            (Some(r), Some(p)) if r > before => {
+                return Err(format!(
+                    "trial {}: position {p} in round {r} (places in a round count from 1)",
+                    t.trial
+                ));
+            }
+            (Some(r), Some(_)) => {
+                return Err(format!(
+                    "trial {}: round {r} does not come after the round of trial {} ({before})",
+                    t.trial,
+                    t.trial - 1
+                ));
+            }
+            (Some(r), None) => {
+                return Err(format!(
+                    "trial {}: round {r} without a position in it",
+                    t.trial
+                ));
+            }
         }
     }
     Ok(())
@@ -183,6 +237,47 @@ fn close(a: f64, b: f64) -> bool {
     (a - b).abs() <= TOLERANCE * a.abs().max(b.abs())
 }
 
+/// A row's `reason`, or a dash where it gives none.
+pub fn reason_or_dash(reason: &str) -> &str {
+    if reason.trim().is_empty() {
+        "—"
+    } else {
+        reason
+    }
+}
+
+/// Why a line of a results CSV (whose header is `columns`) is not a row: it has too few or too
+/// many fields, or which column holds what cannot be read (e.g. `status` holds a word other
+/// than `ok` and `failed`).
+pub fn unreadable(err: &csv::Error, columns: &[&str]) -> String {
+    match err.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!("it has {len} fields, not {expected_len}"),
+        csv::ErrorKind::Deserialize { err, .. } => {
+            let column = err
+                .field()
+                .and_then(|i| usize::try_from(i).ok())
+                .and_then(|i| columns.get(i));
+            let what = match err.kind() {
+                csv::DeserializeErrorKind::Message(m) => m.clone(),
+                csv::DeserializeErrorKind::Unsupported(m) => m.clone(),
+                csv::DeserializeErrorKind::UnexpectedEndOfRow => "a field is missing".to_owned(),
+                csv::DeserializeErrorKind::InvalidUtf8(_) => "not UTF-8 text".to_owned(),
+                csv::DeserializeErrorKind::ParseBool(_) => "not true or false".to_owned(),
+                csv::DeserializeErrorKind::ParseInt(_) => "not a whole number".to_owned(),
+                csv::DeserializeErrorKind::ParseFloat(_) => "not a number".to_owned(),
+            };
+            match column {
+                Some(c) => format!("column {c}: {what}"),
+                None => what,
+            }
+        }
+        csv::ErrorKind::Utf8 { .. } => "not UTF-8 text".to_owned(),
+        _ => "cut off, or garbled".to_owned(),
+    }
+}
+
 fn show(v: Option<f64>) -> String {
     v.map_or_else(|| "empty".to_owned(), |v| v.to_string())
 }
@@ -241,6 +336,39 @@ mod tests {
         assert!(cell(&s, &t).unwrap_err().contains("mean_s = 0.4"));
         let (s, t) = rows();
         assert!(cell(&s, &t[..2]).unwrap_err().contains("counts 3 trials"));
+    }
+
+    #[test]
+    fn a_failed_trial_in_an_ok_cell_and_renumbered_trials_or_rounds_are_refused() {
+        let (s, mut t) = rows();
+        t[1].status = Status::Failed;
+        t[1].reason = "boom".to_owned();
+        assert_eq!(
+            cell(&s, &t).unwrap_err(),
+            "trial 2 is marked failed (boom) in a cell marked ok"
+        );
+        let (s, mut t) = rows();
+        t[2].trial = 7;
+        assert!(
+            cell(&s, &t)
+                .unwrap_err()
+                .contains("numbered 1, 2, 7, not 1 to 3"),
+            "{t:?}"
+        );
+        let (s, mut t) = rows();
+        t[2].round = Some(2);
+        assert!(
+            cell(&s, &t)
+                .unwrap_err()
+                .contains("trial 3: round 2 does not come after the round of trial 2 (2)")
+        );
+        let (s, mut t) = rows();
+        t[0].round = None;
+        assert!(
+            cell(&s, &t)
+                .unwrap_err()
+                .contains("a round and others none")
+        );
     }
 
     #[test]

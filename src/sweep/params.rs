@@ -14,7 +14,11 @@ impl SweepParams {
                 anyhow::bail!("{what}: the list is empty");
             }
             if values.windows(2).any(|w| w[0] >= w[1]) {
-                anyhow::bail!("{what}: the list {values:?} is not sorted without repeats");
+                let shown: Vec<String> = values.iter().map(ToString::to_string).collect();
+                anyhow::bail!(
+                    "{what}: the list {} is not sorted without repeats",
+                    shown.join(",")
+                );
             }
             for &v in values {
                 check(what, v, 1, max)?;

@@ -5,8 +5,9 @@
 //! `trials.csv` has exactly `trials` rows for it (numbered 1, 2, …). The runs of a phase that
 //! has no summary row yet are **pending**: each (cell, phase, round) is kept once, and the
 //! runner skips those runs and continues the round it was in. Everything else — a line cut off
-//! mid-write, a repeated row, a run the caller's check refuses — is dropped, both files are
-//! written back without it, and the run happens again. Failed cells are finished too: their
+//! mid-write, a repeated row, a whole line that is not a row (a field too many, a status word
+//! other than `ok` and `failed`: listed with why), a run the caller's check refuses — is
+//! dropped, both files are written back without it, and the run happens again. Failed cells are finished too: their
 //! failure is a result (delete their rows by hand to retry them).
 //!
 //! A finished cell is believed only if it passes [`crate::results::validate::cell`] (finite
@@ -32,6 +33,7 @@ use crate::results::rows::{
     Phase, SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow, is_older_summary_header,
     is_older_trial_header,
 };
+use crate::results::validate::unreadable;
 
 /// Why a directory's files cannot be resumed.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -74,7 +76,8 @@ pub struct Repaired {
     pub finished_trials: Vec<TrialRow>,
     /// The runs of unfinished cell phases, each (cell, phase, round) once, in file order.
     pub pending: Vec<TrialRow>,
-    /// Rows that were dropped although they were whole: the cell (or run) and why.
+    /// Rows that were dropped although they were whole, and whole lines that are not rows:
+    /// the cell, run or line, and why.
     pub rejected: Vec<String>,
     /// `trials.csv` as it should be: header, the finished cells' trial rows, the pending runs.
     pub trials_csv: Vec<u8>,
@@ -97,14 +100,18 @@ pub fn repair(
     check_cell: CheckCell<'_>,
     check_run: CheckRun<'_>,
 ) -> Result<Repaired, NotResumable> {
-    let (summary_rows, mut dropped_summary_rows) = read_rows::<SummaryRow>(
+    let (summary_rows, mut dropped_summary_rows, unreadable_summary) = read_rows::<SummaryRow>(
         summary,
         "summary.csv",
         &SUMMARY_COLUMNS,
         is_older_summary_header,
     )?;
-    let (trial_rows, mut dropped_trial_rows) =
+    let (trial_rows, mut dropped_trial_rows, unreadable_trials) =
         read_rows::<TrialRow>(trials, "trials.csv", &TRIAL_COLUMNS, is_older_trial_header)?;
+    let mut rejected: Vec<String> = unreadable_summary
+        .into_iter()
+        .chain(unreadable_trials)
+        .collect();
 
     // The first summary row of each cell phase; the trial rows of each, once per number.
     let mut seen = HashSet::new();
@@ -133,7 +140,6 @@ pub fn repair(
     // Finished = a summary row and trials numbered exactly 1..=trials.
     let mut finished = Vec::new();
     let mut kept: Vec<(usize, TrialRow)> = Vec::new();
-    let mut rejected = Vec::new();
     for row in candidates {
         let mut trials = by_cell.remove(&row.phased_key()).unwrap_or_default();
         trials.sort_by_key(|(_, t)| t.trial);
@@ -219,22 +225,24 @@ impl Repaired {
     }
 }
 
-/// The complete rows of a CSV file and the number of lines that were not (a last line without
-/// its newline, cut off by a kill, or a row that does not parse). A header that `older`
-/// accepts is an earlier version's file, which cannot be resumed.
+/// The complete rows of a CSV file, the number of lines that were not (a last line without
+/// its newline, cut off by a kill, or a row that does not parse), and a note saying why for
+/// each whole line that is not a row (too many or too few fields, a status word other than
+/// `ok` and `failed`, …). A header that `older` accepts is an earlier version's file, which
+/// cannot be resumed.
 fn read_rows<R: serde::de::DeserializeOwned>(
     bytes: &[u8],
     file: &'static str,
     columns: &[&str],
     older: fn(&[&str]) -> bool,
-) -> Result<(Vec<R>, usize), NotResumable> {
+) -> Result<(Vec<R>, usize, Vec<String>), NotResumable> {
     let complete = match bytes.iter().rposition(|&b| b == b'\n') {
         Some(last) => &bytes[..=last],
         None => &[][..],
     };
     let mut dropped = usize::from(complete.len() < bytes.len());
     if complete.is_empty() {
-        return Ok((Vec::new(), dropped));
+        return Ok((Vec::new(), dropped, Vec::new()));
     }
     let mut reader = csv::ReaderBuilder::new()
         .has_headers(true)
@@ -264,14 +272,32 @@ fn read_rows<R: serde::de::DeserializeOwned>(
             });
         }
     }
+    let header = csv::StringRecord::from(columns.to_vec());
+    let line =
+        |p: Option<&csv::Position>| p.map_or_else(|| "?".to_owned(), |p| p.line().to_string());
     let mut rows = Vec::new();
-    for record in reader.deserialize::<R>() {
-        match record {
-            Ok(row) => rows.push(row),
-            Err(_) => dropped += 1,
+    let mut notes = Vec::new();
+    for record in reader.records() {
+        let why = match record {
+            Err(e) => Some((line(e.position()), unreadable(&e, columns))),
+            Ok(r) if r.len() != columns.len() => Some((
+                line(r.position()),
+                format!("it has {} fields, not {}", r.len(), columns.len()),
+            )),
+            Ok(r) => match r.deserialize::<R>(Some(&header)) {
+                Ok(row) => {
+                    rows.push(row);
+                    None
+                }
+                Err(e) => Some((line(r.position()), unreadable(&e, columns))),
+            },
+        };
+        if let Some((at, why)) = why {
+            dropped += 1;
+            notes.push(format!("{file} line {at}: not a bench-sph row ({why})"));
         }
     }
-    Ok((rows, dropped))
+    Ok((rows, dropped, notes))
 }
 
 /// Reads `dir`'s CSV files (a missing one counts as empty), repairs them with `check`, and
@@ -444,6 +470,28 @@ mod tests {
         let r = repair_all(text.as_bytes(), &empty);
         assert_eq!(r.pending.len(), 5);
         assert!(r.rejected[0].contains("wall_s = -1"), "{:?}", r.rejected);
+    }
+
+    #[test]
+    fn a_whole_line_that_is_not_a_row_is_dropped_saying_why() {
+        let (t, s) = finished_phase();
+        let text = String::from_utf8(t).unwrap();
+        let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+        lines[2] = lines[2].replacen(",ok,", ",boom,", 1);
+        lines[3] = lines[3].replacen(",ok,", ",failed,boom,", 1);
+        let edited = format!("{}\n", lines.join("\n"));
+        let r = repair_all(edited.as_bytes(), &s);
+        assert_eq!(r.finished.len(), 0, "both cells lost a run");
+        assert!(
+            r.rejected[0].starts_with("trials.csv line 3: not a bench-sph row (")
+                && r.rejected[0].contains("status 'boom' is neither ok nor failed"),
+            "{:?}",
+            r.rejected
+        );
+        assert_eq!(
+            r.rejected[1],
+            "trials.csv line 4: not a bench-sph row (it has 24 fields, not 23)"
+        );
     }
 
     #[test]

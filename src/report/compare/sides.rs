@@ -177,6 +177,7 @@ pub(crate) mod tests {
             confirmed: Vec::new(),
             trials: Vec::new(),
             dropped: Vec::new(),
+            without_trials: false,
         }
     }
 
