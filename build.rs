@@ -11,11 +11,12 @@ use std::process::Command;
 
 /// The tracked paths that go into the build: a change to one of them marks the commit dirty
 /// (measured results and reports in `results/` and `report/` do not change the program).
-const BUILD_INPUTS: [&str; 6] = [
+const BUILD_INPUTS: [&str; 7] = [
     "Cargo.toml",
     "Cargo.lock",
     "build.rs",
     "src",
+    "solver",
     "strategies",
     "assets",
 ];

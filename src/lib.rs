@@ -25,7 +25,8 @@
 //! - [`trace`]: per-worker timelines of a few steps (`bench-sph trace`);
 //! - [`cli`]: the `bench-sph` command line.
 
-pub mod checksum;
+pub use sph_solver::{checksum, scene, simd, solver, sph, with_lanes};
+
 pub mod cli;
 pub mod clock;
 pub mod contention;
@@ -39,11 +40,7 @@ pub mod render;
 pub mod report;
 pub mod results;
 pub mod run;
-pub mod scene;
 pub mod signals;
-pub mod simd;
-pub mod solver;
-pub mod sph;
 pub mod sweep;
 pub mod topology;
 pub mod trace;

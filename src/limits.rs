@@ -20,8 +20,7 @@
 pub const MAX_CORES: usize = 1024;
 /// The most chunks per pass any command accepts.
 pub const MAX_CHUNKS: usize = 10_000_000;
-/// The most particles any command accepts (memory is checked separately).
-pub const MAX_PARTICLES: usize = 100_000_000;
+pub use sph_solver::MAX_PARTICLES;
 /// The most steps of one run.
 pub const MAX_STEPS: usize = 1_000_000_000;
 /// The longest simulated time `--t-end` accepts, s.

@@ -2,8 +2,6 @@
 //! output file goes, and the one way every file of a results, trace or output directory is
 //! read ([`capped`]: regular files only, at most a cap per kind).
 
-pub mod bounded;
 pub mod capped;
-pub mod dump_csv;
-pub mod init_csv;
 pub mod sink;
+pub use sph_solver::io::{bounded, dump_csv, init_csv};

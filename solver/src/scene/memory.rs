@@ -18,7 +18,7 @@
 
 use std::mem::size_of;
 
-use crate::limits::MAX_PARTICLES;
+use crate::MAX_PARTICLES;
 use crate::scene::{dam_break, tank};
 use crate::solver::SPEED_BLOCK;
 use crate::sph::neighbors::{Grid, GridKeys, NeighborMode, SLOTS, WCSPH_SLOTS};

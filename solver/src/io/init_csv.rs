@@ -12,9 +12,9 @@ use std::path::Path;
 
 use serde::Deserialize;
 
+use crate::MAX_PARTICLES;
 use crate::io::bounded::{BoundedLines, Overrun, overrun};
 use crate::io::dump_csv::DumpInfo;
-use crate::limits::MAX_PARTICLES;
 use crate::sph::state::{Domain, State};
 
 /// Comment lines an init file may hold besides its header and particles.
