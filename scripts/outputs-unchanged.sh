@@ -7,7 +7,7 @@
 #   BASE_BIN=path  use this binary for BASE instead of building it (in target/outputs-base/).
 #
 # The commands: the committed report regenerated from the committed results (traces included),
-# two sweeps under the hidden --fake-timings/--fake-contention (one contended, one
+# two sweeps under the test hooks --fake-timings/--fake-contention (one contended, one
 # oversubscribed cell) and their report, a third interrupted and resumed, simulate
 # --json/--dump on three strategies and from an --init file, render to a GIF and to PNG
 # frames, list, two errors. Left out of the diff: what a run measures (simulate's wall and CPU
@@ -19,12 +19,17 @@ BASE="${1:-HEAD~1}"
 work=$(mktemp -d)
 trap 'git worktree remove --force "$work/base-src" >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
 
-cargo build --release --quiet
-NEW="$PWD/target/release/bench-sph"
+# Both binaries are built with the test hooks (the `testing` feature; revisions before it had
+# them without a feature), each in its own target directory: target/release stays the shipped
+# build.
+CARGO_TARGET_DIR="$PWD/target/outputs-new" cargo build --release --quiet --features testing
+NEW="$PWD/target/outputs-new/release/bench-sph"
 if [ -z "${BASE_BIN:-}" ]; then
     git worktree add --quiet --detach "$work/base-src" "$BASE"
+    base_features=()
+    if grep -q '^testing = ' "$work/base-src/Cargo.toml"; then base_features=(--features testing); fi
     CARGO_TARGET_DIR="$PWD/target/outputs-base" cargo build --release --quiet \
-        --manifest-path "$work/base-src/Cargo.toml"
+        --manifest-path "$work/base-src/Cargo.toml" "${base_features[@]}"
     BASE_BIN="$PWD/target/outputs-base/release/bench-sph"
 fi
 
@@ -46,7 +51,7 @@ outputs() {
     { "$bin" report sw1 sw2 --out rep12; echo "rc=$?"; } > rep12.stdout 2>&1
     # A sweep stopped as if by Ctrl-C after 2 cells, then resumed (with its charts).
     { "$bin" sweep --n 100 --steps 2 --cores 1,2 --chunks 2 --trials 2 --warmup 0 \
-        --strategies rayon-chunks,std-static --fake-timings 0.3,0.2 --stop-after-cells 2 \
+        --strategies rayon-chunks,std-static --fake-timings 0.3,0.2 --stop-after-runs 2 \
         --no-plots --out sw3; echo "rc=$?"; } > sw3.stdout 2>&1
     { "$bin" sweep --resume sw3; echo "rc=$?"; } > sw3-resume.stdout 2>&1
     local timed='s/"(wall_s|cpu_s|particle_steps_per_s)":[^,}]*/"\1":X/g'

@@ -11,6 +11,7 @@ mod scene;
 mod simulate;
 mod speedup;
 mod sweep;
+mod testing;
 mod trace;
 mod validate;
 mod values;

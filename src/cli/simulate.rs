@@ -47,10 +47,10 @@ pub struct SimulateArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
-    /// Test-only: make the density kernel panic at this particle, to check that a worker's
-    /// panic becomes an error of the run on every strategy.
-    #[arg(long, hide = true, value_name = "PARTICLE")]
-    pub inject_panic_at: Option<usize>,
+    /// Test hooks (only with the `testing` cargo feature).
+    #[cfg(feature = "testing")]
+    #[command(flatten)]
+    pub hooks: super::testing::SimulateHooks,
 }
 
 /// What `simulate --json` prints (field names as in the study's CSVs).
@@ -98,7 +98,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         },
     };
     let strategy = args.parallel.strategy;
-    let outcome = match args.inject_panic_at {
+    let outcome = match args.hooks().inject_panic_at {
         None => run_timed_steps(&mut sim, strategy, &config, steps, &mut ()),
         Some(particle) => {
             run_timed_steps(&mut sim, strategy, &config, steps, &mut PanicAt(particle))
@@ -201,4 +201,14 @@ fn print_report(r: &Report, json: bool) -> anyhow::Result<()> {
     ))?;
     say(&format!("checksum {}", r.checksum))?;
     Ok(())
+}
+
+impl SimulateArgs {
+    /// The test hooks given; none in a build without the `testing` feature.
+    fn hooks(&self) -> super::testing::SimulateHooks {
+        #[cfg(feature = "testing")]
+        return self.hooks.clone();
+        #[cfg(not(feature = "testing"))]
+        super::testing::SimulateHooks::default()
+    }
 }

@@ -139,24 +139,25 @@ pub struct SweepArgs {
     /// Do not draw charts at the end.
     #[arg(long)]
     pub no_plots: bool,
-    /// A small study that finishes in about a minute on 2 cores: the defaults, but 300 steps,
-    /// chunks 10,45,90 and 3 trials per cell.
+    /// A small study, about 10 s of runs on 2 cores: the defaults, but 300 steps, chunks
+    /// 10,45,90 and 3 trials per cell.
     #[arg(long, conflicts_with_all = ["steps", "chunks", "trials"])]
     pub quick: bool,
-    /// Test only: record these times (WALL or WALL:CPU seconds, comma-separated, taken in
-    /// turn) instead of the measured ones. The runs still happen and are checked.
-    #[arg(long, value_name = "LIST", hide = true)]
-    pub fake_timings: Option<String>,
-    /// Test only: record these shares (0 ..= 1, comma-separated, taken in turn) of the
-    /// machine's capacity as taken by other work, instead of the measured foreign CPU.
-    #[arg(long, value_name = "LIST", hide = true)]
-    pub fake_contention: Option<String>,
-    /// Test only: stop as if Ctrl-C was pressed once this many runs are written.
-    #[arg(long, value_name = "K", hide = true)]
-    pub stop_after_runs: Option<usize>,
+    /// Test hooks (only with the `testing` cargo feature).
+    #[cfg(feature = "testing")]
+    #[command(flatten)]
+    pub hooks: super::testing::SweepHooks,
 }
 
 impl SweepArgs {
+    /// The test hooks given; none in a build without the `testing` feature.
+    fn hooks(&self) -> super::testing::SweepHooks {
+        #[cfg(feature = "testing")]
+        return self.hooks.clone();
+        #[cfg(not(feature = "testing"))]
+        super::testing::SweepHooks::default()
+    }
+
     /// The parameters of a new sweep, with every list expanded and checked.
     pub fn params(&self) -> anyhow::Result<SweepParams> {
         let list = |option: &str, spec: &str, axis: Axis| {
@@ -207,8 +208,8 @@ impl SweepArgs {
             },
             seed: self.seed,
             simd: Some(crate::simd::current()),
-            fake_timings: self.fake_timings.clone(),
-            fake_contention: self.fake_contention.clone(),
+            fake_timings: self.hooks().fake_timings,
+            fake_contention: self.hooks().fake_contention,
             pin: {
                 let mut pins = self.pin.clone();
                 pins.sort();
@@ -233,7 +234,7 @@ impl SweepArgs {
             target,
             remeasure_contended: self.remeasure_contended,
             wait_quiet_s: self.wait_quiet,
-            stop_after_runs: self.stop_after_runs,
+            stop_after_runs: self.hooks().stop_after_runs,
             command_line: std::env::args_os()
                 .map(|a| a.to_string_lossy().into_owned())
                 .collect(),

@@ -1,15 +1,16 @@
 //! Where a trial's numbers come from: the clock and the machine's counters, or — **for tests
 //! only** — fixed lists.
 //!
-//! - The hidden option `--fake-timings LIST` (comma-separated items `WALL` or `WALL:CPU`, in
+//! - The test hook `--fake-timings LIST` (comma-separated items `WALL` or `WALL:CPU`, in
 //!   seconds; CPU defaults to WALL) replaces the measured times of every timed trial, so tests
 //!   can check the statistics exactly.
-//! - The hidden option `--fake-contention LIST` (comma-separated shares in [0, 1] of the
+//! - The test hook `--fake-contention LIST` (comma-separated shares in [0, 1] of the
 //!   machine's capacity taken by other work) replaces the foreign-CPU readings: a trial given
 //!   share f records `foreign_cpu_s` = f × hardware threads × its wall seconds, no steal, and a
 //!   1-minute load of f × hardware threads; the busy-machine check before the plan reads the
 //!   first item.
 //!
+//! Both exist only in a build with the `testing` cargo feature (`crate::cli`'s test hooks).
 //! `--fake-timings` alone implies `--fake-contention 0` (a quiet machine), so a test's files do
 //! not depend on what else the machine was doing.
 //!
