@@ -1,7 +1,6 @@
 #!/usr/bin/env bash
 # Runs a bench-sph sweep as K shards, on several machines over ssh with GNU parallel, or one
-# after another on this machine, then merges them and draws the report (README, "Sharded
-# sweeps").
+# after another on this machine, then merges them and draws the report (book/src/commands/merge.md).
 #
 # Usage: scripts/parallel-sweep.sh -k K -o RESULTS_DIR [-S HOST,HOST...] [-f | -r] [-n]
 #                                  -- SWEEP PLAN OPTIONS

@@ -60,14 +60,14 @@ mkdir -p report
 "$BIN" report results/paper results/grid results/all-pairs-small results/wcsph \
     --out report --force
 "$BIN" validate --resolution 40 --out report/validation --force
-# Placement (README, "Hyperthreading and placement"): every strategy unpinned and pinned
+# Placement (book/src/hyperthreading.md): every strategy unpinned and pinned
 # `spread`, reported on its own (its unpinned cells repeat results/grid's N = 10 000 group).
 "$BIN" sweep --preset seed --neighbors grid --n 10000 --steps 100 \
     --cores "$CORES" --chunks 10,50 --pin none,spread --out results/pin --force --no-plots
 mkdir -p report/pin
 "$BIN" report results/pin --out report/pin --force
 
-# A stand-in for a second machine (README, "Comparing machines"): the grid study again at 50
+# A stand-in for a second machine (book/src/commands/report.md, "Comparing machines"): the grid study again at 50
 # steps on this machine, compared with --compare, whose banner says it is one machine.
 "$BIN" sweep --preset seed --neighbors grid --n 1000,10000 --steps 50 \
     --cores "$CORES" --chunks 10,50,200 --out results/grid-50steps --force --no-plots

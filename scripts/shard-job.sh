@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One piece of a sharded sweep (README, "Sharded sweeps"): the job that slurm-sweep.sh submits
+# One piece of a sharded sweep (book/src/commands/merge.md): the job that slurm-sweep.sh submits
 # and parallel-sweep.sh runs for every shard, kept in one file so that both follow one rule.
 # Not usually called by hand, but it can be, e.g. to run one shard again.
 #

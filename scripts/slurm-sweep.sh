@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Runs a bench-sph sweep on a Slurm cluster as K shards, one array task and one whole node per
-# shard, then a job that merges the shards and draws the report (README, "Sharded sweeps").
+# shard, then a job that merges the shards and draws the report (book/src/commands/merge.md).
 # Run it on the login node, in a clone on a filesystem the compute nodes share (home,
 # scratch), after `cargo build --release`.
 #

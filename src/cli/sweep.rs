@@ -15,7 +15,7 @@ use crate::sweep::schedule::Schedule;
 use crate::sweep::{Request, Target};
 use crate::topology::Pin;
 
-/// `--quick`: chunks, steps and trials of the README's first command.
+/// `--quick`: chunks, steps and trials of the README's quickstart.
 const QUICK_CHUNKS: &str = "10,45,90";
 /// See [`QUICK_CHUNKS`].
 const QUICK_STEPS: usize = 300;

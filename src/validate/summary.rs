@@ -6,7 +6,7 @@ use serde::Serialize;
 use super::Validation;
 use super::verdict::{Check, FRONT_SHIFT, FRONT_WINDOW, PointCheck, SLOPE_WINDOW, Slopes, Verdict};
 
-/// The shift, and why, in one sentence (printed and in the README).
+/// The shift, and why, in one sentence (printed, and in the book's validation page).
 pub const SHIFT_NOTE: &str = "the experiment's early front lags (the gate takes time to \
     remove) while converged SPH leads by dT = 0.2-0.25, so, as Lethe's validation does, the \
     simulated front is shifted right by T = 0.175 before positions are compared";

@@ -1,5 +1,5 @@
-//! The constants of one step, per preset (`../../SOLVER.md` in the design notes; see the
-//! README's "Physics" section). Units: pixels (px), seconds (s), mass units (mu).
+//! The constants of one step, per preset (see the book's "Physics" page,
+//! book/src/physics.md). Units: pixels (px), seconds (s), mass units (mu).
 
 use glam::DVec2;
 use serde::Serialize;

@@ -1,5 +1,6 @@
 //! The constants of the weakly compressible dam break, in SI units (m, s, kg), from its
-//! resolution (see the README's "Physics" section and the module docs of [`super`]).
+//! resolution (see the book's "Physics" page, book/src/physics.md, and the module docs of
+//! [`super`]).
 
 use glam::DVec2;
 use std::f64::consts::PI;
