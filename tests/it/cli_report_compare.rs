@@ -10,8 +10,8 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
-use common::{assert_holds_all, fails_with, fake_sweep, line_containing, names, run, text};
+use crate::common;
+use crate::common::{assert_holds_all, fails_with, fake_sweep, line_containing, names, run, text};
 
 const WIDTH: u32 = 1000;
 const HEIGHT: u32 = 650;

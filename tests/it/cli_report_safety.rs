@@ -5,8 +5,9 @@
 use std::path::Path;
 use std::process::Output;
 
-mod common;
-use common::{assert_file_holds, fake_sweep, line_containing, run, scratch, sweep_into, text};
+use crate::common::{
+    assert_file_holds, fake_sweep, line_containing, run, scratch, sweep_into, text,
+};
 
 /// A small finished sweep under fake times: seq, rayon-chunks and rayon-iter at 1 and 2 cores,
 /// N = `n` (a list).

@@ -6,8 +6,7 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Child, Command, Output, Stdio};
 
-mod common;
-use common::{
+use crate::common::{
     assert_file_holds, assert_interrupted, bench_sph, fake_sweep, no_panic, num, rows, run,
     scratch, start, sweep_command, sweep_into, text, wait_until,
 };

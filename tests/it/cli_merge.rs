@@ -3,13 +3,11 @@
 //! spoil the timings), merged, give exactly the unsharded plan's cells and trials; and every
 //! refusal of the merge. Timings are the hidden `--fake-timings`, so nothing here is timed.
 
-mod common;
-
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, MutexGuard};
 
-use common::*;
+use crate::common::*;
 
 /// 1 group: seq, rayon-chunks at 1..2 cores × chunks 2,4 and std-static at 1..2 cores: 7
 /// cells, 6 of them dealt to shards; no confirmation (a shard has none, and the unsharded

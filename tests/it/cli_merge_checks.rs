@@ -7,13 +7,11 @@
 //! on this 2-core machine that would spoil the timings), timed by the hidden
 //! `--fake-timings`, so nothing here is timed.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 use std::process::Output;
 use std::sync::{Mutex, MutexGuard};
 
-use common::*;
+use crate::common::*;
 
 /// 1 group: seq, rayon-chunks at 1..2 cores × chunks 2,4 and std-static at 1..2 cores: 7
 /// cells; shard 2/3 holds seq, rayon-chunks at 1 core and 4 chunks, and std-static at 1 core.

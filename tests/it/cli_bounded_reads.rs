@@ -7,8 +7,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 use std::sync::{Mutex, MutexGuard};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// Makes `path` a FIFO; false where `mkfifo` is missing (the test then has nothing to check).
 fn mkfifo(path: &Path) -> bool {

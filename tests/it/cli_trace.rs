@@ -13,8 +13,7 @@ use std::process::Output;
 use serde_json::Value;
 use sph_strategies::StrategyName;
 
-mod common;
-use common::{
+use crate::common::{
     DIVERGING_INIT, assert_file_holds, fails_with, line_containing, names, run, scratch, stderr,
     stdout,
 };

@@ -8,8 +8,8 @@ use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::Duration;
 
-mod common;
-use common::{
+use crate::common;
+use crate::common::{
     Row, assert_file_holds, assert_holds_all, bench_sph, fails_with, num, poll_until, rows, run,
     scratch, start, stderr, stdout, sweep_into, wait_until,
 };

@@ -2,8 +2,6 @@
 //! `assert_cmd` (whose failures show the command, its exit and both streams), with
 //! `predicates` for what standard error must hold.
 
-#![allow(dead_code)] // each test file uses its own subset
-
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};

@@ -8,8 +8,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::{Mutex, MutexGuard};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// Waits until `dir`'s lock file says `running` holds it for `command`.
 fn wait_for_lock(dir: &Path, command: &str, running: &Running) {

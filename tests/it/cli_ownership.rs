@@ -7,8 +7,7 @@
 use std::path::Path;
 use std::sync::{Mutex, MutexGuard};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// Writes a real PNG of `width` × `height` pixels (the size of a report's charts is 1000 ×
 /// 650): what the old guess took for a chart.

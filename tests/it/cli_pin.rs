@@ -4,9 +4,7 @@
 //! placement name is a clear error. (This 2-core machine has no SMT: the SMT cases are tested
 //! on injected topologies in `src/topology`.)
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 fn simulate_json(extra: &[&str]) -> serde_json::Value {
     let mut args = vec!["simulate", "--n", "200", "--steps", "10", "--json"];
