@@ -5,7 +5,8 @@
 //! The fixtures stay in `tests/fixtures/`, found from `CARGO_MANIFEST_DIR`.
 //!
 //! All modules' tests share one process and its test threads (as many as the machine has
-//! cores, as before for one file's tests).
+//! cores, as before for one file's tests); tests that run shards one after another take
+//! `common::alone()`, one lock for all modules.
 
 mod common;
 
