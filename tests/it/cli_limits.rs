@@ -2,8 +2,7 @@
 //! line is parsed: a value beyond it is a clear error with a non-zero exit, before any thread
 //! is started or any memory allocated — never an abort, a panic or a hang.
 
-mod common;
-use common::fails_with_in;
+use crate::common::fails_with_in;
 
 /// Runs `args` in an empty directory and expects a failure naming `needle`, with nothing
 /// written.

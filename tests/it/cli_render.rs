@@ -4,8 +4,7 @@
 
 use std::path::Path;
 
-mod common;
-use common::{
+use crate::common::{
     DIVERGING_INIT, assert_file_holds, bench_sph, fails_with_in, names, run_in, stderr, succeeds,
     wait_until,
 };

@@ -8,10 +8,10 @@ use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::Duration;
 
-mod common;
-use common::{
-    Row, assert_file_holds, assert_holds_all, bench_sph, fails_with, num, poll_until, rows, run,
-    scratch, start, stderr, stdout, sweep_into, wait_until,
+use crate::common;
+use crate::common::{
+    Row, assert_file_holds, assert_holds_all, bench_sph, fails_with, num, poll_until, read_json,
+    rows, run, scratch, start, stderr, stdout, sweep_into, wait_until,
 };
 
 const TRIAL_HEADER: &str = "strategy,neighbors,preset,n,steps,cores,chunks,particles_per_chunk,\
@@ -213,8 +213,7 @@ fn a_tiny_sweep_writes_trials_summary_and_meta_with_the_documented_columns() {
             .all(|t| num(t, "wall_s") > 0.0 && num(t, "cpu_s") >= 0.0)
     );
 
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap();
+    let meta = read_json(&dir.join("meta.json"));
     for field in ["cpu_model", "hardware_threads", "os", "kernel"] {
         assert!(
             !meta["machine"][field].is_null(),
@@ -520,8 +519,7 @@ fn a_sweep_stopped_midway_and_resumed_ends_with_exactly_one_row_per_run() {
             "{file}"
         );
     }
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap();
+    let meta = read_json(&dir.join("meta.json"));
     assert_eq!(meta["status"], "complete");
     assert_eq!(meta["sessions"].as_array().unwrap().len(), 2);
     assert_eq!(meta["sessions"][1]["cells_run"], TINY_CELLS);
@@ -603,8 +601,7 @@ fn a_busy_machine_can_be_waited_for_and_its_contended_groups_measured_again() {
         stdout(&o)
     );
     assert_one_row_per_trial(&dir, 2, 3);
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap();
+    let meta = read_json(&dir.join("meta.json"));
     assert_eq!(meta["sessions"][1]["cells_run"], 3);
     // --remeasure-contended belongs to --resume.
     fails_with(

@@ -7,56 +7,17 @@
 //! on this 2-core machine that would spoil the timings), timed by the hidden
 //! `--fake-timings`, so nothing here is timed.
 
-mod common;
-
 use std::path::{Path, PathBuf};
-use std::process::Output;
-use std::sync::{Mutex, MutexGuard};
 
-use common::*;
+use crate::common::*;
 
-/// 1 group: seq, rayon-chunks at 1..2 cores × chunks 2,4 and std-static at 1..2 cores: 7
-/// cells; shard 2/3 holds seq, rayon-chunks at 1 core and 4 chunks, and std-static at 1 core.
-const PLAN: &str = "--n 60 --steps 3 --trials 2 --warmup 0 --cores 1..2 --chunks 2,4 \
-                    --strategies rayon-chunks,std-static --confirm-rounds 0 \
-                    --fake-timings 1,1.1,0.9 --no-plots";
-
-/// The group of [`PLAN`], as messages name it.
+/// The group of [`SHARDED_PLAN`], as messages name it.
 const GROUP: &str = "preset seed, all-pairs, N = 60, 3 steps";
 
-/// Held by every test that runs sweeps, for its whole run: the tests of one file run on
-/// parallel threads.
-static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
-
-fn alone() -> MutexGuard<'static, ()> {
-    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-fn sweep(dir: &Path, extra: &str) -> Output {
-    let o = sweep_into(dir, &format!("{PLAN} {extra}"));
-    assert!(o.status.success(), "{}", stderr(&o));
-    o
-}
-
-/// Shards 1/3, 2/3 and 3/3 of [`PLAN`] under `root`, run one after another.
+/// [`three_shards`] under `root`, alone.
 fn shards(root: &Path) -> Vec<PathBuf> {
     let _alone = alone();
-    (1..=3)
-        .map(|i| {
-            let dir = root.join(format!("shard-{i}"));
-            sweep(&dir, &format!("--shard {i}/3"));
-            dir
-        })
-        .collect()
-}
-
-fn merge(dirs: &[PathBuf], out: &Path, extra: &[&str]) -> Output {
-    let mut args: Vec<String> = vec!["merge".into()];
-    args.extend(dirs.iter().map(|d| d.display().to_string()));
-    args.extend(["--out".into(), out.display().to_string()]);
-    args.extend(extra.iter().map(|s| s.to_string()));
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    run(&args)
+    three_shards(root)
 }
 
 /// Asserts that a message shows no Rust debug text of an `Option`.
@@ -179,17 +140,7 @@ fn edit(dir: &Path, file: &str, cell: &Key, edit: impl FnOnce(&mut Csv, &[usize]
 }
 
 /// Copies a results directory (its files only).
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let e = e.unwrap();
-        if e.path().is_file() {
-            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
-        }
-    }
-}
-
-/// Three fresh shards of [`PLAN`], shard 2's first rayon-chunks cell, and an output path.
+/// Three fresh shards of [`SHARDED_PLAN`], shard 2's first rayon-chunks cell, and an output path.
 struct Study {
     _tmp: tempfile::TempDir,
     parts: Vec<PathBuf>,
@@ -333,9 +284,7 @@ fn with_allow_partial_the_cells_of_a_shard_without_its_seq_have_no_speedup_and_s
         three_seq["reason"].contains("wall_s = -0.5 is not a positive time"),
         "{three_seq:?}"
     );
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(study.out.join("meta.json")).unwrap())
-            .unwrap();
+    let meta = read_json(&study.out.join("meta.json"));
     assert_eq!(meta["status"], "partial");
     assert_eq!(
         meta["merge"]["without_reference"].as_array().unwrap().len(),
@@ -587,8 +536,7 @@ fn merge_refuses_an_edited_planned_cells() {
 /// Sets `key` of `dir/meta.json`'s top level (not its sessions').
 fn set_top_level(dir: &Path, key: &str, value: serde_json::Value) {
     let path = dir.join("meta.json");
-    let mut meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let mut meta = read_json(&path);
     meta[key] = value;
     std::fs::write(&path, serde_json::to_string_pretty(&meta).unwrap()).unwrap();
 }
@@ -617,7 +565,7 @@ fn shards_of_different_splits_are_named_as_such_not_as_a_repeat() {
     let half = study.out.parent().unwrap().join("half");
     {
         let _alone = alone();
-        sweep(&half, "--shard 2/2");
+        sweep_plan(&half, "--shard 2/2");
     }
     let err = merge_refused(
         &[study.parts[1].clone(), half],
@@ -636,7 +584,7 @@ fn a_one_part_shard_says_it_holds_the_whole_plan() {
     let dir = tmp.path().join("one");
     let o = {
         let _alone = alone();
-        sweep(&dir, "--shard 1/1")
+        sweep_plan(&dir, "--shard 1/1")
     };
     let out = stdout(&o);
     assert!(out.contains("shard 1/1 holds the whole plan"), "{out}");

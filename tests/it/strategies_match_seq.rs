@@ -18,7 +18,7 @@ use bench_sph::sph::params::Preset;
 use bench_sph::sph::state::{FIELD_NAMES, State};
 use sph_strategies::{Config, Executor, KernelPanic, Session, Split, StrategyName};
 
-mod common;
+use crate::common;
 
 const N: usize = 500;
 const STEPS: usize = 25;

@@ -4,8 +4,7 @@
 use std::fs::File;
 use std::process::Stdio;
 
-mod common;
-use common::{bench_sph, fails_with, fake_sweep, run, scratch, stderr};
+use crate::common::{bench_sph, fails_with, fake_sweep, run, scratch, stderr};
 
 /// Runs `args` with standard output on `/dev/full` (every write fails: no space left).
 fn to_a_full_device(args: &[&str]) -> std::process::Output {

@@ -5,8 +5,9 @@
 use std::path::Path;
 use std::process::Output;
 
-mod common;
-use common::{assert_file_holds, fake_sweep, line_containing, run, scratch, sweep_into, text};
+use crate::common::{
+    assert_file_holds, fake_sweep, line_containing, read_json, run, scratch, sweep_into, text,
+};
 
 /// A small finished sweep under fake times: seq, rayon-chunks and rayon-iter at 1 and 2 cores,
 /// N = `n` (a list).
@@ -171,8 +172,7 @@ fn charts_of_an_earlier_report_that_are_not_drawn_again_are_removed() {
     let stale = dir.join("seed-all-pairs-n999-s3-4-speedup.png");
     std::fs::copy(dir.join("seed-all-pairs-n60-s3-4-speedup.png"), &stale).unwrap();
     let record = dir.join("bench-sph-files.json");
-    let mut entries: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&record).unwrap()).unwrap();
+    let mut entries = read_json(&record);
     entries["files"]["seed-all-pairs-n999-s3-4-speedup.png"] = "report".into();
     std::fs::write(&record, entries.to_string()).unwrap();
     // A user's files that merely look like the report's by name are not its own.

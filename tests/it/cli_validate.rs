@@ -9,8 +9,7 @@ use std::path::Path;
 
 use serde_json::Value;
 
-mod common;
-use common::{
+use crate::common::{
     assert_holds_all, fails_with, names, no_panic, run, scratch, stderr, stdout, succeeds,
 };
 

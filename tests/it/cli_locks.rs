@@ -4,12 +4,10 @@
 
 use std::fs::File;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
-use std::sync::{Mutex, MutexGuard};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// Waits until `dir`'s lock file says `running` holds it for `command`.
 fn wait_for_lock(dir: &Path, command: &str, running: &Running) {
@@ -46,8 +44,7 @@ fn stop(running: Running) {
 
 /// A sweep of seq alone, long enough to be caught (it is killed).
 fn long_sweep(dir: &Path) -> Running {
-    let options = "--n 2000 --steps 1000 --trials 50 --cores 1 --strategies seq --no-plots";
-    started(sweep_command(dir, options))
+    started(sweep_command(dir, LONG_SWEEP))
 }
 
 /// A trace of seq over many steps, long enough to be caught (it is killed).
@@ -69,25 +66,6 @@ fn long_trace(dir: &Path) -> Running {
     started(cmd)
 }
 
-/// The tiny fake sweep's arguments into `dir`.
-fn tiny(dir: &Path) -> Vec<String> {
-    let mut args: Vec<String> = fake_sweep("seq,rayon-chunks", "1.0,1.1,0.9,0.5,0.55,0.6")
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
-    args.extend([
-        "--no-plots".into(),
-        "--out".into(),
-        dir.display().to_string(),
-    ]);
-    args
-}
-
-fn run_strings(args: &[String]) -> std::process::Output {
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    run(&args)
-}
-
 #[test]
 fn a_trace_and_a_sweep_cannot_write_one_directory_at_once() {
     let (_tmp, dir) = scratch("d");
@@ -95,7 +73,7 @@ fn a_trace_and_a_sweep_cannot_write_one_directory_at_once() {
     let trace = long_trace(&dir);
     wait_for_lock(&dir, "trace", &trace);
     let pid = trace.0.id();
-    let o = run_strings(&tiny(&dir));
+    let o = tiny_fake_sweep_into(&dir, &["--no-plots"]);
     stop(trace);
     assert!(!o.status.success());
     no_panic(&o);
@@ -138,7 +116,7 @@ fn a_trace_and_a_sweep_cannot_write_one_directory_at_once() {
 fn every_writer_is_refused_while_a_sweep_holds_the_directory() {
     let (tmp, dir) = scratch("d");
     let finished = tmp.path().join("finished");
-    let o = run_strings(&tiny(&finished));
+    let o = tiny_fake_sweep_into(&finished, &["--no-plots"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let sweep = long_sweep(&dir);
     wait_for_lock(&dir, "sweep", &sweep);
@@ -163,46 +141,6 @@ fn every_writer_is_refused_while_a_sweep_holds_the_directory() {
             "{args:?}: {err}"
         );
     }
-}
-
-/// Shards run one at a time (this 2-core machine), even across this file's tests.
-static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
-
-fn alone() -> MutexGuard<'static, ()> {
-    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-/// Two shards of a 3-cell plan, one after the other, under `root`.
-fn two_shards(root: &Path) -> Vec<PathBuf> {
-    (1..=2)
-        .map(|i| {
-            let dir = root.join(format!("shard-{i}"));
-            let o = sweep_into(
-                &dir,
-                &format!(
-                    "--n 60 --steps 3 --trials 2 --warmup 0 --cores 1..2 --chunks 2 \
-                     --strategies rayon-chunks --confirm-rounds 0 --fake-timings 1,1.1,0.9 \
-                     --no-plots --shard {i}/2"
-                ),
-            );
-            assert!(o.status.success(), "{}", stderr(&o));
-            dir
-        })
-        .collect()
-}
-
-fn merge_command(shards: &[PathBuf], out: &Path, extra: &[&str]) -> Command {
-    let mut cmd = bench_sph();
-    cmd.arg("merge")
-        .args(shards)
-        .arg("--out")
-        .arg(out)
-        .args(extra);
-    cmd
-}
-
-fn merge(shards: &[PathBuf], out: &Path, extra: &[&str]) -> std::process::Output {
-    merge_command(shards, out, extra).output().unwrap()
 }
 
 /// Every file under `dir` with its bytes and modification time.

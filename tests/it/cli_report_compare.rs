@@ -10,8 +10,10 @@
 
 use std::path::{Path, PathBuf};
 
-mod common;
-use common::{assert_holds_all, fails_with, fake_sweep, line_containing, names, run, text};
+use crate::common;
+use crate::common::{
+    assert_holds_all, fails_with, fake_sweep, line_containing, names, read_json, run, text,
+};
 
 const WIDTH: u32 = 1000;
 const HEIGHT: u32 = 650;
@@ -47,8 +49,7 @@ fn move_to_machine(dir: &Path, cpu: &str) {
 
 /// The label of the machine in `dir`'s meta.json, as the report names it.
 fn machine_label(dir: &Path) -> String {
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap();
+    let meta = read_json(&dir.join("meta.json"));
     let threads = meta["machine"]["hardware_threads"].as_u64().unwrap();
     format!(
         "{}, {threads} hardware thread{}",

@@ -2,11 +2,10 @@
 //! `assert_cmd` (whose failures show the command, its exit and both streams), with
 //! `predicates` for what standard error must hold.
 
-#![allow(dead_code)] // each test file uses its own subset
-
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
+use std::sync::{Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use assert_cmd::assert::Assert;
@@ -73,6 +72,122 @@ pub fn fake_sweep<'a>(strategies: &'a str, timings: &'a str) -> Vec<&'a str> {
             .collect();
     args.extend(["--strategies", strategies, "--fake-timings", timings]);
     args
+}
+
+/// The tiny sweep under fake times that tests of a results directory start from: seq and
+/// rayon-chunks on [`fake_sweep`]'s plan, 3 cells of 3 trials. Callers add `--out` and
+/// whatever else they test.
+pub fn tiny_fake_sweep() -> Vec<&'static str> {
+    fake_sweep("seq,rayon-chunks", "1.0,1.1,0.9,0.5,0.55,0.6")
+}
+
+/// Runs [`tiny_fake_sweep`] into `dir`, then `extra`, to the end, whatever its outcome.
+pub fn tiny_fake_sweep_into(dir: &Path, extra: &[&str]) -> Output {
+    run(&[
+        &tiny_fake_sweep()[..],
+        &["--out", dir.to_str().unwrap()],
+        extra,
+    ]
+    .concat())
+}
+
+/// A finished [`tiny_fake_sweep`] in `dir`, with `extra` (its report and charts unless
+/// `extra` says `--no-plots`); fails the test if the sweep fails.
+pub fn swept(dir: &Path, extra: &[&str]) {
+    let o = tiny_fake_sweep_into(dir, extra);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+/// The options of a sweep of seq alone that runs for minutes: long enough to be caught
+/// holding its directory (the tests that start it kill it).
+pub const LONG_SWEEP: &str =
+    "--n 2000 --steps 1000 --trials 50 --cores 1 --strategies seq --no-plots";
+
+/// Held by every test that runs shards (one sweep after another) for its whole run, so that
+/// no two such tests overlap: all the tests run on parallel threads of one process.
+static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
+
+/// Waits until no other test holds [`ONE_AT_A_TIME`], then holds it until the guard drops (a
+/// failed test's poison does not matter here).
+pub fn alone() -> MutexGuard<'static, ()> {
+    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Two shards of a 3-cell plan (seq and rayon-chunks at 1..2 cores, 2 chunks, under fake
+/// times), one after the other, under `root`; returns their directories.
+pub fn two_shards(root: &Path) -> Vec<PathBuf> {
+    (1..=2)
+        .map(|i| {
+            let dir = root.join(format!("shard-{i}"));
+            let o = sweep_into(
+                &dir,
+                &format!(
+                    "--n 60 --steps 3 --trials 2 --warmup 0 --cores 1..2 --chunks 2 \
+                     --strategies rayon-chunks --confirm-rounds 0 --fake-timings 1,1.1,0.9 \
+                     --no-plots --shard {i}/2"
+                ),
+            );
+            assert!(o.status.success(), "{}", stderr(&o));
+            dir
+        })
+        .collect()
+}
+
+/// The plan that the merge tests shard in three: 1 group: seq, rayon-chunks at 1..2 cores ×
+/// chunks 2,4 and std-static at 1..2 cores: 7 cells, 6 of them dealt to shards (shard 2/3
+/// holds seq, rayon-chunks at 1 core and 4 chunks, and std-static at 1 core); no
+/// confirmation (a shard has none, and an unsharded sweep compared with the merge must have
+/// the same plan).
+pub const SHARDED_PLAN: &str = "--n 60 --steps 3 --trials 2 --warmup 0 --cores 1..2 \
+                                --chunks 2,4 --strategies rayon-chunks,std-static \
+                                --confirm-rounds 0 --fake-timings 1,1.1,0.9 --no-plots";
+
+/// Runs a sweep of [`SHARDED_PLAN`] with `extra` into `dir`; fails the test if it fails.
+pub fn sweep_plan(dir: &Path, extra: &str) -> Output {
+    let o = sweep_into(dir, &format!("{SHARDED_PLAN} {extra}"));
+    assert!(o.status.success(), "{}", stderr(&o));
+    o
+}
+
+/// Shards 1/3, 2/3 and 3/3 of [`SHARDED_PLAN`], run one after another, under `root`;
+/// returns their directories. (Callers hold [`alone`].)
+pub fn three_shards(root: &Path) -> Vec<PathBuf> {
+    (1..=3)
+        .map(|i| {
+            let dir = root.join(format!("shard-{i}"));
+            sweep_plan(&dir, &format!("--shard {i}/3"));
+            dir
+        })
+        .collect()
+}
+
+/// `bench-sph merge` of `dirs` into `out`, then `extra`, ready to run or start.
+pub fn merge_command(dirs: &[PathBuf], out: &Path, extra: &[&str]) -> Command {
+    let mut cmd = bench_sph();
+    cmd.arg("merge")
+        .args(dirs)
+        .arg("--out")
+        .arg(out)
+        .args(extra);
+    cmd
+}
+
+/// Runs [`merge_command`] to the end, whatever its outcome.
+pub fn merge(dirs: &[PathBuf], out: &Path, extra: &[&str]) -> Output {
+    merge_command(dirs, out, extra)
+        .output()
+        .expect("binary runs")
+}
+
+/// Copies the files of `from` (not its directories) into `to`, made if missing.
+pub fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        if e.path().is_file() {
+            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        }
+    }
 }
 
 /// Checks `ready` every `every` until it holds or `limit` has passed; says whether it held.
@@ -179,6 +294,13 @@ pub const DIVERGING_INIT: &str = "x,y,vx,vy\n500,500,0,1e308\n505,500,0,-1e308\n
 pub fn assert_file_holds(path: &Path, text: &str) {
     let held = std::fs::read_to_string(path).unwrap();
     assert_eq!(held, text, "{}", path.display());
+}
+
+/// The JSON document in the file at `path` (a `meta.json`, a `trace.json`, a record); fails
+/// the test if it is missing or not JSON.
+pub fn read_json(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap();
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
 /// bench-sph's bookkeeping in a directory it writes: the lock file and the record of the files
@@ -289,8 +411,7 @@ pub fn no_panic(o: &Output) {
 /// How tests make a sweep look measured on another machine or by another build.
 pub fn set_in_meta(dir: &Path, mut set: impl FnMut(&mut serde_json::Value)) {
     let path = dir.join("meta.json");
-    let mut meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let mut meta = read_json(&path);
     set(&mut meta);
     for s in meta["sessions"].as_array_mut().unwrap() {
         set(s);

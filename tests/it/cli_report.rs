@@ -11,8 +11,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-mod common;
-use common::{
+use crate::common::{
     assert_holds_all, fake_sweep, line_containing, png_size, run, scratch, sweep_into, text,
 };
 

@@ -4,9 +4,7 @@
 //! placement name is a clear error. (This 2-core machine has no SMT: the SMT cases are tested
 //! on injected topologies in `src/topology`.)
 
-mod common;
-
-use common::*;
+use crate::common::*;
 
 fn simulate_json(extra: &[&str]) -> serde_json::Value {
     let mut args = vec!["simulate", "--n", "200", "--steps", "10", "--json"];
@@ -80,8 +78,7 @@ fn a_trace_records_its_placement() {
         out,
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap();
+    let meta = read_json(&dir.join("meta.json"));
     assert_eq!(meta["pin"], "spread");
 }
 
@@ -130,8 +127,7 @@ fn a_sweep_over_placements_has_one_cell_per_pin_and_marks_smt_from_the_recorded_
         4 * 3
     );
 
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap();
+    let meta = read_json(&dir.join("meta.json"));
     assert_eq!(meta["params"]["pin"], serde_json::json!(["none", "spread"]));
     let topology = &meta["machine"]["topology"];
     let logical = topology["logical_cpus"].as_u64().unwrap();

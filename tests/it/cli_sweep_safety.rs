@@ -4,29 +4,19 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Child, Command, Stdio};
 
-mod common;
-use common::{
-    assert_file_holds, assert_interrupted, bench_sph, fake_sweep, no_panic, num, rows, run,
-    scratch, start, sweep_command, sweep_into, text, wait_until,
+use crate::common::{
+    LONG_SWEEP, assert_file_holds, assert_interrupted, bench_sph, no_panic, num, rows, run,
+    scratch, start, sweep_command, sweep_into, text, tiny_fake_sweep, tiny_fake_sweep_into,
+    wait_until,
 };
-
-/// A tiny sweep of seq and rayon-chunks under fake times.
-fn tiny_args() -> Vec<&'static str> {
-    fake_sweep("seq,rayon-chunks", "1.0,1.1,0.9,0.5,0.55,0.6")
-}
-
-/// Runs the tiny sweep into `dir`, then `extra`.
-fn tiny(dir: &Path, extra: &[&str]) -> Output {
-    run(&[&tiny_args()[..], &["--out", dir.to_str().unwrap()], extra].concat())
-}
 
 /// The tiny sweep without charts into `out` (with none, into a new directory under `results/`
 /// of its working directory), as a command whose streams the caller sets.
 fn tiny_without_plots(out: Option<&Path>) -> Command {
     let mut cmd = bench_sph();
-    cmd.args(tiny_args()).arg("--no-plots");
+    cmd.args(tiny_fake_sweep()).arg("--no-plots");
     if let Some(dir) = out {
         cmd.arg("--out").arg(dir);
     }
@@ -36,7 +26,7 @@ fn tiny_without_plots(out: Option<&Path>) -> Command {
 #[test]
 fn fake_contention_marks_cells_contended_and_warns_in_the_output_and_the_report() {
     let (_tmp, dir) = scratch("r");
-    let o = tiny(&dir, &["--fake-contention", "0.5"]);
+    let o = tiny_fake_sweep_into(&dir, &["--fake-contention", "0.5"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     let err = text(&o.stderr);
     assert!(err.contains("cores busy with other work"), "{err}");
@@ -55,7 +45,7 @@ fn fake_contention_marks_cells_contended_and_warns_in_the_output_and_the_report(
 #[test]
 fn a_quiet_fake_machine_gives_no_contended_cell_and_intervals_around_the_mean() {
     let (_tmp, dir) = scratch("r");
-    let o = tiny(&dir, &["--no-plots"]);
+    let o = tiny_fake_sweep_into(&dir, &["--no-plots"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(!text(&o.stderr).contains("busy with other work"));
     for r in rows(&dir.join("summary.csv")) {
@@ -122,8 +112,7 @@ fn a_sweep_beside_busy_processes_measures_their_cpu_and_marks_its_cells_contende
 /// Starts a sweep that runs long enough to be caught holding its directory's lock, and waits
 /// until it holds it.
 fn long_sweep(dir: &Path) -> Child {
-    let options = "--n 2000 --steps 1000 --trials 50 --cores 1 --strategies seq --no-plots";
-    let child = sweep_command(dir, options)
+    let child = sweep_command(dir, LONG_SWEEP)
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
@@ -142,7 +131,7 @@ fn a_second_sweep_on_a_directory_in_use_is_refused_naming_the_holders_pid() {
     let mut first = long_sweep(&dir);
     let pid = first.id().to_string();
     let o = run(&["sweep", "--resume", dir.to_str().unwrap()]);
-    let o2 = tiny(&dir, &["--force"]);
+    let o2 = tiny_fake_sweep_into(&dir, &["--force"]);
     first.kill().unwrap();
     first.wait().unwrap();
     for o in [o, o2] {
@@ -286,7 +275,7 @@ fn the_plan_of_a_huge_all_pairs_sweep_is_printed_before_any_long_run() {
 #[test]
 fn resume_rechecks_its_meta_json_and_reruns_corrupt_or_short_cells() {
     let (_tmp, dir) = scratch("r");
-    assert!(tiny(&dir, &["--no-plots"]).status.success());
+    assert!(tiny_fake_sweep_into(&dir, &["--no-plots"]).status.success());
     let d = dir.to_str().unwrap();
     let meta_path = dir.join("meta.json");
     let meta = std::fs::read_to_string(&meta_path).unwrap();
@@ -355,10 +344,10 @@ fn grid_rows(path: &Path) -> usize {
 #[test]
 fn force_replaces_a_sweeps_earlier_report_and_keeps_foreign_files() {
     let (tmp, dir) = scratch("r");
-    assert!(tiny(&dir, &[]).status.success());
+    assert!(tiny_fake_sweep_into(&dir, &[]).status.success());
     assert!(dir.join("REPORT.md").is_file());
     std::fs::write(dir.join("notes.txt"), "mine").unwrap();
-    let o = tiny(&dir, &["--force", "--no-plots"]);
+    let o = tiny_fake_sweep_into(&dir, &["--force", "--no-plots"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
     assert!(
         !dir.join("REPORT.md").exists(),
@@ -381,14 +370,14 @@ fn force_replaces_a_sweeps_earlier_report_and_keeps_foreign_files() {
     let other = tmp.path().join("other");
     std::fs::create_dir(&other).unwrap();
     std::fs::write(other.join("meta.json"), "{\"tool\": \"bench-sph trace\"}").unwrap();
-    let o = tiny(&other, &["--no-plots"]);
+    let o = tiny_fake_sweep_into(&other, &["--no-plots"]);
     assert!(!o.status.success());
     assert!(
         text(&o.stderr).contains("'meta.json'"),
         "{}",
         text(&o.stderr)
     );
-    let o = tiny(&other, &["--force", "--no-plots"]);
+    let o = tiny_fake_sweep_into(&other, &["--force", "--no-plots"]);
     assert!(!o.status.success());
     assert!(text(&o.stderr).contains("was not written by bench-sph sweep"));
     assert!(

@@ -13,10 +13,9 @@ use std::process::Output;
 use serde_json::Value;
 use sph_strategies::StrategyName;
 
-mod common;
-use common::{
-    DIVERGING_INIT, assert_file_holds, fails_with, line_containing, names, run, scratch, stderr,
-    stdout,
+use crate::common::{
+    DIVERGING_INIT, assert_file_holds, fails_with, line_containing, names, read_json, run, scratch,
+    stderr, stdout,
 };
 
 const N: usize = 200;
@@ -236,9 +235,7 @@ fn with_the_grid_the_rebuild_s_kernel_calls_are_traced_beside_the_passes() {
         assert!(o.status.success(), "{strategy}: {}", stderr(&o));
         let events = check_trace_json(strategy, &dir);
         check_stats_csv(strategy, &dir, events, true);
-        let json: Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("trace.json")).unwrap())
-                .unwrap();
+        let json = read_json(&dir.join("trace.json"));
         let rebuilds = kernels(&json, &["rebuild"]);
         assert!(!rebuilds.is_empty(), "{strategy}");
         assert!(rebuilds.iter().all(|e| e.pass == "grid rebuild"));
@@ -250,9 +247,7 @@ fn a_traced_run_ends_in_the_same_state_as_simulate() {
     let tmp = tempfile::tempdir().unwrap();
     let o = trace(StrategyName::RayonChunks, tmp.path(), &[]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let meta: Value =
-        serde_json::from_str(&std::fs::read_to_string(tmp.path().join("meta.json")).unwrap())
-            .unwrap();
+    let meta = read_json(&tmp.path().join("meta.json"));
     let s = run(&[
         "simulate",
         "--n",
@@ -290,9 +285,7 @@ fn the_timeline_can_show_only_the_last_steps() {
     let tmp = tempfile::tempdir().unwrap();
     let o = trace(StrategyName::Seq, tmp.path(), &["--timeline-steps", "1"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let meta: Value =
-        serde_json::from_str(&std::fs::read_to_string(tmp.path().join("meta.json")).unwrap())
-            .unwrap();
+    let meta = read_json(&tmp.path().join("meta.json"));
     assert_eq!(meta["timeline_steps"], serde_json::json!([2, 2]));
 }
 
@@ -392,7 +385,7 @@ fn finished_sweep(dir: &Path) {
 }
 
 fn meta(dir: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap()
+    read_json(&dir.join("meta.json"))
 }
 
 #[test]

@@ -3,53 +3,10 @@
 //! spoil the timings), merged, give exactly the unsharded plan's cells and trials; and every
 //! refusal of the merge. Timings are the hidden `--fake-timings`, so nothing here is timed.
 
-mod common;
-
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, MutexGuard};
 
-use common::*;
-
-/// 1 group: seq, rayon-chunks at 1..2 cores × chunks 2,4 and std-static at 1..2 cores: 7
-/// cells, 6 of them dealt to shards; no confirmation (a shard has none, and the unsharded
-/// sweep compared with the merge must have the same plan).
-const PLAN: &str = "--n 60 --steps 3 --trials 2 --warmup 0 --cores 1..2 --chunks 2,4 \
-                    --strategies rayon-chunks,std-static --confirm-rounds 0 \
-                    --fake-timings 1,1.1,0.9 --no-plots";
-
-/// Held by every test for its whole run: the tests of one file run on parallel threads.
-static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
-
-/// Waits for the other tests' shards to finish (a failed test's poison does not matter here).
-fn alone() -> MutexGuard<'static, ()> {
-    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-fn sweep(dir: &Path, extra: &str) {
-    let o = sweep_into(dir, &format!("{PLAN} {extra}"));
-    assert!(o.status.success(), "{}", stderr(&o));
-}
-
-/// Shards 1/3, 2/3 and 3/3 of [`PLAN`], run one after another, under `root`.
-fn shards(root: &Path) -> Vec<PathBuf> {
-    (1..=3)
-        .map(|i| {
-            let dir = root.join(format!("shard-{i}"));
-            sweep(&dir, &format!("--shard {i}/3"));
-            dir
-        })
-        .collect()
-}
-
-fn merge(dirs: &[PathBuf], out: &Path, extra: &[&str]) -> std::process::Output {
-    let mut args: Vec<String> = vec!["merge".into()];
-    args.extend(dirs.iter().map(|d| d.display().to_string()));
-    args.extend(["--out".into(), out.display().to_string()]);
-    args.extend(extra.iter().map(|s| s.to_string()));
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    run(&args)
-}
+use crate::common::*;
 
 fn merge_fails(dirs: &[PathBuf], out: &Path, needles: &[&str]) {
     let o = merge(dirs, out, &[]);
@@ -74,21 +31,13 @@ fn trials_per_cell(dir: &Path) -> BTreeMap<String, usize> {
     cells
 }
 
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for e in std::fs::read_dir(from).unwrap() {
-        let e = e.unwrap();
-        std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
-    }
-}
-
 #[test]
 fn three_shards_run_one_after_another_merge_into_exactly_the_unsharded_plans_cells_and_trials() {
     let _alone = alone();
     let tmp = tempfile::tempdir().unwrap();
     let whole = tmp.path().join("whole");
-    sweep(&whole, "");
-    let parts = shards(tmp.path());
+    sweep_plan(&whole, "");
+    let parts = three_shards(tmp.path());
     let merged = tmp.path().join("merged");
     let o = merge(&parts, &merged, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -129,8 +78,7 @@ fn three_shards_run_one_after_another_merge_into_exactly_the_unsharded_plans_cel
     assert!(meta["params"].get("shard").is_none());
     assert_eq!(meta["merge"]["shards"].as_array().unwrap().len(), 3);
     assert_eq!(meta["sessions"].as_array().unwrap().len(), 3);
-    let whole_meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(whole.join("meta.json")).unwrap()).unwrap();
+    let whole_meta = read_json(&whole.join("meta.json"));
     assert_eq!(meta["plan_fingerprint"], whole_meta["plan_fingerprint"]);
 
     let report = succeeds(tmp.path(), &["report", merged.to_str().unwrap()]);
@@ -145,7 +93,7 @@ fn a_shard_records_its_part_and_the_plans_fingerprint_and_draws_no_charts() {
     let _alone = alone();
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("s");
-    let o = sweep_into(&dir, &format!("{PLAN} --shard 2/3"));
+    let o = sweep_into(&dir, &format!("{SHARDED_PLAN} --shard 2/3"));
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("shard 2/3 of plan "), "{}", stdout(&o));
     assert!(
@@ -158,8 +106,7 @@ fn a_shard_records_its_part_and_the_plans_fingerprint_and_draws_no_charts() {
         "{}",
         stdout(&o)
     );
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("meta.json")).unwrap()).unwrap();
+    let meta = read_json(&dir.join("meta.json"));
     assert_eq!(meta["params"]["shard"]["index"], 2);
     assert_eq!(meta["params"]["shard"]["count"], 3);
     assert_eq!(meta["plan_fingerprint"].as_str().unwrap().len(), 16);
@@ -176,12 +123,12 @@ fn a_shard_records_its_part_and_the_plans_fingerprint_and_draws_no_charts() {
 fn a_shard_that_would_be_empty_or_a_malformed_shard_is_refused() {
     let _alone = alone();
     let (_tmp, dir) = scratch("s");
-    let mut cmd = sweep_command(&dir, &format!("{PLAN} --shard 7/7"));
+    let mut cmd = sweep_command(&dir, &format!("{SHARDED_PLAN} --shard 7/7"));
     cmd.env("NO_COLOR", "1");
     expect_failure(cmd, &["Error: ", "--shard 7/7", "at most 6 shards"]);
     assert!(!dir.join("summary.csv").exists());
     for bad in ["0/3", "4/3", "x"] {
-        let cmd = sweep_command(&dir, &format!("{PLAN} --shard {bad}"));
+        let cmd = sweep_command(&dir, &format!("{SHARDED_PLAN} --shard {bad}"));
         expect_failure(cmd, &["--shard", "expected I/K"]);
     }
 }
@@ -190,7 +137,7 @@ fn a_shard_that_would_be_empty_or_a_malformed_shard_is_refused() {
 fn merging_refuses_missing_cells_unless_partial_and_then_the_report_says_so() {
     let _alone = alone();
     let tmp = tempfile::tempdir().unwrap();
-    let parts = shards(tmp.path());
+    let parts = three_shards(tmp.path());
     let out = tmp.path().join("merged");
     let two = [parts[0].clone(), parts[2].clone()];
     merge_fails(
@@ -226,7 +173,7 @@ fn merging_refuses_missing_cells_unless_partial_and_then_the_report_says_so() {
 fn merging_refuses_repeats_other_plans_other_splits_and_directories_that_are_not_shards() {
     let _alone = alone();
     let tmp = tempfile::tempdir().unwrap();
-    let parts = shards(tmp.path());
+    let parts = three_shards(tmp.path());
     let out = tmp.path().join("merged");
 
     let again = tmp.path().join("again");
@@ -235,18 +182,18 @@ fn merging_refuses_repeats_other_plans_other_splits_and_directories_that_are_not
     merge_fails(&repeated, &out, &["shard 1/3 is given twice"]);
 
     let other = tmp.path().join("other-plan");
-    let o = sweep_into(&other, &format!("{PLAN} --shard 2/3 --seed 7"));
+    let o = sweep_into(&other, &format!("{SHARDED_PLAN} --shard 2/3 --seed 7"));
     assert!(o.status.success(), "{}", stderr(&o));
     let mixed = [parts[0].clone(), other, parts[2].clone()];
     merge_fails(&mixed, &out, &["different plans"]);
 
     let halves = tmp.path().join("half");
-    let o = sweep_into(&halves, &format!("{PLAN} --shard 2/2"));
+    let o = sweep_into(&halves, &format!("{SHARDED_PLAN} --shard 2/2"));
     assert!(o.status.success(), "{}", stderr(&o));
     merge_fails(&[parts[0].clone(), halves], &out, &["different splits"]);
 
     let whole = tmp.path().join("whole");
-    sweep(&whole, "");
+    sweep_plan(&whole, "");
     merge_fails(&[whole], &out, &["is not a shard"]);
 
     let shard_one = std::fs::read(parts[0].join("summary.csv")).unwrap();
@@ -267,7 +214,7 @@ fn merging_refuses_repeats_other_plans_other_splits_and_directories_that_are_not
 fn merging_refuses_shards_from_another_machine_or_another_build() {
     let _alone = alone();
     let tmp = tempfile::tempdir().unwrap();
-    let parts = shards(tmp.path());
+    let parts = three_shards(tmp.path());
     let out = tmp.path().join("merged");
 
     let elsewhere = tmp.path().join("elsewhere");
@@ -293,7 +240,7 @@ fn merging_refuses_shards_from_another_machine_or_another_build() {
 fn a_merge_never_replaces_existing_results_without_force() {
     let _alone = alone();
     let tmp = tempfile::tempdir().unwrap();
-    let parts = shards(tmp.path());
+    let parts = three_shards(tmp.path());
     let out = tmp.path().join("merged");
     assert!(merge(&parts, &out, &[]).status.success());
     let before = std::fs::read(out.join("summary.csv")).unwrap();
@@ -323,12 +270,16 @@ fn parallel_sweep_without_hosts_runs_the_shards_one_after_another_then_merges_an
     let root = tmp.path().join("study");
     let mut cmd = script("parallel-sweep.sh");
     cmd.args(["-k", "3", "-o", root.to_str().unwrap(), "--"])
-        .args(PLAN.split_whitespace().filter(|&a| a != "--no-plots"));
+        .args(
+            SHARDED_PLAN
+                .split_whitespace()
+                .filter(|&a| a != "--no-plots"),
+        );
     let o = cmd.output().unwrap();
     assert!(o.status.success(), "{}\n{}", stdout(&o), stderr(&o));
     let merged = root.join("merged");
     let whole = tmp.path().join("whole");
-    sweep(&whole, "");
+    sweep_plan(&whole, "");
     assert_eq!(trials_per_cell(&merged), trials_per_cell(&whole));
     assert!(merged.join("REPORT.md").is_file());
     // Run again without -f or -r: refused, nothing replaced.
@@ -336,7 +287,7 @@ fn parallel_sweep_without_hosts_runs_the_shards_one_after_another_then_merges_an
     let mut again = script("parallel-sweep.sh");
     again
         .args(["-k", "3", "-o", root.to_str().unwrap(), "--"])
-        .args(PLAN.split_whitespace());
+        .args(SHARDED_PLAN.split_whitespace());
     let o = again.output().unwrap();
     assert!(!o.status.success());
     assert!(

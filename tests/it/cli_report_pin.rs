@@ -4,11 +4,11 @@
 //! (this test must not depend on the machine it runs on, and this 2-core one has no SMT).
 //! No test asserts a duration.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 
 /// The fake sweep's trials, three per cell, in the sweep's order: seq, then per strategy,
 /// per cores, `none` then `spread`. rayon-chunks: the same at 1 core, `spread` faster at 2

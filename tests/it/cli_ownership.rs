@@ -5,10 +5,8 @@
 //! writes one.
 
 use std::path::Path;
-use std::sync::{Mutex, MutexGuard};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// Writes a real PNG of `width` × `height` pixels (the size of a report's charts is 1000 ×
 /// 650): what the old guess took for a chart.
@@ -20,16 +18,6 @@ fn png(path: &Path, width: u32, height: u32) {
     writer
         .write_image_data(&vec![200; (width * height) as usize])
         .unwrap();
-}
-
-/// A finished tiny sweep under fake times into `dir`, with its report unless `extra` says
-/// `--no-plots`.
-fn swept(dir: &Path, extra: &[&str]) {
-    let mut args = fake_sweep("seq,rayon-chunks", "1.0,1.1,0.9,0.5,0.55,0.6");
-    args.extend(["--out", dir.to_str().unwrap()]);
-    args.extend(extra);
-    let o = run(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
 }
 
 /// Each file's bytes, to show they did not change.
@@ -202,40 +190,6 @@ fn a_trace_never_replaces_a_sweeps_meta_json_even_with_force() {
         !dir.join("trace.json").exists(),
         "nothing of the trace is written"
     );
-}
-
-/// Shards run one at a time (this 2-core machine), even across this file's tests.
-static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
-
-fn alone() -> MutexGuard<'static, ()> {
-    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-/// Two shards of a 3-cell plan, one after the other, under `root`; returns their directories.
-fn two_shards(root: &Path) -> Vec<std::path::PathBuf> {
-    (1..=2)
-        .map(|i| {
-            let dir = root.join(format!("shard-{i}"));
-            let o = sweep_into(
-                &dir,
-                &format!(
-                    "--n 60 --steps 3 --trials 2 --warmup 0 --cores 1..2 --chunks 2 \
-                     --strategies rayon-chunks --confirm-rounds 0 --fake-timings 1,1.1,0.9 \
-                     --no-plots --shard {i}/2"
-                ),
-            );
-            assert!(o.status.success(), "{}", stderr(&o));
-            dir
-        })
-        .collect()
-}
-
-fn merge(shards: &[std::path::PathBuf], out: &Path, extra: &[&str]) -> std::process::Output {
-    let mut args: Vec<&str> = vec!["merge"];
-    args.extend(shards.iter().map(|d| d.to_str().unwrap()));
-    args.extend(["--out", out.to_str().unwrap()]);
-    args.extend(extra);
-    run(&args)
 }
 
 #[test]

@@ -1,8 +1,7 @@
 //! `bench-sph speedup` driven through the built binary: a strategy and seq stepped in turn
 //! end with the bits of a plain run, the figures hang together, and bad input is an error.
 
-mod common;
-use common::{DIVERGING_INIT, fails_with, run, stderr, stdout};
+use crate::common::{DIVERGING_INIT, fails_with, run, stderr, stdout};
 
 fn json(args: &[&str]) -> serde_json::Value {
     let o = run(args);

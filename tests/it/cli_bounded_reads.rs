@@ -5,10 +5,8 @@
 
 use std::path::{Path, PathBuf};
 use std::process::Output;
-use std::sync::{Mutex, MutexGuard};
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// Makes `path` a FIFO; false where `mkfifo` is missing (the test then has nothing to check).
 fn mkfifo(path: &Path) -> bool {
@@ -38,18 +36,10 @@ fn refused(o: &Output, needles: &[&str]) {
     assert_holds_all("the refusal", &stderr(o), needles);
 }
 
-/// A finished tiny sweep under fake times, without charts.
-fn swept(dir: &Path) {
-    let mut args = fake_sweep("seq,rayon-chunks", "1.0,1.1,0.9,0.5,0.55,0.6");
-    args.extend(["--no-plots", "--out", dir.to_str().unwrap()]);
-    let o = run(&args);
-    assert!(o.status.success(), "{}", stderr(&o));
-}
-
 #[test]
 fn report_reading_dev_zero_as_summary_is_refused_at_once() {
     let (_tmp, dir) = scratch("r");
-    swept(&dir);
+    swept(&dir, &["--no-plots"]);
     let summary = dir.join("summary.csv");
     dev_zero(&summary);
     let o = bounded(&["report", dir.to_str().unwrap()]);
@@ -65,7 +55,7 @@ fn report_reading_dev_zero_as_summary_is_refused_at_once() {
 #[test]
 fn a_summary_larger_than_its_cap_is_refused_naming_the_cap() {
     let (_tmp, dir) = scratch("r");
-    swept(&dir);
+    swept(&dir, &["--no-plots"]);
     let summary = dir.join("summary.csv");
     // Sparse: it takes no disk, but says 1 GiB and a byte.
     std::fs::File::create(&summary)
@@ -85,7 +75,7 @@ fn a_summary_larger_than_its_cap_is_refused_naming_the_cap() {
 #[test]
 fn report_and_resume_refuse_meta_json_linked_to_dev_zero_at_once() {
     let (_tmp, dir) = scratch("r");
-    swept(&dir);
+    swept(&dir, &["--no-plots"]);
     let meta = dir.join("meta.json");
     dev_zero(&meta);
     let needle = format!("'{}' is a character device", meta.display());
@@ -97,7 +87,7 @@ fn report_and_resume_refuse_meta_json_linked_to_dev_zero_at_once() {
 #[test]
 fn report_refuses_trials_as_a_fifo_at_once() {
     let (_tmp, dir) = scratch("r");
-    swept(&dir);
+    swept(&dir, &["--no-plots"]);
     let trials = dir.join("trials.csv");
     std::fs::remove_file(&trials).unwrap();
     if !mkfifo(&trials) {
@@ -113,7 +103,7 @@ fn report_refuses_trials_as_a_fifo_at_once() {
 #[test]
 fn a_trace_whose_meta_json_is_a_fifo_is_skipped_not_waited_on() {
     let (tmp, dir) = scratch("r");
-    swept(&dir);
+    swept(&dir, &["--no-plots"]);
     let trace = dir.join("trace-seq");
     let o = run(&[
         "trace",
@@ -161,37 +151,9 @@ fn a_record_linked_to_dev_zero_is_refused_at_once() {
     assert!(!dir.join("trace.json").exists());
 }
 
-/// Shards run one at a time (this 2-core machine), even across this file's tests.
-static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
-
-fn alone() -> MutexGuard<'static, ()> {
-    ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-/// Two shards of a 3-cell plan, one after the other, under `root`.
-fn two_shards(root: &Path) -> Vec<PathBuf> {
-    (1..=2)
-        .map(|i| {
-            let dir = root.join(format!("shard-{i}"));
-            let o = sweep_into(
-                &dir,
-                &format!(
-                    "--n 60 --steps 3 --trials 2 --warmup 0 --cores 1..2 --chunks 2 \
-                     --strategies rayon-chunks --confirm-rounds 0 --fake-timings 1,1.1,0.9 \
-                     --no-plots --shard {i}/2"
-                ),
-            );
-            assert!(o.status.success(), "{}", stderr(&o));
-            dir
-        })
-        .collect()
-}
-
-fn merge(shards: &[PathBuf], out: &Path) -> Output {
-    let mut args: Vec<&str> = vec!["merge"];
-    args.extend(shards.iter().map(|d| d.to_str().unwrap()));
-    args.extend(["--out", out.to_str().unwrap()]);
-    bounded(&args)
+/// Merges `shards` into `out` within a minute.
+fn merge_within_a_minute(shards: &[PathBuf], out: &Path) -> Output {
+    output_within_a_minute(merge_command(shards, out, &[]))
 }
 
 #[test]
@@ -206,7 +168,7 @@ fn merge_refuses_a_fifo_at_once() {
     }
     let out = tmp.path().join("merged");
     refused(
-        &merge(&shards, &out),
+        &merge_within_a_minute(&shards, &out),
         &[&format!("'{}' is a FIFO (named pipe)", trials.display())],
     );
     assert!(!out.join("summary.csv").exists());
@@ -223,14 +185,14 @@ fn merge_refuses_a_shard_file_linked_to_dev_zero_at_once() {
         let kept = std::fs::read(&path).unwrap();
         dev_zero(&path);
         refused(
-            &merge(&shards, &out),
+            &merge_within_a_minute(&shards, &out),
             &[&format!("'{}' is a character device", path.display())],
         );
         std::fs::remove_file(&path).unwrap();
         std::fs::write(&path, kept).unwrap();
     }
     assert!(!out.join("summary.csv").exists());
-    let o = merge(&shards, &out);
+    let o = merge_within_a_minute(&shards, &out);
     assert!(o.status.success(), "{}", stderr(&o));
 }
 
@@ -247,7 +209,7 @@ fn merge_refuses_trials_larger_than_the_cap_naming_it() {
         .set_len((1 << 30) + 1)
         .unwrap();
     refused(
-        &merge(&shards, &tmp.path().join("merged")),
+        &merge_within_a_minute(&shards, &tmp.path().join("merged")),
         &[&format!(
             "'{}' is larger than 1 GiB, the most a trials.csv may be",
             trials.display()

@@ -5,8 +5,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
-mod common;
-use common::{
+use crate::common::{
     DIVERGING_INIT, assert_holds_all, bench_sph, fails_with, names, run, scratch, start, stderr,
     stdout, wait_until,
 };

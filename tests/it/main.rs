@@ -1,0 +1,35 @@
+//! The root package's integration tests, in one test binary: one binary links (thin LTO,
+//! one codegen unit under `--release`) once instead of once per file. Each file of this
+//! directory is a module, named as its test binary was (`cargo test --release --test it
+//! cli_sweep::` runs what `--test cli_sweep` ran); `common` holds the helpers they share.
+//! The fixtures stay in `tests/fixtures/`, found from `CARGO_MANIFEST_DIR`.
+//!
+//! All modules' tests share one process and its test threads (as many as the machine has
+//! cores, as before for one file's tests); tests that run shards one after another take
+//! `common::alone()`, one lock for all modules.
+
+mod common;
+
+mod cli_bounded_reads;
+mod cli_limits;
+mod cli_locks;
+mod cli_merge;
+mod cli_merge_checks;
+mod cli_messages;
+mod cli_ownership;
+mod cli_pin;
+mod cli_render;
+mod cli_report;
+mod cli_report_compare;
+mod cli_report_pin;
+mod cli_report_safety;
+mod cli_simulate;
+mod cli_speedup;
+mod cli_sweep;
+mod cli_sweep_safety;
+mod cli_trace;
+mod cli_validate;
+mod physics_step;
+mod solver_runs;
+mod strategies_match_seq;
+mod wcsph_physics;
