@@ -4,6 +4,11 @@
 //! cli_sweep::` runs what `--test cli_sweep` ran); `common` holds the helpers they share.
 //! The fixtures stay in `tests/fixtures/`, found from `CARGO_MANIFEST_DIR`.
 //!
+//! The binary needs the test hooks of bench-sph (`sweep --fake-timings`, ...), which exist
+//! only with the `testing` cargo feature: Cargo.toml makes it a required feature, so the
+//! README's `cargo test --release --workspace --all-features` runs it, and a plain `cargo test
+//! --test it` says which feature to add.
+//!
 //! All modules' tests share one process and its test threads (as many as the machine has
 //! cores, as before for one file's tests); tests that run shards one after another take
 //! `common::alone()`, one lock for all modules.
@@ -29,6 +34,8 @@ mod cli_sweep;
 mod cli_sweep_safety;
 mod cli_trace;
 mod cli_validate;
+mod docs_links;
+mod layers;
 mod physics_step;
 mod solver_runs;
 mod strategies_match_seq;
