@@ -7,7 +7,8 @@
 //! pure); [`charts`] draws
 //! them (one file per chart kind, [`charts::WIDTH`] × [`charts::HEIGHT`] PNGs in the bundled
 //! font); [`traces`] finds trace directories to embed; [`markdown`] writes the report's text
-//! (pure); [`paper`] holds the seed paper's published numbers.
+//! (pure), opening with [`answer`] (per group and core count, the fastest strategy as the
+//! group's findings decide it); [`paper`] holds the seed paper's published numbers.
 //!
 //! Charts, per group (preset, neighbours, N, steps):
 //! 1. runtime against chunks, one line per core count, each line's minimum crossed, each trial
@@ -36,6 +37,7 @@
 //! search) is not drawn; `REPORT.md` says so. Failed cells enter no chart or table; the report
 //! lists them with their reason.
 
+pub mod answer;
 pub mod charts;
 pub mod compare;
 pub mod findings;
