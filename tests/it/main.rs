@@ -25,6 +25,7 @@ mod cli_ownership;
 mod cli_pin;
 mod cli_render;
 mod cli_report;
+mod cli_report_answer;
 mod cli_report_compare;
 mod cli_report_pin;
 mod cli_report_safety;

@@ -2,13 +2,12 @@
 //! group and core count the strategy with the lowest mean, in bold only where the group's own
 //! findings call it fastest, "not resolved" where they find it not distinguishable, and for a
 //! group whose findings are withheld, the reason — all before the method and the machine
-//! table, under the banners that qualify every number. Driven through the built binary on sweeps timed by `--fake-timings` and on the
-//! committed fixture `tests/fixtures/report-results`.
+//! table, under the banners that qualify every number. Driven through the built binary on
+//! sweeps timed by `--fake-timings` and on the committed fixture `tests/fixtures/report-results`.
 
 use std::path::{Path, PathBuf};
 
-mod common;
-use common::{fake_sweep, run, scratch, text};
+use crate::common::{fake_sweep, run, scratch, text};
 
 fn fixture() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/report-results")
