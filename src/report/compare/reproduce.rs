@@ -181,6 +181,16 @@ pub fn markdown(reproduced: &[Reproduced], tags: &[&str]) -> String {
             0 => "none has an interval on both sides".to_owned(),
             n => format!("{k} of {n} ({})", percent(k as f64 / n as f64 * 100.0)),
         };
+        if r.cells == 0 {
+            let _ = writeln!(
+                md,
+                "## Reproducibility: {b} against {a}\n\n{a} and {b} ran on the same machine, but \
+                 no cell was measured on both (matched by cell and phase: preset, neighbour \
+                 search, N, steps, strategy, cores, chunks): they cannot say whether one \
+                 reproduces the other.\n"
+            );
+            continue;
+        }
         let reversed = r.changed.iter().filter(|c| c.reversed()).count();
         let _ = writeln!(
             md,
@@ -308,5 +318,20 @@ mod tests {
         other.meta.machine.cpu_model = "EPYC".to_owned();
         let s = [s[0].clone(), other];
         assert!(pairs(&sides(&s, SideRule::EachDirectory)).is_empty());
+    }
+
+    #[test]
+    fn two_runs_on_one_machine_that_share_no_cell_say_so_in_one_sentence() {
+        let a = sweep("a", &FAST, &SLOW);
+        let mut b = sweep("b", &FAST, &SLOW);
+        b.rows.iter_mut().for_each(|r| r.steps = 50);
+        b.trials.iter_mut().for_each(|t| t.steps = 50);
+        let s = [a, b];
+        let r = pairs(&sides(&s, SideRule::EachDirectory));
+        assert_eq!(r.len(), 1);
+        assert_eq!(r[0].cells, 0);
+        let md = markdown(&r, &["A", "B"]);
+        assert!(md.contains("no cell was measured on both"), "{md}");
+        assert!(!md.contains("none has an interval"), "{md}");
     }
 }
