@@ -167,7 +167,8 @@ pub struct Session {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Statistics {
     /// How the intervals were computed: `student-t` ([`crate::results::intervals`]: the
-    /// mean's on the times, the speedup's on the logarithms of the per-round ratios); absent
+    /// time's on the logarithms of the runs, the speedup's on the logarithms of the per-round
+    /// ratios, both exponentiated); absent
     /// in sweeps written before rounds, whose intervals came from the percentile bootstrap.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub intervals: Option<String>,
