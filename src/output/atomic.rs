@@ -1,16 +1,18 @@
-//! Files written whole or not at all: a temporary file `.NAME.PID.tmp` beside the
-//! destination, synced and renamed over it by [`AtomicFile::commit`]. An `AtomicFile` dropped
-//! without a commit (an error, a panic, an early return) removes its temporary file, and the
-//! destination keeps its earlier contents. A command stopped by a signal removes the
-//! temporary files it was writing ([`remove_live_temporaries`], from [`crate::signals`]), so
-//! an interrupted run leaves none behind either.
+//! Files written whole or not at all: a temporary file `.NAME.XXXXXX.tmp` beside the
+//! destination (`tempfile`'s [`NamedTempFile`], created with the permissions a plain
+//! `File::create` would give), synced and renamed over it by [`AtomicFile::commit`]
+//! (`persist`). An `AtomicFile` dropped without a commit (an error, a panic, an early return)
+//! removes its temporary file, and the destination keeps its earlier contents. A command
+//! stopped by a signal runs no destructor: it removes the temporary files it was writing
+//! ([`remove_live_temporaries`], from [`crate::signals`]), so an interrupted run leaves none
+//! behind either.
 
-use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, PoisonError};
 
 use anyhow::Context;
+use tempfile::NamedTempFile;
 
 /// The temporary files being written now, for [`remove_live_temporaries`].
 static LIVE: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
@@ -30,8 +32,8 @@ pub fn remove_live_temporaries() {
 /// The suffix of every temporary file (see [`is_temporary`]).
 pub const TMP_SUFFIX: &str = ".tmp";
 
-/// Whether a file name is one of [`AtomicFile`]'s temporary names (`.NAME.PID.tmp`): debris
-/// of a killed process, never a result.
+/// Whether a file name is one of [`AtomicFile`]'s temporary names (`.NAME.XXXXXX.tmp`):
+/// debris of a killed process, never a result.
 pub fn is_temporary(name: &str) -> bool {
     name.starts_with('.') && name.ends_with(TMP_SUFFIX)
 }
@@ -41,22 +43,29 @@ pub fn is_temporary(name: &str) -> bool {
 pub struct AtomicFile {
     dest: PathBuf,
     tmp: PathBuf,
-    out: Option<BufWriter<File>>,
+    out: Option<BufWriter<NamedTempFile>>,
 }
 
 impl AtomicFile {
     /// Starts writing `dest` (its directory must exist). Errors name `dest`.
     pub fn create(dest: &Path) -> anyhow::Result<AtomicFile> {
+        let context = || format!("cannot write '{}'", dest.display());
         let name = dest
             .file_name()
             .with_context(|| format!("cannot write '{}': not a file name", dest.display()))?;
-        let tmp = dest.with_file_name(format!(
-            ".{}.{}{TMP_SUFFIX}",
-            name.to_string_lossy(),
-            std::process::id()
-        ));
-        let file =
-            File::create(&tmp).with_context(|| format!("cannot write '{}'", dest.display()))?;
+        let dir = match dest.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p,
+            _ => Path::new("."),
+        };
+        let mut builder = tempfile::Builder::new();
+        let prefix = format!(".{}.", name.to_string_lossy());
+        builder.prefix(&prefix).suffix(TMP_SUFFIX);
+        // `NamedTempFile` is private (0600) by default; results are ordinary files (0666
+        // less the umask, as `File::create` makes them).
+        #[cfg(unix)]
+        builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+        let file = builder.tempfile_in(dir).with_context(context)?;
+        let tmp = file.path().to_path_buf();
         live().push(tmp.clone());
         Ok(AtomicFile {
             dest: dest.to_path_buf(),
@@ -75,17 +84,16 @@ impl AtomicFile {
     /// destination keeps what it had.
     pub fn commit(mut self) -> anyhow::Result<()> {
         let out = self.out.take().expect("an AtomicFile is committed once");
-        let context = || format!("cannot write '{}'", self.dest.display());
+        // On every error the `NamedTempFile` is dropped, which removes the temporary file.
         let renamed = out
             .into_inner()
             .map_err(|e| e.into_error())
-            .and_then(|file| file.sync_all())
-            .and_then(|()| std::fs::rename(&self.tmp, &self.dest));
-        if renamed.is_err() {
-            let _ = std::fs::remove_file(&self.tmp);
-        }
+            .and_then(|file| file.as_file().sync_all().map(|()| file))
+            .and_then(|file| file.persist(&self.dest).map_err(|e| e.error));
         forget_live(&self.tmp);
-        renamed.with_context(context)
+        renamed
+            .map(drop)
+            .with_context(|| format!("cannot write '{}'", self.dest.display()))
     }
 }
 
@@ -101,9 +109,9 @@ impl Write for AtomicFile {
 
 impl Drop for AtomicFile {
     fn drop(&mut self) {
-        if self.out.take().is_some() {
-            // Not committed: the destination keeps what it had.
-            let _ = std::fs::remove_file(&self.tmp);
+        // Not committed: dropping the file removes it, and the destination keeps what it had.
+        if let Some(out) = self.out.take() {
+            drop(out);
             forget_live(&self.tmp);
         }
     }
@@ -160,6 +168,19 @@ mod tests {
         drop(f);
         assert_eq!(std::fs::read_to_string(&dest).unwrap(), "old");
         assert_eq!(names(dir.path()), ["out.csv"]);
+    }
+
+    #[test]
+    #[cfg(unix)]
+    fn a_committed_file_has_the_permissions_a_plain_create_gives() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let plain = dir.path().join("plain.csv");
+        std::fs::File::create(&plain).unwrap();
+        let dest = dir.path().join("out.csv");
+        write(&dest, b"new").unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&dest), mode(&plain));
     }
 
     #[test]
