@@ -12,9 +12,11 @@
 
 use std::fmt::Write as _;
 
-use super::findings::{AtCores, Entry, Finding, Verdict, Withheld, and_list};
+use super::cell::Best;
+use super::findings::{AtCores, Finding, Withheld};
 use super::numbers::{faster, plus_minus};
-use super::series::{self, Best};
+use super::select;
+use super::verdict::{Entry, Verdict, and_list};
 use super::view::{Design, GroupView};
 use crate::results::intervals::MIN_ROUNDS;
 use crate::results::key::LabelStyle;
@@ -79,7 +81,7 @@ fn said(v: &GroupView, found: &[Finding]) -> Vec<Said> {
     }
     let seq_trusted = !found.contains(&Finding::ContendedReference);
     let mut out = Vec::new();
-    for c in series::cores(&v.rows, &v.group) {
+    for c in select::cores(&v.rows, &v.group) {
         let at = found.iter().find_map(|f| match f {
             Finding::AtCores(at) if at.cores == c => Some(at.clone()),
             _ => None,
@@ -115,7 +117,9 @@ pub fn markdown(groups: &[GroupAnswer]) -> String {
          whose best cell has the lowest mean time (at its best chunks), its paired speedup over \
          `seq`, and that cell against the next lowest mean, paired by round. **Bold**: \
          fastest, its 95 % interval excluding 1 against every other strategy; *not resolved*: \
-         the paired rounds do not separate it from the strategies named.\n\n",
+         the paired rounds do not separate it from the strategies named. Where even the \
+         fastest strategy did not beat `seq` (its speedup's interval holds 1, or lies below \
+         it), the speedup says so.\n\n",
     );
     md.push_str(
         "| workload | cores | fastest | speedup (95 % CI) | vs runner-up |\n\
@@ -183,7 +187,7 @@ fn cells(s: &Said) -> String {
     };
     let speedup = |(_, b): &Entry| match b.speedup {
         _ if !seq_trusted => "— (seq contended)".to_owned(),
-        Some(s) => plus_minus(s, b.speedup_ci),
+        Some(s) => format!("{}{}", plus_minus(s, b.speedup_ci), against_seq(b)),
         None => "—".to_owned(),
     };
     let left_out = match at.contended {
@@ -222,6 +226,17 @@ fn cells(s: &Said) -> String {
         },
         speedup(winner),
     )
+}
+
+/// What the fastest cell's speedup interval says against `seq` where it did not beat it:
+/// below 1, slower; holding 1 on more than one core, not distinguishable (on one core every
+/// strategy does `seq`'s work, so a tie there is the expected result and goes unsaid).
+fn against_seq(b: &Best) -> &'static str {
+    match b.speedup_ci {
+        Some(i) if i.high < 1.0 => ", slower than `seq`",
+        Some(i) if i.low <= 1.0 && b.cores > 1 => ", not distinguishable from `seq`",
+        _ => "",
+    }
 }
 
 /// A best cell by its series and chunks: `crossbeam-pool, 10 chunks`.
@@ -342,6 +357,39 @@ mod tests {
                 ..
             }
         ));
+    }
+
+    #[test]
+    fn a_fastest_strategy_that_does_not_beat_seq_says_so() {
+        // rayon-chunks beats rayon-iter in every round at 2 cores, but neither beats seq: the
+        // rounds put rayon-chunks at 0.95x, 1.07x and 1.0x of seq's time.
+        let v = view(&[
+            (Seq, 1, None, NONE, &SEQ),
+            (RayonChunks, 2, Some(10), NONE, &[4.2, 4.5, 3.2]),
+            (RayonIter, 2, None, NONE, &[4.41, 4.73, 3.36]),
+            (CrossbeamPool, 2, Some(10), NONE, &[6.0, 7.2, 4.8]),
+        ]);
+        let (_, md) = answered(std::slice::from_ref(&v));
+        let row = rows(&md)[0];
+        assert!(
+            row.contains("| 2 | **rayon-chunks, 10 chunks** | ")
+                && row.contains("×, not distinguishable from `seq` | "),
+            "{md}"
+        );
+        // Slower than seq in every round: said as slower.
+        let v = view(&[
+            (Seq, 1, None, NONE, &SEQ),
+            (RayonChunks, 2, Some(10), NONE, &[5.0, 6.0, 4.0]),
+            (RayonIter, 2, None, NONE, &[5.5, 6.6, 4.4]),
+        ]);
+        let (_, md) = answered(std::slice::from_ref(&v));
+        assert!(
+            rows(&md)[0].contains("| 0.800 ± 0.000×, slower than `seq` | "),
+            "{md}"
+        );
+        // Faster than seq: nothing added (the test above has 2.00 ± 0.00× alone).
+        let (_, md) = answered(&[view(&RESOLVED)]);
+        assert!(!md.contains("than `seq` |"), "{md}");
     }
 
     #[test]

@@ -17,7 +17,7 @@
 //!   interval lies above 0 ([`Best::serial_fraction`]), as a measurement at that core count,
 //!   never extrapolated.
 //! - Each strategy at each placement (`sweep --pin`) is a series of its own
-//!   ([`series::SeriesKey`]); two placements are compared cell against cell
+//!   ([`select::SeriesKey`]); two placements are compared cell against cell
 //!   ([`super::placements`]).
 //! - Across workloads ([`super::rank_shift`]): a winner is named only where it is resolved on
 //!   both; a strategy has moved only where both orders are resolved.
@@ -25,11 +25,17 @@
 //! [`findings`] decides what the data supports, as [`Finding`] values; [`Finding::sentence`]
 //! words each one.
 
-use super::numbers::{faster, interval, plus_minus, secs, sig};
+use super::cell::Best;
+use super::numbers::{faster, interval, plus_minus, sig};
 use super::paper;
 use super::placements::Placements;
 use super::rank_shift::RankShift;
-use super::series::{self, Best, SeriesKey};
+use super::select;
+use super::select::SeriesKey;
+use super::series;
+use super::verdict::{
+    Entry, Order, Verdict, and_list, calm, describe, named, order, trusted, verdict,
+};
 use super::view::{Design, GroupView};
 use crate::results::intervals::{MIN_ROUNDS, Ratio};
 use crate::results::stats::Interval;
@@ -111,56 +117,6 @@ pub struct PaperPoint {
     pub paper: f64,
 }
 
-/// A strategy's best cell at one core count (boxed: verdicts hold several).
-pub type Entry = (StrategyName, Box<Best>);
-
-/// Why two cells cannot be ordered.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Unknown {
-    /// They share this many rounds, fewer than [`MIN_ROUNDS`]: no interval.
-    Rounds(usize),
-    /// Their runs do not pair (other rounds: another shard or phase, or a sweep whose rounds
-    /// do not pair).
-    Unpaired,
-}
-
-/// What the paired rounds say about one cell `a` against another `b`. The ratio is `b`'s
-/// time over `a`'s, paired by round: how many times faster `a` is.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Order {
-    /// `a` is faster: the interval lies above 1.
-    AFaster(Ratio),
-    /// `b` is faster: the interval lies below 1.
-    BFaster(Ratio),
-    /// The interval contains 1: not distinguishable.
-    Unresolved(Ratio),
-    /// No interval.
-    Unknown(Unknown),
-}
-
-/// `a` against `b`, by their runs paired by round (see [`Order`]).
-pub fn order(a: &Best, b: &Best) -> Order {
-    // A strategy the confirmation left out (it lost by more than twice in the grid) has only
-    // grid runs: it pairs with the other's runs of the grid's rounds.
-    let paired = b.runs.ratio(&a.runs).or_else(|| b.grid().ratio(a.grid()));
-    let Some(r) = paired else {
-        return Order::Unknown(Unknown::Unpaired);
-    };
-    match r.interval {
-        None => Order::Unknown(Unknown::Rounds(r.rounds)),
-        Some(_) if !r.resolved() => Order::Unresolved(r),
-        Some(_) if r.value > 1.0 => Order::AFaster(r),
-        Some(_) => Order::BFaster(r),
-    }
-}
-
-impl Order {
-    /// Whether the order is resolved (either way).
-    pub fn resolved(&self) -> bool {
-        matches!(self, Order::AFaster(_) | Order::BFaster(_))
-    }
-}
-
 /// The paired speedup of `b` over `seq` as a ratio.
 pub fn speedup(b: &Best) -> Option<Ratio> {
     Some(Ratio {
@@ -191,7 +147,7 @@ pub fn findings(view: &GroupView) -> Vec<Finding> {
     if !seq_trusted {
         out.push(Finding::ContendedReference);
     }
-    for c in series::cores(&view.rows, &view.group) {
+    for c in select::cores(&view.rows, &view.group) {
         let at: Vec<Entry> = bests
             .iter()
             .filter_map(|(k, b)| {
@@ -205,7 +161,7 @@ pub fn findings(view: &GroupView) -> Vec<Finding> {
             out.push(Finding::OneCore(one));
         }
     }
-    let strategies: Vec<StrategyName> = series::strategies(&view.rows, &view.group)
+    let strategies: Vec<StrategyName> = select::strategies(&view.rows, &view.group)
         .into_iter()
         .filter(|&s| s != StrategyName::Seq)
         .collect();
@@ -217,74 +173,6 @@ pub fn findings(view: &GroupView) -> Vec<Finding> {
         out.extend(against_paper(view, &bests));
     }
     out
-}
-
-/// Whether a cell was measured without contention.
-fn calm(b: &Best) -> bool {
-    !b.contended
-}
-
-/// What can be said about the fastest strategy at one core count, from the cells measured
-/// without contention (lowest mean first).
-#[derive(Debug, Clone, PartialEq)]
-pub enum Verdict {
-    /// Only one cell.
-    Only(Entry),
-    /// Some cell cannot be ordered against the lowest mean: that one, and why.
-    Unknown(Entry, Unknown),
-    /// The lowest mean is faster than every other cell, each by its paired rounds.
-    Fastest {
-        /// The fastest.
-        winner: Entry,
-        /// The second lowest mean.
-        runner_up: Entry,
-        /// How many times faster the winner is than the runner-up.
-        by: Ratio,
-    },
-    /// These cells are not distinguishable from the lowest mean (it first).
-    Tied {
-        /// The lowest mean and the cells not distinguishable from it.
-        tied: Vec<Entry>,
-        /// How many are slower by their paired rounds.
-        slower: usize,
-    },
-}
-
-/// The verdict on `trusted` (lowest mean first); `None` when it is empty.
-pub fn verdict(trusted: &[Entry]) -> Option<Verdict> {
-    let first = trusted.first()?.clone();
-    let Some(runner_up) = trusted.get(1).cloned() else {
-        return Some(Verdict::Only(first));
-    };
-    let mut tied = vec![first.clone()];
-    let mut by = None;
-    for other in &trusted[1..] {
-        match order(&first.1, &other.1) {
-            Order::Unknown(why) => return Some(Verdict::Unknown(first, why)),
-            Order::AFaster(r) => {
-                by.get_or_insert(r);
-            }
-            Order::BFaster(_) | Order::Unresolved(_) => tied.push(other.clone()),
-        }
-    }
-    Some(match by {
-        Some(by) if tied.len() == 1 => Verdict::Fastest {
-            winner: first,
-            runner_up,
-            by,
-        },
-        _ => Verdict::Tied {
-            slower: trusted.len() - tied.len(),
-            tied,
-        },
-    })
-}
-
-/// The cells of `at` measured without contention, lowest mean first (the first of equals).
-pub(super) fn trusted(at: &[Entry]) -> Vec<Entry> {
-    let mut trusted: Vec<Entry> = at.iter().filter(|(_, b)| calm(b)).cloned().collect();
-    trusted.sort_by(|a, b| a.1.mean_s.total_cmp(&b.1.mean_s));
-    trusted
 }
 
 /// The verdict at `cores` on the cells `at`, the contended ones left out.
@@ -320,7 +208,7 @@ fn best_chunks(view: &GroupView, bests: &[(SeriesKey, Vec<Best>)]) -> Vec<Findin
 fn chunking(view: &GroupView, bests: &[(SeriesKey, Vec<Best>)]) -> Vec<Finding> {
     bests
         .iter()
-        .filter(|(k, _)| series::is_chunked(&view.rows, &view.group, k.strategy))
+        .filter(|(k, _)| select::is_chunked(&view.rows, &view.group, k.strategy))
         .filter_map(|&(key, _)| {
             let from: Vec<(usize, usize)> = series::chunk_table(view, key)
                 .iter()
@@ -357,7 +245,7 @@ fn against_paper(view: &GroupView, bests: &[(SeriesKey, Vec<Best>)]) -> Option<F
     if !paper::comparable(&view.group) {
         return None;
     }
-    let points: Vec<PaperPoint> = series::cores(&view.rows, &view.group)
+    let points: Vec<PaperPoint> = select::cores(&view.rows, &view.group)
         .into_iter()
         .filter_map(|c| {
             let p = paper::at(c)?;
@@ -597,66 +485,6 @@ impl AtCores {
     }
 }
 
-impl Unknown {
-    /// Why no order: `only 2 paired rounds (3 are needed for an interval)`.
-    pub fn phrase(self) -> String {
-        match self {
-            Unknown::Rounds(k) => format!(
-                "with only {} in common ({MIN_ROUNDS} are needed for an interval)",
-                crate::output::console::plural(k, "paired round", "paired rounds")
-            ),
-            Unknown::Unpaired => "these cells did not run in the same rounds".to_owned(),
-        }
-    }
-}
-
-/// A verdict in a few words, strategies by name only (the table beside it has the numbers).
-pub(super) fn verdict_phrase(v: Option<&Verdict>) -> String {
-    match v {
-        None => "no cell was measured without contention".to_owned(),
-        Some(Verdict::Only((s, _))) => format!("only {s} was measured"),
-        Some(Verdict::Unknown((s, _), why)) => format!(
-            "the lowest mean is {s}'s, but {}, so no strategy can be called fastest",
-            why.phrase()
-        ),
-        Some(Verdict::Fastest { winner, .. }) => format!("**{}** is fastest", winner.0),
-        Some(Verdict::Tied { tied, .. }) => format!(
-            "{} are not distinguishable by their paired rounds",
-            names(&tied.iter().map(|(s, _)| *s).collect::<Vec<_>>())
-        ),
-    }
-}
-
-/// Strategy names as `a`, `a and b`, `a, b and c`.
-pub(super) fn names(strategies: &[StrategyName]) -> String {
-    and_list(&strategies.iter().map(|s| s.to_string()).collect::<Vec<_>>())
-}
-
-/// A cell by its series and chunks: `rayon-chunks with 45 chunks`, or pinned,
-/// `rayon-chunks (spread) with 45 chunks`.
-fn named(b: &Best) -> String {
-    format!(
-        "{}{}",
-        b.key(),
-        b.chunks
-            .map_or_else(String::new, |k| format!(" with {k} chunks"))
-    )
-}
-
-/// A cell as findings name it: `rayon-chunks with 45 chunks (0.412 s [0.40–0.42])`.
-pub(super) fn describe((_, b): &Entry) -> String {
-    format!("{} ({} s{})", named(b), secs(b.mean_s), interval(b.mean_ci))
-}
-
-/// `a`, `a and b`, `a, b and c`.
-pub(super) fn and_list(items: &[String]) -> String {
-    match items {
-        [] => String::new(),
-        [one] => one.clone(),
-        [init @ .., last] => format!("{} and {last}", init.join(", ")),
-    }
-}
-
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
@@ -815,5 +643,42 @@ pub(crate) mod tests {
         let f = said(&v);
         assert_eq!(f.len(), 1);
         assert!(f[0].starts_with("Findings withheld: this sweep was measured before rounds"));
+    }
+
+    #[test]
+    fn a_placement_is_faster_only_where_the_paired_rounds_resolve_it_and_named_wherever_a_cell_is()
+    {
+        let (none, spread) = (Pin::None, Pin::Spread);
+        let f = sentences(&[
+            (Seq, 1, None, none, &SEQ),
+            (RayonChunks, 1, Some(10), none, &[3.9, 4.9, 3.3]),
+            (RayonChunks, 1, Some(10), spread, &[4.0, 4.7, 3.3]),
+            (RayonChunks, 2, Some(10), none, &[2.2, 2.64, 1.76]),
+            (RayonChunks, 2, Some(10), spread, &[1.8, 2.16, 1.44]),
+            // Spread's 5 chunks have no unpinned twin: not compared, though faster.
+            (RayonChunks, 2, Some(5), spread, &[1.0, 1.2, 0.8]),
+        ]);
+        let compared = |s: &&String| s.contains("` against ");
+        let s = f.iter().find(compared).unwrap();
+        assert_eq!(
+            s,
+            "rayon-chunks, `spread` against unpinned (at each core count, the chunks value \
+             fastest under either): `spread` is faster (paired rounds) at 2 cores; they are \
+             not distinguishable at 1 core; the largest difference is at 2 cores with 10 \
+             chunks: `spread` 2.22 ± 0.00× against unpinned 1.82 ± 0.00× over seq."
+        );
+        assert_eq!(f.iter().filter(compared).count(), 1, "{f:#?}");
+        assert!(
+            f.iter().any(|s| s
+                == "rayon-chunks (spread): more chunks stop paying (no larger chunk count is \
+                    faster by the grid's paired rounds) from 5 chunks at 2 cores."),
+            "{f:#?}"
+        );
+        // Pinned cells are named as such wherever a finding names a cell.
+        assert!(
+            f.iter()
+                .any(|s| s.contains("**rayon-chunks (spread) with 5 chunks (1.00 s")),
+            "{f:?}"
+        );
     }
 }

@@ -4,27 +4,21 @@
 
 use std::fmt::Write as _;
 
+use super::cell;
+use super::cell::Best;
 use super::findings::{Finding, findings};
 use super::load::Sweep;
 use super::numbers::{interval, plus_minus, sig};
 use super::paper;
-use super::plan::ChartPlan;
-use super::series::{self, Best, Group, SmtBand};
+use super::plan::{ChartPlan, Skipped};
+use super::select;
+use super::series::{self, Group, SmtBand};
 use super::traces::TraceDir;
 use super::view::{Design, GroupView};
 use crate::results::key::LabelStyle;
 use crate::results::rows::{Status, SummaryRow};
 use crate::topology::Topology;
 use sph_strategies::StrategyName;
-
-/// A chart that does not apply, and why.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Skipped {
-    /// The group (`None` for charts across groups).
-    pub group: Option<Group>,
-    /// E.g. `Chart 6 (all-pairs vs grid)`, and why it is not drawn.
-    pub note: String,
-}
 
 /// Everything the report says.
 #[derive(Debug, Clone)]
@@ -425,7 +419,7 @@ fn smt_note(md: &mut String, sweeps: &[Sweep]) {
          CPUs (`smt = true` in summary.csv: at {} cores): their threads shared physical cores \
          as SMT siblings, pinned or not.\n",
         crate::output::console::plural(smt.len(), "cell", "cells"),
-        super::findings::and_list(&cores)
+        super::verdict::and_list(&cores)
     );
 }
 
@@ -504,14 +498,14 @@ fn group(md: &mut String, v: &GroupView, found: &[Finding], input: &Input<'_>) {
     let _ = writeln!(md, "### Best cell per core count (Table 1 analogue)\n");
     let _ = writeln!(md, "{}\n", chosen(v));
     let smt =
-        topology_of(input.sweeps, g).and_then(|t| series::smt_band(t, &series::cores(&v.rows, g)));
+        topology_of(input.sweeps, g).and_then(|t| series::smt_band(t, &select::cores(&v.rows, g)));
     let columns = Columns {
-        pin: series::is_pinned(&v.rows, g),
+        pin: select::is_pinned(&v.rows, g),
         smt: smt.as_ref(),
         confirmed: v.is_confirmed(),
     };
     let bests = v.series_bests();
-    for s in series::strategies(&v.rows, g)
+    for s in select::strategies(&v.rows, g)
         .into_iter()
         .filter(|&s| s != StrategyName::Seq)
     {
@@ -525,7 +519,7 @@ fn group(md: &mut String, v: &GroupView, found: &[Finding], input: &Input<'_>) {
             let _ = writeln!(md, "**{s}**: no successful cell.\n");
             continue;
         }
-        let with_paper = comparable && series::is_chunked(&v.rows, g, s);
+        let with_paper = comparable && select::is_chunked(&v.rows, g, s);
         table(md, s, &best, with_paper, columns);
     }
     if let Some(band) = &smt {
@@ -587,7 +581,7 @@ fn reference(md: &mut String, v: &GroupView) {
         format!(
             "{} s{} over {} trials",
             mean_sd(r.mean_s.unwrap_or(0.0), r.stddev_s),
-            series::interval(r.mean_ci_low_s, r.mean_ci_high_s)
+            cell::interval(r.mean_ci_low_s, r.mean_ci_high_s)
                 .map_or_else(String::new, |i| format!(" (95 % CI{})", interval(Some(i)))),
             r.trials,
         )
@@ -684,7 +678,7 @@ fn smt_paragraph(md: &mut String, band: &SmtBand) {
          where the siblings add throughput; the efficiency per physical core, S / min(p, {n}), \
          sets the speedup against the physical cores the threads had: above 1, the siblings \
          gave more than {physical} could at best.\n",
-        super::findings::and_list(&cores),
+        super::verdict::and_list(&cores),
     );
 }
 
@@ -858,7 +852,7 @@ pub(super) fn best_cells(b: &Best) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::series::SeriesKey;
+    use crate::report::select::SeriesKey;
     use crate::report::series::tests::pinned;
     use crate::report::view::tests::of_rows;
     use crate::results::rows::tests::row;

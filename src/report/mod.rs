@@ -2,7 +2,9 @@
 //!
 //! The pipeline: [`crate::results::load`] reads `meta.json`, `summary.csv` and `trials.csv`;
 //! [`view`] builds one view of each group (its grid and confirmation rows, each cell's runs by
-//! round), which every table, chart and finding reads; [`series`] turns it into the series
+//! round: [`cell`]; which rows form a series: [`select`]), which every table, chart and
+//! finding reads; [`verdict`] orders two cells by their paired rounds and decides the fastest
+//! of a core count, for the findings and the comparisons; [`series`] turns it into the series
 //! each chart and table needs and [`plan`] into the charts to draw, with their captions (both
 //! pure); [`charts`] draws
 //! them (one file per chart kind, [`charts::WIDTH`] × [`charts::HEIGHT`] PNGs in the bundled
@@ -38,6 +40,7 @@
 //! lists them with their reason.
 
 pub mod answer;
+pub mod cell;
 pub mod charts;
 pub mod compare;
 pub mod findings;
@@ -47,8 +50,10 @@ pub mod paper;
 pub mod placements;
 pub mod plan;
 pub mod rank_shift;
+pub mod select;
 pub mod series;
 pub mod traces;
+pub mod verdict;
 pub mod view;
 pub mod workloads;
 

@@ -2,15 +2,18 @@
 //! each core count where both were measured without contention with the same chunks (the
 //! chunks value fastest under either), among the cells the findings rest on (the confirmation
 //! rounds' where the group has them), one placement is called faster only where the 95 %
-//! interval of their time ratio, paired by round ([`findings::order`]), excludes 1; otherwise
+//! interval of their time ratio, paired by round ([`verdict::order`]), excludes 1; otherwise
 //! they are not distinguishable, and without an interval no order is told. Each strategy gets
 //! one sentence per pair of placements (`compact` against `spread`, each pinned one against
 //! `none`): where each is faster, where the rounds cannot tell, and the largest difference
 //! with both cells' speedups. [`compare`] decides, [`Placements::sentence`] words.
 
-use super::findings::{self, Order, and_list};
+use super::cell::Best;
 use super::numbers::{interval, plus_minus, secs};
-use super::series::{self, Best};
+use super::select;
+use super::series;
+use super::verdict;
+use super::verdict::{Order, and_list};
 use super::view::GroupView;
 use crate::topology::Pin;
 use sph_strategies::StrategyName;
@@ -71,7 +74,7 @@ pub fn compare<'a>(
     show_speedup: bool,
 ) -> impl Iterator<Item = Placements> + 'a {
     strategies.iter().flat_map(move |&s| {
-        let pins = series::pins(&view.rows, &view.group, s);
+        let pins = select::pins(&view.rows, &view.group, s);
         PIN_PAIRS
             .iter()
             .filter(move |(a, b)| pins.contains(a) && pins.contains(b))
@@ -86,7 +89,7 @@ fn placement_pair(
     (a, b): (Pin, Pin),
     show_speedup: bool,
 ) -> Option<Placements> {
-    let ok = series::ok_rows(view.findings_rows(), &view.group);
+    let ok = select::ok_rows(view.findings_rows(), &view.group);
     let cell = |pin: Pin, cores: usize, chunks: Option<usize>| {
         ok.iter()
             .find(|r| r.strategy == s && r.pin == pin && r.cores == cores && r.chunks == chunks)
@@ -94,7 +97,7 @@ fn placement_pair(
     };
     let mut at = Vec::new();
     let mut contended = 0;
-    for c in series::cores(&view.rows, &view.group) {
+    for c in select::cores(&view.rows, &view.group) {
         let both: Vec<PinPair> = ok
             .iter()
             .filter(|r| r.strategy == s && r.pin == a && r.cores == c)
@@ -121,7 +124,7 @@ fn placement_pair(
         a,
         b,
         at,
-        chunked: series::is_chunked(&view.rows, &view.group, s),
+        chunked: select::is_chunked(&view.rows, &view.group, s),
         show_speedup,
         contended,
     })
@@ -141,7 +144,7 @@ impl Placements {
     pub fn sentence(&self) -> String {
         let (a, b) = (pin_name(self.a), pin_name(self.b));
         // What the paired rounds say of a pair, as the place of its phrase below.
-        let said = |p: &PinPair| match findings::order(&p.a, &p.b) {
+        let said = |p: &PinPair| match verdict::order(&p.a, &p.b) {
             Order::AFaster(_) => 0,
             Order::BFaster(_) => 1,
             Order::Unresolved(_) => 2,
@@ -241,53 +244,26 @@ fn cores_list(cores: &[usize]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::findings::tests::SEQ;
-    use crate::report::findings::{Finding, findings};
     use crate::report::view::tests::{Spec, of_rows, view};
     use crate::results::rows::tests::row;
-    use StrategyName::{RayonChunks, Seq, StdStatic};
+    use StrategyName::{Seq, StdStatic};
 
-    fn sentences(specs: &[Spec<'_>]) -> Vec<String> {
-        findings(&view(specs))
-            .iter()
-            .map(Finding::sentence)
+    /// `seq`'s times by round.
+    const SEQ: [f64; 3] = [4.0, 4.8, 3.2];
+
+    /// The placement sentences of `v`, as the findings word them (its `seq` trusted).
+    fn sentences_of(v: &GroupView) -> Vec<String> {
+        let strategies: Vec<StrategyName> = select::strategies(&v.rows, &v.group)
+            .into_iter()
+            .filter(|&s| s != Seq)
+            .collect();
+        compare(v, &strategies, true)
+            .map(|p| p.sentence())
             .collect()
     }
 
-    #[test]
-    fn a_placement_is_faster_only_where_the_paired_rounds_resolve_it() {
-        let (none, spread) = (Pin::None, Pin::Spread);
-        let f = sentences(&[
-            (Seq, 1, None, none, &SEQ),
-            (RayonChunks, 1, Some(10), none, &[3.9, 4.9, 3.3]),
-            (RayonChunks, 1, Some(10), spread, &[4.0, 4.7, 3.3]),
-            (RayonChunks, 2, Some(10), none, &[2.2, 2.64, 1.76]),
-            (RayonChunks, 2, Some(10), spread, &[1.8, 2.16, 1.44]),
-            // Spread's 5 chunks have no unpinned twin: not compared, though faster.
-            (RayonChunks, 2, Some(5), spread, &[1.0, 1.2, 0.8]),
-        ]);
-        let compared = |s: &&String| s.contains("` against ");
-        let s = f.iter().find(compared).unwrap();
-        assert_eq!(
-            s,
-            "rayon-chunks, `spread` against unpinned (at each core count, the chunks value \
-             fastest under either): `spread` is faster (paired rounds) at 2 cores; they are \
-             not distinguishable at 1 core; the largest difference is at 2 cores with 10 \
-             chunks: `spread` 2.22 ± 0.00× against unpinned 1.82 ± 0.00× over seq."
-        );
-        assert_eq!(f.iter().filter(compared).count(), 1, "{f:#?}");
-        assert!(
-            f.iter().any(|s| s
-                == "rayon-chunks (spread): more chunks stop paying (no larger chunk count is \
-                    faster by the grid's paired rounds) from 5 chunks at 2 cores."),
-            "{f:#?}"
-        );
-        // Pinned cells are named as such wherever a finding names a cell.
-        assert!(
-            f.iter()
-                .any(|s| s.contains("**rayon-chunks (spread) with 5 chunks (1.00 s")),
-            "{f:?}"
-        );
+    fn sentences(specs: &[Spec<'_>]) -> Vec<String> {
+        sentences_of(&view(specs))
     }
 
     #[test]
@@ -317,7 +293,7 @@ mod tests {
             row(StrategyName::RayonIter, 2, None, 2.0),
             spread,
         ]);
-        let f: Vec<String> = findings(&v).iter().map(Finding::sentence).collect();
+        let f = sentences_of(&v);
         let f = f.join("\n");
         assert!(
             f.contains("the paired rounds give no interval, so no order can be told at 2 cores"),

@@ -14,15 +14,26 @@
 
 use sph_strategies::StrategyName;
 
+use super::cell;
 use super::charts::best::BestChart;
-use super::markdown::Skipped;
 use super::paper;
-use super::series::{self, Line, Metric, SeriesKey, SmtBand};
+use super::select;
+use super::select::SeriesKey;
+use super::series::{self, Line, Metric, SmtBand};
 use super::view::GroupView;
 use crate::results::key::{Group, LabelStyle};
 use crate::results::rows::SummaryRow;
 use crate::sph::params::Preset;
 use crate::topology::{Pin, Topology};
+
+/// A chart that does not apply, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Skipped {
+    /// The group (`None` for charts across groups).
+    pub group: Option<Group>,
+    /// E.g. `Chart 6 (all-pairs vs grid)`, and why it is not drawn.
+    pub note: String,
+}
 
 /// What a chart shows, with its series.
 #[derive(Debug, Clone)]
@@ -93,7 +104,7 @@ pub fn plan<'t>(
     let mut out = ReportPlan::default();
     for v in views {
         chunk_charts(v, &mut out);
-        let cores = series::cores(&v.rows, &v.group);
+        let cores = select::cores(&v.rows, &v.group);
         let smt = topology(&v.group).and_then(|t| series::smt_band(t, &cores));
         cores_charts(v, smt, &mut out);
     }
@@ -135,9 +146,9 @@ impl ReportPlan {
 fn chunk_charts(v: &GroupView, out: &mut ReportPlan) {
     let (rows, g) = (&v.rows, &v.group);
     let subtitle = g.label(LabelStyle::Report);
-    let chunked: Vec<StrategyName> = series::strategies(rows, g)
+    let chunked: Vec<StrategyName> = select::strategies(rows, g)
         .into_iter()
-        .filter(|&s| series::is_chunked(rows, g, s))
+        .filter(|&s| select::is_chunked(rows, g, s))
         .collect();
     if chunked.is_empty() {
         out.skip(
@@ -147,7 +158,7 @@ fn chunk_charts(v: &GroupView, out: &mut ReportPlan) {
         );
     }
     let keys = chunked.into_iter().flat_map(|s| {
-        series::pins(rows, g, s)
+        select::pins(rows, g, s)
             .into_iter()
             .map(move |p| SeriesKey::new(s, p))
     });
@@ -201,7 +212,7 @@ fn chunk_charts(v: &GroupView, out: &mut ReportPlan) {
 /// Charts 3–5 of `v`, or why they are not drawn.
 fn cores_charts(v: &GroupView, smt: Option<SmtBand>, out: &mut ReportPlan) {
     let g = &v.group;
-    let cores = series::cores(&v.rows, g);
+    let cores = select::cores(&v.rows, g);
     match v.reference().and_then(|r| r.mean_s) {
         Some(seq_s) if cores.len() > 1 => {
             let bests = v.series_bests();
@@ -233,7 +244,7 @@ fn cores_charts(v: &GroupView, smt: Option<SmtBand>, out: &mut ReportPlan) {
 /// line per placement; `bests` are its series' best cells.
 fn best_charts(
     v: &GroupView,
-    bests: &[(SeriesKey, Vec<series::Best>)],
+    bests: &[(SeriesKey, Vec<cell::Best>)],
     seq_s: f64,
     out: &mut ReportPlan,
 ) {
@@ -241,7 +252,7 @@ fn best_charts(
     let subtitle = g.label(LabelStyle::Report);
     let comparable = paper::comparable(g);
     let speedups = series::speedup_lines(bests);
-    for s in series::strategies(&v.rows, g)
+    for s in select::strategies(&v.rows, g)
         .into_iter()
         .filter(|&s| s != StrategyName::Seq)
     {
@@ -295,7 +306,7 @@ fn chosen(v: &GroupView) -> &'static str {
 /// Charts 4 and 5 of `g`, from the best cells `bests`, with the core counts in `smt` shaded.
 fn speedup_and_efficiency_charts(
     g: &Group,
-    bests: &[(SeriesKey, Vec<series::Best>)],
+    bests: &[(SeriesKey, Vec<cell::Best>)],
     smt: Option<SmtBand>,
     out: &mut ReportPlan,
 ) {

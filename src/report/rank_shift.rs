@@ -6,12 +6,13 @@
 
 use sph_strategies::StrategyName;
 
-use super::findings::{Entry, Verdict, and_list, names, order, trusted, verdict, verdict_phrase};
-use super::series::{self, Best};
+use super::cell::Best;
+use super::series;
+use super::verdict::{Entry, Verdict, and_list, names, order, trusted, verdict, verdict_phrase};
 
 /// Whether `a` is resolved faster than `b` by their paired rounds.
 fn ahead(a: &Best, b: &Best) -> bool {
-    matches!(order(a, b), super::findings::Order::AFaster(_))
+    matches!(order(a, b), super::verdict::Order::AFaster(_))
 }
 
 /// The ranking of the toy workload (a Müller preset) against the real one (`wcsph`) at one
@@ -204,8 +205,7 @@ impl RankShift {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::findings::Finding;
-    use crate::report::view::{Batch, Runs};
+    use crate::report::cell::{Batch, Runs};
     use crate::results::rows::Phase;
     use crate::results::rows::tests::row;
 
@@ -236,7 +236,7 @@ mod tests {
     }
 
     fn shift(toy: &[Entry], real: &[Entry]) -> String {
-        Finding::RankShift(Box::new(rank_shift(2, toy, real))).sentence()
+        rank_shift(2, toy, real).sentence()
     }
 
     #[test]

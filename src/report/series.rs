@@ -1,141 +1,20 @@
 //! Pure functions from summary rows and a group's view ([`GroupView`]) to what the charts and
-//! the report show: groups, lines of points, a best cell's numbers ([`Best`]), speedup
-//! intervals, the Karp–Flatt serial fraction with its interval.
+//! the report show: lines of points with their intervals, chunk tables, the SMT band.
 //!
 //! Only cells with `status = ok` and a mean enter a series; failed cells are listed by the
-//! report instead. Times are seconds.
-//!
-//! A series is one strategy at one placement ([`SeriesKey`]): pinned and unpinned cells of a
-//! strategy (`sweep --pin`) are never pooled into one line, one best cell or one table row.
+//! report instead. Times are seconds. Which rows form a series: [`super::select`]; a best
+//! cell's numbers: [`super::cell`].
 
 use std::collections::BTreeSet;
-use std::fmt;
 
-use crate::results::stats::Interval;
-
-use sph_strategies::StrategyName;
-
-use super::view::{GroupView, Runs};
+use super::cell::{Best, Runs};
+use super::select::{SeriesKey, cores, groups, ok_rows};
+use super::view::GroupView;
 pub use crate::results::key::Group;
 use crate::results::rows::{Contended, SummaryRow, fastest};
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
 use crate::topology::{Pin, Topology};
-
-/// The groups of `rows`, in the order they first appear.
-pub fn groups(rows: &[SummaryRow]) -> Vec<Group> {
-    let mut out: Vec<Group> = Vec::new();
-    for r in rows {
-        let g = r.group();
-        if !out.contains(&g) {
-            out.push(g);
-        }
-    }
-    out
-}
-
-/// The rows of `group` that may be used.
-pub fn ok_rows<'a>(rows: &'a [SummaryRow], group: &Group) -> Vec<&'a SummaryRow> {
-    rows.iter()
-        .filter(|r| r.group() == *group && r.is_usable())
-        .collect()
-}
-
-/// The strategies of `group` in the order they first appear (the registry order of the plan).
-pub fn strategies(rows: &[SummaryRow], group: &Group) -> Vec<StrategyName> {
-    let mut out: Vec<StrategyName> = Vec::new();
-    for r in rows.iter().filter(|r| r.group() == *group) {
-        if !out.contains(&r.strategy) {
-            out.push(r.strategy);
-        }
-    }
-    out
-}
-
-/// One strategy's cells at one placement: what a line of the charts and a row of the tables
-/// are drawn from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct SeriesKey {
-    /// The strategy.
-    pub strategy: StrategyName,
-    /// Where its threads ran (`pin`).
-    pub pin: Pin,
-}
-
-impl SeriesKey {
-    /// `strategy` at placement `pin`.
-    pub fn new(strategy: StrategyName, pin: Pin) -> SeriesKey {
-        SeriesKey { strategy, pin }
-    }
-
-    /// `strategy`'s unpinned cells (`pin = none`).
-    pub fn unpinned(strategy: StrategyName) -> SeriesKey {
-        SeriesKey::new(strategy, Pin::None)
-    }
-
-    /// Whether a row belongs to the series (any group).
-    pub fn holds(&self, r: &SummaryRow) -> bool {
-        r.strategy == self.strategy && r.pin == self.pin
-    }
-}
-
-/// `rayon-chunks` unpinned, `rayon-chunks (spread)` pinned: legends, tables and findings.
-impl fmt::Display for SeriesKey {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.pin {
-            Pin::None => write!(f, "{}", self.strategy),
-            pin => write!(f, "{} ({pin})", self.strategy),
-        }
-    }
-}
-
-/// The placements `strategy` was measured at in `group`, `none` first, then `compact`,
-/// `spread`.
-pub fn pins(rows: &[SummaryRow], group: &Group, strategy: StrategyName) -> Vec<Pin> {
-    let set: BTreeSet<Pin> = rows
-        .iter()
-        .filter(|r| r.group() == *group && r.strategy == strategy)
-        .map(|r| r.pin)
-        .collect();
-    set.into_iter().collect()
-}
-
-/// The series of `group` (every strategy but `seq`): the strategies in the order they first
-/// appear, each at its placements in the order of [`pins`].
-pub fn series(rows: &[SummaryRow], group: &Group) -> Vec<SeriesKey> {
-    strategies(rows, group)
-        .into_iter()
-        .filter(|&s| s != StrategyName::Seq)
-        .flat_map(|s| {
-            pins(rows, group, s)
-                .into_iter()
-                .map(move |p| SeriesKey::new(s, p))
-        })
-        .collect()
-}
-
-/// Whether some cell of `group` was pinned (`seq` never is): the report then names each
-/// cell's placement.
-pub fn is_pinned(rows: &[SummaryRow], group: &Group) -> bool {
-    rows.iter()
-        .any(|r| r.group() == *group && r.pin != Pin::None)
-}
-
-/// Whether `strategy` has cells with a chunks value in `group`.
-pub fn is_chunked(rows: &[SummaryRow], group: &Group, strategy: StrategyName) -> bool {
-    rows.iter()
-        .any(|r| r.group() == *group && r.strategy == strategy && r.chunks.is_some())
-}
-
-/// The distinct core counts of the usable cells of `group` (any strategy but `seq`).
-pub fn cores(rows: &[SummaryRow], group: &Group) -> Vec<usize> {
-    let set: BTreeSet<usize> = ok_rows(rows, group)
-        .iter()
-        .filter(|r| !r.is_reference())
-        .map(|r| r.cores)
-        .collect();
-    set.into_iter().collect()
-}
 
 /// A point with its uncertainty: `y` the value, `lo..hi` its 95 % confidence interval
 /// (equal to `y` when unknown).
@@ -290,113 +169,6 @@ pub fn chunk_lines(view: &GroupView, key: SeriesKey, metric: Metric) -> Vec<Line
 /// `1 core`, `3 cores`.
 pub fn cores_label(c: usize) -> String {
     format!("{c} {}", if c == 1 { "core" } else { "cores" })
-}
-
-/// A strategy's best cell at one core count ([`GroupView::best_per_cores`]), or any cell
-/// with its runs.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Best {
-    /// The strategy.
-    pub strategy: StrategyName,
-    /// Worker threads.
-    pub cores: usize,
-    /// Chunks of the cell (`None` for strategies without chunks).
-    pub chunks: Option<usize>,
-    /// Where its threads ran.
-    pub pin: Pin,
-    /// Mean wall seconds.
-    pub mean_s: f64,
-    /// Median wall seconds.
-    pub median_s: f64,
-    /// Fastest trial.
-    pub min_s: f64,
-    /// The speedup over the group's `seq` of the same rounds (paired by round).
-    pub speedup: Option<f64>,
-    /// Speedup over cores.
-    pub efficiency: Option<f64>,
-    /// More threads than the machine has.
-    pub oversubscribed: bool,
-    /// 95 % interval of the typical seconds (`None` under 3 trials or in an older sweep).
-    pub mean_ci: Option<Interval>,
-    /// 95 % interval of the speedup.
-    pub speedup_ci: Option<Interval>,
-    /// Other work used the machine while it was measured.
-    pub contended: bool,
-    /// Whether its numbers come from confirmation rounds, which did not choose it; `false`:
-    /// from the grid's rounds, which chose it too (biased fast).
-    pub confirmed: bool,
-    /// Its runs, by round: what comparisons pair.
-    pub runs: Runs,
-    /// Where `runs` are the confirmation's: the same cell's runs in the grid's rounds, which
-    /// pair with a strategy the confirmation left out (more than twice the fastest cell's
-    /// time: the grid settled that it lost).
-    pub grid_runs: Option<Runs>,
-}
-
-impl Best {
-    /// A usable cell's numbers with its `runs` (`None` without a mean).
-    pub fn of(r: &SummaryRow, runs: Runs) -> Option<Best> {
-        let mean_s = r.mean_s?;
-        Some(Best {
-            strategy: r.strategy,
-            cores: r.cores,
-            chunks: r.chunks,
-            pin: r.pin,
-            mean_s,
-            median_s: r.median_s.unwrap_or(mean_s),
-            min_s: r.min_s.unwrap_or(mean_s),
-            speedup: r.speedup,
-            efficiency: r.efficiency,
-            oversubscribed: r.oversubscribed,
-            mean_ci: interval(r.mean_ci_low_s, r.mean_ci_high_s),
-            speedup_ci: interval(r.speedup_ci_low, r.speedup_ci_high),
-            contended: r.contended == Some(true),
-            confirmed: r.phase == crate::results::rows::Phase::Confirm,
-            runs,
-            grid_runs: None,
-        })
-    }
-
-    /// Its runs in the grid's rounds: [`Best::grid_runs`], or its own runs where they are the
-    /// grid's.
-    pub fn grid(&self) -> &Runs {
-        self.grid_runs.as_ref().unwrap_or(&self.runs)
-    }
-
-    /// The series it belongs to.
-    pub fn key(&self) -> SeriesKey {
-        SeriesKey::new(self.strategy, self.pin)
-    }
-
-    /// The Karp–Flatt serial fraction at this cell with its 95 % interval, the speedup's
-    /// carried through [`karp_flatt`] (which falls as the speedup rises); `None` without an
-    /// interval, at a speedup of 1 or less, and wherever the interval reaches 0 or below.
-    pub fn serial_fraction(&self) -> Option<(f64, Interval)> {
-        let s = self.speedup.filter(|&s| s > 1.0)?;
-        let i = self.speedup_ci?;
-        let e = karp_flatt(s, self.cores)?;
-        let low = karp_flatt(i.high, self.cores)?;
-        let high = karp_flatt(i.low, self.cores)?;
-        (low > 0.0).then_some((e, Interval { low, high }))
-    }
-}
-
-/// An interval from its two ends, if both are known.
-pub fn interval(low: Option<f64>, high: Option<f64>) -> Option<Interval> {
-    Some(Interval {
-        low: low?,
-        high: high?,
-    })
-}
-
-/// The Karp–Flatt experimentally determined serial fraction
-/// `e = (1/S − 1/p) / (1 − 1/p)` for speedup `S` on `p` processors; undefined for `p = 1`.
-pub fn karp_flatt(speedup: f64, p: usize) -> Option<f64> {
-    if p < 2 || !(speedup.is_finite() && speedup > 0.0) {
-        return None;
-    }
-    let p = p as f64;
-    Some((1.0 / speedup - 1.0 / p) / (1.0 - 1.0 / p))
 }
 
 /// A best cell as a point at its cores: `y` and its interval `(lo, hi)`.
@@ -640,9 +412,13 @@ pub fn smt_band(topology: &Topology, cores: &[usize]) -> Option<SmtBand> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::report::cell::karp_flatt;
+    use crate::report::select::{is_pinned, series};
     use crate::report::view::tests::{of_rows, view, views};
     use crate::results::rows::Status;
     use crate::results::rows::tests::row;
+    use crate::results::stats::Interval;
+    use sph_strategies::StrategyName;
 
     fn sample() -> Vec<SummaryRow> {
         let mut failed = row(StrategyName::RayonChunks, 2, Some(20), 0.1);

@@ -14,8 +14,8 @@
 
 use std::collections::{BTreeSet, HashMap};
 
-use super::series::{self, Best, SeriesKey};
-use crate::results::intervals::{self, Ratio};
+use super::cell::{Batch, Best, Runs};
+use super::select::{self, SeriesKey};
 use crate::results::key::{Cell, Group};
 use crate::results::load::Sweep;
 use crate::results::meta::Meta;
@@ -51,45 +51,6 @@ impl Design {
     /// Whether comparisons pair runs by round (and so findings may be drawn).
     pub fn pairs(self) -> bool {
         self == Design::Rounds
-    }
-}
-
-/// The runs that may be paired with each other: one sweep's, one phase's, one shard's.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Batch {
-    /// The sweep, by its place in the study.
-    pub source: usize,
-    /// Grid or confirmation rounds.
-    pub phase: Phase,
-    /// The shard that measured the cell (`reference_shard`), in a sharded sweep or a merge.
-    pub shard: Option<usize>,
-    /// Whether the sweep's rounds pair at all ([`Design::pairs`]).
-    pub paired: bool,
-}
-
-/// A cell's ok runs of one phase.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Runs {
-    /// What they may be paired with.
-    pub batch: Batch,
-    /// (round, wall seconds), in trial order.
-    pub rounds: Vec<(usize, f64)>,
-}
-
-impl Runs {
-    /// These runs' times over `other`'s, paired by round ([`intervals::paired_ratio`]): below
-    /// 1 these are faster. `None` where the two cannot be paired (other rounds, no rounds in
-    /// common, a sweep whose rounds do not pair).
-    pub fn ratio(&self, other: &Runs) -> Option<Ratio> {
-        if self.batch != other.batch || !self.batch.paired {
-            return None;
-        }
-        intervals::paired_ratio(&self.rounds, &other.rounds)
-    }
-
-    /// The wall seconds of each run.
-    pub fn walls(&self) -> impl Iterator<Item = f64> + '_ {
-        self.rounds.iter().map(|&(_, w)| w)
     }
 }
 
@@ -258,7 +219,7 @@ impl GroupView {
     /// Each series of the group (every strategy but `seq`, at each of its placements) with
     /// its best cell per core count.
     pub fn series_bests(&self) -> Vec<(SeriesKey, Vec<Best>)> {
-        series::series(&self.rows, &self.group)
+        select::series(&self.rows, &self.group)
             .into_iter()
             .map(|k| (k, self.best_per_cores(k)))
             .collect()
@@ -284,7 +245,7 @@ impl GroupView {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::report::compare::sides::tests::sweep_on;
+    use crate::results::load::tests::sweep_on;
     use crate::results::summarize::{CellContext, fixtures::trials, summary_row};
     use crate::topology::Pin;
     use sph_strategies::StrategyName;
@@ -437,8 +398,8 @@ pub(crate) mod tests {
             "other phases never pair"
         );
         // In the grid's rounds rayon-spawn took 2.5 times as long, round by round.
-        match crate::report::findings::order(chunks, spawn) {
-            crate::report::findings::Order::AFaster(r) => {
+        match crate::report::verdict::order(chunks, spawn) {
+            crate::report::verdict::Order::AFaster(r) => {
                 assert!((r.value - 2.5).abs() < 1e-9, "{r:?}");
             }
             other => panic!("{other:?}"),

@@ -19,10 +19,14 @@ use std::fmt::Write as _;
 
 use sph_strategies::StrategyName;
 
-use super::findings::{Entry, Finding};
+use super::cell;
+use super::cell::Best;
+use super::findings::Finding;
 use super::numbers::{interval, plus_minus, sig, times};
 use super::rank_shift::rank_shift;
-use super::series::{self, Best, Group};
+use super::select;
+use super::series::{self, Group};
+use super::verdict::Entry;
 use super::view::GroupView;
 use crate::results::key::LabelStyle;
 use crate::results::stats::Interval;
@@ -122,7 +126,7 @@ fn workload(v: &GroupView) -> Workload {
     Workload {
         group: *g,
         ns_per_particle_step: seq.and_then(|r| {
-            let ci = series::interval(r.mean_ci_low_s, r.mean_ci_high_s).map(|i| Interval {
+            let ci = cell::interval(r.mean_ci_low_s, r.mean_ci_high_s).map(|i| Interval {
                 low: per(i.low),
                 high: per(i.high),
             });
@@ -133,11 +137,11 @@ fn workload(v: &GroupView) -> Workload {
 
 /// Each strategy's best cell at `cores` in `v` (every strategy but `seq`), fastest first.
 fn entries(v: &GroupView, cores: usize) -> Vec<Entry> {
-    let mut out: Vec<Entry> = series::strategies(&v.rows, &v.group)
+    let mut out: Vec<Entry> = select::strategies(&v.rows, &v.group)
         .into_iter()
         .filter(|&s| s != StrategyName::Seq)
         .filter_map(|s| {
-            let best = v.best_per_cores(series::SeriesKey::unpinned(s));
+            let best = v.best_per_cores(select::SeriesKey::unpinned(s));
             Some((s, Box::new(best.into_iter().find(|b| b.cores == cores)?)))
         })
         .collect();
@@ -146,8 +150,8 @@ fn entries(v: &GroupView, cores: usize) -> Vec<Entry> {
 }
 
 fn rankings(toy: &GroupView, real: &GroupView) -> Vec<RankingAt> {
-    let real_cores = series::cores(&real.rows, &real.group);
-    series::cores(&toy.rows, &toy.group)
+    let real_cores = select::cores(&real.rows, &real.group);
+    select::cores(&toy.rows, &toy.group)
         .into_iter()
         .filter(|c| real_cores.contains(c))
         .map(|c| {

@@ -36,6 +36,7 @@ mod cli_sweep_safety;
 mod cli_trace;
 mod cli_validate;
 mod docs_links;
+mod imports;
 mod layers;
 mod physics_step;
 mod solver_runs;

@@ -36,6 +36,7 @@
 
 mod lanes;
 mod quad;
+mod quad_paths;
 
 use std::sync::atomic::{AtomicU8, Ordering};
 

@@ -1,6 +1,6 @@
 //! Chart 5: parallel efficiency `S / p` (above) and the Karp–Flatt serial fraction
 //! `e = (1/S − 1/p) / (1 − 1/p)` with its 95 % interval as bars (below, only where S > 1 and
-//! the interval lies above 0: [`crate::report::series::Best::serial_fraction`]) against cores,
+//! the interval lies above 0: [`crate::report::cell::Best::serial_fraction`]) against cores,
 //! one line per strategy and placement; the serial-fraction axis is clipped to [0, 1] and
 //! says when it clips. Core counts on SMT siblings are shaded in both panels.
 

@@ -15,13 +15,14 @@ use std::fmt::Write as _;
 
 use super::plan::{CompareChart, ComparePlan, Compared, MachineBest, Ranking};
 use super::sides::{Side, SideRule, same_hardware_sets};
-use crate::report::findings::{Entry, and_list, describe};
+use crate::report::cell::Best;
 use crate::report::load::Sweep;
 use crate::report::markdown::{
     BEST_HEAD, BEST_RULE, CONTENDED, OVERSUBSCRIBED, banners, method, test_data_banner,
 };
 use crate::report::numbers::faster;
-use crate::report::series::{Best, Group};
+use crate::report::series::Group;
+use crate::report::verdict::{Entry, and_list, describe};
 use crate::results::key::LabelStyle;
 use crate::results::rows::{Status, SummaryRow};
 
@@ -408,8 +409,8 @@ mod tests {
     use super::*;
     use crate::report::compare::plan::plan;
     use crate::report::compare::sides::sides;
-    use crate::report::compare::sides::tests::sweep_on;
     use crate::report::view::tests::measured;
+    use crate::results::load::tests::sweep_on;
     use crate::results::rows::Phase;
     use crate::topology::Pin;
     use sph_strategies::StrategyName;

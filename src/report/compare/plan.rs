@@ -20,9 +20,13 @@
 use sph_strategies::StrategyName;
 
 use super::sides::{Side, names};
+use crate::report::cell::Best;
 use crate::report::charts::compare::MachineLines;
-use crate::report::findings::{self, Entry, Unknown, Verdict};
-use crate::report::series::{self, Best, Group, Line, Point, SeriesKey};
+use crate::report::select;
+use crate::report::select::SeriesKey;
+use crate::report::series::{self, Group, Line, Point};
+use crate::report::verdict;
+use crate::report::verdict::{Entry, Unknown, Verdict};
 use crate::report::view::GroupView;
 use crate::results::files::COMPARE_CHART_PREFIX;
 use crate::results::intervals::Ratio;
@@ -191,7 +195,7 @@ pub fn strategy_best(v: &GroupView, s: StrategyName) -> Option<Best> {
 
 /// Every parallel strategy's best cell in `v` over every cores value, in registry order.
 pub fn strategy_bests(v: &GroupView) -> Vec<Entry> {
-    series::strategies(&v.rows, &v.group)
+    select::strategies(&v.rows, &v.group)
         .into_iter()
         .filter(|&s| s != StrategyName::Seq)
         .filter_map(|s| Some((s, Box::new(strategy_best(v, s)?))))
@@ -244,12 +248,12 @@ pub struct MachineBest {
 }
 
 /// The fastest strategy of the group of `v` on side `side`: the verdict of the group's
-/// findings ([`findings::verdict`]) on each strategy's best cell, contended ones left out.
+/// findings ([`verdict::verdict`]) on each strategy's best cell, contended ones left out.
 pub fn machine_best(side: usize, v: &GroupView) -> MachineBest {
     let entries = strategy_bests(v);
-    let trusted = findings::trusted(&entries);
+    let trusted = verdict::trusted(&entries);
     let contended_left_out = entries.len() - trusted.len();
-    let (best, ranking) = match findings::verdict(&trusted) {
+    let (best, ranking) = match verdict::verdict(&trusted) {
         Some(Verdict::Only(e)) => (Some(e), Ranking::Only),
         Some(Verdict::Unknown(e, why)) => (
             Some(e),
@@ -396,7 +400,7 @@ fn compare(sides: &[Side<'_>], names: &[String], matched: Matched) -> Compared {
         } else {
             speedups.push((*i, series::speedup_lines(&v.series_bests())));
         }
-        for s in series::strategies(&v.rows, g) {
+        for s in select::strategies(&v.rows, g) {
             if s != StrategyName::Seq && !strategies.contains(&s) {
                 strategies.push(s);
             }
@@ -486,9 +490,9 @@ pub fn efficiency_of(speedup: &Line) -> Line {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::compare::sides::tests::sweep_on;
     use crate::report::compare::sides::{SideRule, sides};
     use crate::report::view::tests::{measured, of_rows, with_trials};
+    use crate::results::load::tests::sweep_on;
     use crate::results::rows::tests::row;
     use crate::results::rows::{Phase, SummaryRow, TrialRow};
     use crate::topology::Pin;

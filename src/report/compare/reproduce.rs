@@ -5,7 +5,7 @@
 //! - the cells both measured, matched by cell and phase, and the share of them whose 95 %
 //!   speedup intervals overlap, and whose intervals of the time overlap;
 //! - every ranking (one strategy's best cell faster than another's at a core count, by their
-//!   paired rounds: [`findings::order`]) resolved on one side and reversed, or not resolved,
+//!   paired rounds: [`verdict::order`]) resolved on one side and reversed, or not resolved,
 //!   on the other. Contended cells enter no ranking.
 //!
 //! Sides of different machines are a comparison of machines ([`super::plan`]), never this.
@@ -14,9 +14,13 @@ use std::collections::HashMap;
 use std::fmt::Write as _;
 
 use super::sides::{Side, same_hardware_sets};
-use crate::report::findings::{self, Order};
+use crate::report::cell;
 use crate::report::numbers::{faster, percent, plus_minus};
-use crate::report::series::{self, Group, SeriesKey};
+use crate::report::select;
+use crate::report::select::SeriesKey;
+use crate::report::series::Group;
+use crate::report::verdict;
+use crate::report::verdict::Order;
 use crate::results::key::{Cell, LabelStyle};
 use crate::results::rows::{Phase, SummaryRow};
 use crate::results::stats::Interval;
@@ -111,8 +115,8 @@ fn reproduced((i, first): (usize, &Side<'_>), (j, second): (usize, &Side<'_>)) -
         first: i,
         second: j,
         cells: both.len(),
-        speedups: overlap(|r| series::interval(r.speedup_ci_low, r.speedup_ci_high)),
-        times: overlap(|r| series::interval(r.mean_ci_low_s, r.mean_ci_high_s)),
+        speedups: overlap(|r| cell::interval(r.speedup_ci_low, r.speedup_ci_high)),
+        times: overlap(|r| cell::interval(r.mean_ci_low_s, r.mean_ci_high_s)),
         rankings,
         changed,
     }
@@ -127,14 +131,14 @@ fn rankings(first: &Side<'_>, second: &Side<'_>) -> (usize, Vec<Changed>) {
             continue;
         };
         let (ours, theirs) = (v.series_bests(), w.series_bests());
-        let at = |bests: &[(SeriesKey, Vec<series::Best>)], k: SeriesKey, c: usize| {
+        let at = |bests: &[(SeriesKey, Vec<cell::Best>)], k: SeriesKey, c: usize| {
             bests
                 .iter()
                 .find(|(key, _)| *key == k)
                 .and_then(|(_, b)| b.iter().find(|b| b.cores == c && !b.contended))
                 .cloned()
         };
-        for c in series::cores(&v.rows, &v.group) {
+        for c in select::cores(&v.rows, &v.group) {
             for (n, (a, _)) in ours.iter().enumerate() {
                 for (b, _) in &ours[n + 1..] {
                     let (Some(a1), Some(b1), Some(a2), Some(b2)) = (
@@ -145,7 +149,7 @@ fn rankings(first: &Side<'_>, second: &Side<'_>) -> (usize, Vec<Changed>) {
                     ) else {
                         continue;
                     };
-                    let (o1, o2) = (findings::order(&a1, &b1), findings::order(&a2, &b2));
+                    let (o1, o2) = (verdict::order(&a1, &b1), verdict::order(&a2, &b2));
                     if !(o1.resolved() || o2.resolved()) {
                         continue;
                     }
@@ -250,9 +254,9 @@ fn said(o: &Order, c: &Changed) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::compare::sides::tests::sweep_on;
     use crate::report::compare::sides::{SideRule, sides};
     use crate::report::view::tests::measured;
+    use crate::results::load::tests::sweep_on;
     use crate::topology::Pin;
     use sph_strategies::StrategyName::{RayonChunks, RayonIter, Seq};
 

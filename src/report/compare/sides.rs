@@ -146,40 +146,9 @@ pub fn names(sides: &[Side<'_>]) -> Vec<String> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::results::meta::{Meta, Session, SweepStatus};
-    use crate::results::params::SweepParams;
+    use crate::results::load::tests::sweep_on;
     use crate::results::rows::tests::row;
     use sph_strategies::StrategyName;
-
-    /// A sweep in `dir` on a machine with `cpu` and `threads`, holding `rows`.
-    pub(crate) fn sweep_on(dir: &str, cpu: &str, threads: usize, rows: Vec<SummaryRow>) -> Sweep {
-        let machine = Machine {
-            cpu_model: cpu.to_owned(),
-            hardware_threads: threads,
-            os: "Debian GNU/Linux 12 (bookworm)".to_owned(),
-            kernel: "6.1.0".to_owned(),
-            arch: "x86_64".to_owned(),
-            topology: Default::default(),
-        };
-        let session = Session::start(vec!["bench-sph".to_owned()], machine);
-        let params = SweepParams {
-            strategies: vec![StrategyName::RayonChunks, StrategyName::RayonIter],
-            chunks: vec![5, 10],
-            trials: 3,
-            ..SweepParams::small()
-        };
-        let mut meta = Meta::new(params, rows.len(), session);
-        meta.finish(SweepStatus::Complete, rows.len());
-        Sweep {
-            dir: dir.into(),
-            meta,
-            rows,
-            confirmed: Vec::new(),
-            trials: Vec::new(),
-            dropped: Vec::new(),
-            without_trials: false,
-        }
-    }
 
     fn seq() -> Vec<SummaryRow> {
         vec![row(StrategyName::Seq, 1, None, 4.0)]

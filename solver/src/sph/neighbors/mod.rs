@@ -471,3 +471,16 @@ impl AnyNeighbors {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[error("all-pairs has no cells: its sums run in index order")]
 pub struct CellOrderNeedsGrid;
+
+#[cfg(test)]
+mod tests {
+    use super::Eight;
+    use std::mem::{align_of, offset_of};
+
+    #[test]
+    fn eight_lanes_sit_on_a_64_byte_boundary_as_the_simd_paths_lane_arrays_do() {
+        // One vector store of eight f64 lanes then never straddles a cache line or a page.
+        assert_eq!(align_of::<Eight>(), 64);
+        assert_eq!(offset_of!(Eight, r2) % 64, 0);
+    }
+}

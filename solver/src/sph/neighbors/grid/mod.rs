@@ -27,7 +27,10 @@ use sph_strategies::{Executor, KernelPanic};
 
 mod hits;
 pub mod keys;
+mod shape;
 mod sort;
+#[cfg(test)]
+mod sort_tests;
 
 pub use hits::GridScratch;
 use hits::{
@@ -35,6 +38,7 @@ use hits::{
     rank_sort, sort_small,
 };
 use keys::GridKey;
+use shape::Shape;
 pub use sort::PARALLEL_SORT;
 use sort::{CellSort, GridArrays};
 
@@ -149,41 +153,6 @@ impl<K, O> Grid<K, O> {
         4 * (self.start.capacity() + self.order.capacity() + self.cell_of.capacity())
             + 8 * (self.sorted_x.capacity() + self.sorted_y.capacity())
             + self.sort.heap_bytes()
-    }
-}
-
-/// Cell size and counts of a grid (small and `Copy`, so kernels can share it).
-#[derive(Debug, Clone, Copy)]
-struct Shape {
-    /// Cells per px: the reciprocal of the cell edge (just over the kernel radius).
-    per_cell: f64,
-    /// Left edge of the first column.
-    x0: f64,
-    /// Lower edge of the first row.
-    y0: f64,
-    /// Cells along x, the empty column on either side included.
-    cols: usize,
-    /// Cells along y, the empty row on either side included.
-    rows: usize,
-}
-
-impl Shape {
-    /// The (column, row) of a position, inside the ring of empty cells. Positions outside
-    /// the domain fall into the edge cells, which never loses a neighbour: anything within H
-    /// of an edge-cell particle is in that cell or the one next to it.
-    #[inline(always)]
-    fn coords(&self, x: f64, y: f64) -> (usize, usize) {
-        // `as i64` saturates (NaN gives 0) and is one instruction on x86-64, unlike `as usize`.
-        let cx = (((x - self.x0) * self.per_cell) as i64).clamp(0, self.cols as i64 - 3);
-        let cy = (((y - self.y0) * self.per_cell) as i64).clamp(0, self.rows as i64 - 3);
-        (cx as usize + 1, cy as usize + 1)
-    }
-
-    /// The row-major cell number of a position.
-    #[inline]
-    fn cell_of(&self, x: f64, y: f64) -> u32 {
-        let (cx, cy) = self.coords(x, y);
-        (cy * self.cols + cx) as u32
     }
 }
 
