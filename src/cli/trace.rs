@@ -14,13 +14,14 @@ use crate::output::atomic::AtomicFile;
 use crate::output::claim::{self, Claimed, Owner};
 use crate::output::console;
 use crate::output::record::Command;
+use crate::plot::timeline;
 use crate::simd::SimdPath;
 use crate::solver::Simulation;
 use crate::topology::Pin;
 use crate::trace::files::{self, TOOL};
 use crate::trace::size::{self, Plan};
 use crate::trace::stats::{self, Stats};
-use crate::trace::{TraceConfig, TracedRun, chrome, run_traced, run_untraced, timeline};
+use crate::trace::{TraceConfig, TracedRun, chrome, run_traced, run_untraced};
 
 /// Options of `trace`.
 #[derive(Debug, Clone, Args)]

@@ -11,8 +11,9 @@ use crate::output::atomic::AtomicFile;
 use crate::output::claim::{self, Claimed, Owner};
 use crate::output::console;
 use crate::output::record::Command;
+use crate::plot::validation as chart;
 use crate::validate::export::{self, COLUMN_HEIGHT_CSV, SURGE_FRONT_CSV, VALIDATION_PNG};
-use crate::validate::{self, Validation, chart, summary};
+use crate::validate::{self, Validation, summary};
 
 /// Options of `validate`.
 #[derive(Debug, Clone, Args)]

@@ -15,7 +15,7 @@ use std::collections::{HashMap, HashSet};
 
 use anyhow::bail;
 
-use crate::report::numbers::sig;
+use crate::output::digits::sig;
 use crate::results::key::{Cell, Group, LabelStyle};
 use crate::results::load::Dropped;
 use crate::results::rows::{Phase, SummaryRow, TrialRow};

@@ -11,11 +11,13 @@
 //!   by the record, refuses one holding files it did not write (unless `--force`, and even
 //!   then replaces only its own), and removes its own stale files afterwards;
 //! - [`console`]: standard output that may be closed under us (`| head`, `> /dev/full`);
+//! - [`digits`]: numbers for a reader, at most three significant digits;
 //! - [`sniff`]: recognising a file's format by its first bytes (a trace's PNG).
 
 pub mod atomic;
 pub mod claim;
 pub mod console;
+pub mod digits;
 pub mod lock;
 pub mod record;
 pub mod sniff;

@@ -2,32 +2,9 @@
 //! noisy trials does not know its fourth digit); intervals of times as `[low–high]`, relative
 //! results as hyperfine writes them, `1.62 ± 0.04×` (± the larger half of the 95 % interval).
 
+pub use crate::output::digits::sig;
 use crate::results::intervals::Ratio;
 use crate::results::stats::Interval;
-
-/// `v` to three significant digits, without exponent: `0.412`, `2.20`, `39.7`, `1230`.
-pub fn sig(v: f64) -> String {
-    if !v.is_finite() {
-        return v.to_string();
-    }
-    if v == 0.0 {
-        return "0".to_owned();
-    }
-    let magnitude = v.abs().log10().floor() as i32;
-    if magnitude >= 2 {
-        // Whole numbers: round away the digits beyond the third.
-        let unit = 10f64.powi(magnitude - 2);
-        return format!("{:.0}", (v / unit).round() * unit);
-    }
-    let places = (2 - magnitude) as usize;
-    let text = format!("{v:.places$}");
-    // Rounding can add a digit (9.996 → "10.00"): write it again at the new magnitude.
-    let rounded: f64 = text.parse().unwrap_or(v);
-    if rounded.abs().log10().floor() as i32 > magnitude {
-        return sig(rounded);
-    }
-    text
-}
 
 /// Seconds: [`sig`].
 pub fn secs(v: f64) -> String {
@@ -96,14 +73,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn numbers_have_at_most_three_significant_digits() {
-        assert_eq!(sig(39.74), "39.7");
-        assert_eq!(sig(0.54433), "0.544");
-        assert_eq!(sig(2.0), "2.00");
-        assert_eq!(sig(1234.5), "1230");
-        assert_eq!(sig(9.996), "10.0");
-        assert_eq!(sig(0.0), "0");
-        assert_eq!(sig(-0.0123456), "-0.0123");
+    fn report_numbers_have_at_most_three_significant_digits() {
         assert_eq!(times(1.8365), "1.84×");
         assert_eq!(mean_sd(1.0886, Some(0.0218)), "1.09 ± 0.02");
         assert_eq!(percent(8.333), "8.33 %");

@@ -14,7 +14,7 @@
 //! before anything runs, the trace's size is estimated and capped ([`size::MAX_EVENTS`]).
 //!
 //! The [`Trace`] then becomes `trace.json` ([`chrome`], for Perfetto or `chrome://tracing`),
-//! `timeline.png` ([`timeline`], a Gantt chart) and `stats.csv` ([`stats`]), all written by
+//! `timeline.png` ([`crate::plot::timeline`], a Gantt chart) and `stats.csv` ([`stats`]), all written by
 //! pure exporters to `impl Write`; [`files`] names them and recognises a trace directory.
 
 pub mod chrome;
@@ -24,7 +24,6 @@ pub mod recorder;
 pub mod session;
 pub mod size;
 pub mod stats;
-pub mod timeline;
 
 use serde::Serialize;
 

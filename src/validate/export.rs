@@ -2,7 +2,7 @@
 //!
 //! - `surge_front.csv`: `t_s,T,Z`, one row per sample;
 //! - `column_height.csv`: `t_s,tau,H`, one row per sample;
-//! - `validation.png`: the chart ([`super::chart`]).
+//! - `validation.png`: the chart ([`crate::plot::validation`]).
 //!
 //! Numbers are written in the shortest form that parses back to the same bits.
 

@@ -3,12 +3,11 @@
 //!
 //! The pipeline: [`data`] (the experiment's tables, shipped as CSV) → a run of the dam break
 //! to T = 3.4 with the grid search, sampled every 0.01 s by [`probe`] → [`verdict`] (pure:
-//! each point's error and three verdicts) → [`export`] (CSV) and [`chart`] (PNG), and
+//! each point's error and three verdicts) → [`export`] (CSV) and [`crate::plot::validation`] (PNG), and
 //! [`summary`] (the printed table and the JSON object). The run goes through
 //! [`run::run_steps`](crate::run::run_steps) like every other, so any strategy gives the same
 //! bits as `seq`; the time reported is the step loop's (sampling excluded).
 
-pub mod chart;
 pub mod data;
 pub mod export;
 pub mod probe;

@@ -20,12 +20,12 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::TraceConfig;
-use super::chrome::worker_track_name;
-use super::recorder::{Phase, SerialWork, Trace};
-use super::stats::WorkerStats;
-use crate::plot::font;
+use super::font;
 use crate::solver::Pass;
+use crate::trace::TraceConfig;
+use crate::trace::chrome::worker_track_name;
+use crate::trace::recorder::{Phase, SerialWork, Trace};
+use crate::trace::stats::WorkerStats;
 
 /// Width of the image in pixels.
 pub const WIDTH: u32 = 1600;
@@ -497,7 +497,7 @@ mod tests {
     #[test]
     fn a_timeline_shows_each_kernel_call_as_a_bar_of_its_pass_colour_on_its_worker_s_row() {
         let trace = trace();
-        let stats = super::super::stats::compute(&trace);
+        let stats = crate::trace::stats::compute(&trace);
         font::ensure_registered().unwrap();
         let (w, h) = image_size(3);
         let mut pixels = vec![0u8; w as usize * h as usize * 3];

@@ -10,9 +10,9 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use super::data::{Experiment, Point};
-use super::verdict::FRONT_SHIFT;
-use crate::plot::font;
+use super::font;
+use crate::validate::data::{Experiment, Point};
+use crate::validate::verdict::FRONT_SHIFT;
 
 /// Width of the chart, pixels.
 pub const WIDTH: u32 = 1200;
@@ -243,7 +243,7 @@ mod tests {
 
     #[test]
     fn the_plan_keeps_the_experiment_inside_the_axes_and_shifts_the_front() {
-        let e = super::super::data::experiment().unwrap();
+        let e = crate::validate::data::experiment().unwrap();
         let front = pts(&[(0.0, 1.0), (3.4, 4.4)]);
         let column = pts(&[(0.0, 1.0), (2.4, 0.4)]);
         let c = plan(&e, &front, &column, 20);
@@ -261,7 +261,7 @@ mod tests {
 
     #[test]
     fn the_chart_is_a_png_of_its_size() {
-        let e = super::super::data::experiment().unwrap();
+        let e = crate::validate::data::experiment().unwrap();
         let front = pts(&[(0.0, 1.0), (3.4, 4.4)]);
         let column = pts(&[(0.0, 1.0), (2.4, 0.4)]);
         let mut out = Vec::new();
