@@ -77,7 +77,7 @@ fn ms(ns: u64) -> f64 {
 }
 
 /// Draws the steps `steps` (1-based, inclusive; clamped to the traced ones) of `trace` and
-/// writes the PNG to `out`. `workers` names the rows (from [`super::stats::compute`]).
+/// writes the PNG to `out`. `workers` names the rows (from [`crate::trace::stats::compute`]).
 pub fn write_png<W: Write>(
     trace: &Trace,
     workers: &[WorkerStats],
