@@ -21,7 +21,7 @@ use crate::results::load::Dropped;
 use crate::results::rows::{Phase, SummaryRow, TrialRow};
 use crate::results::shard::Shard;
 use crate::results::summarize::{CellContext, summary_row};
-use crate::sweep::plan::Plan;
+use crate::sweep::Plan;
 
 /// One shard's believed cells.
 #[derive(Debug, Clone)]

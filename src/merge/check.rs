@@ -10,7 +10,7 @@ use crate::results::meta::{Meta, SWEEP_TOOL};
 use crate::results::params::SweepParams;
 use crate::results::rows::{Phase, Status, SummaryRow, TrialRow};
 use crate::results::shard::Shard;
-use crate::sweep::plan::Plan;
+use crate::sweep::Plan;
 
 /// A shard directory's `meta.json`, with where it was read from.
 #[derive(Debug, Clone)]

@@ -28,12 +28,12 @@ use anyhow::{Context, bail};
 use crate::output::console::plural;
 use crate::output::lock;
 use crate::output::record::Command;
+use crate::results::export::to_csv;
 use crate::results::load::{Dropped, believed_with, read_summary, read_trials};
 use crate::results::meta::{Merge, MergedShard, Meta, SweepStatus};
 use crate::results::rows::{SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow};
 use crate::results::{META_FILE, REFERENCES_FILE, SUMMARY_FILE, TRIALS_FILE};
-use crate::sweep::export::to_csv;
-use crate::sweep::plan::Plan;
+use crate::sweep::Plan;
 use assemble::Part;
 
 /// One invocation of `bench-sph merge`.
@@ -155,7 +155,7 @@ pub fn run(request: &Request) -> anyhow::Result<Merged> {
         ));
     }
     let meta = merged_meta(&read, &shards, &params, &whole, &merged, &warnings);
-    let mut claimed = crate::sweep::dir::open_new(&request.out, request.force, Command::Merge)?;
+    let mut claimed = crate::results::dir::open_new(&request.out, request.force, Command::Merge)?;
     claimed.record(&[TRIALS_FILE, SUMMARY_FILE, REFERENCES_FILE, META_FILE])?;
     write_all(&request.out, &merged, &meta)?;
     drop(claimed);

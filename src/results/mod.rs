@@ -3,8 +3,9 @@
 //! `trials.csv` and `summary.csv` ([`rows`]), `meta.json` ([`meta`]) with the sweep's
 //! parameters ([`params`]) written by name ([`names`]), the statistics of a cell ([`stats`])
 //! and their intervals ([`intervals`]), a cell's summary row from its trial rows
-//! ([`summarize`]), the checks a cell read back must pass ([`validate`]) and the lenient
-//! reading of whole directories ([`load`]).
+//! ([`summarize`]), the checks a cell read back must pass ([`validate`]), writing the two CSVs
+//! ([`export`]), the lenient reading of whole directories ([`load`]), and opening a directory
+//! to write results into ([`dir`]: new or empty, or an earlier sweep's with `--force`).
 //!
 //! A results directory holds:
 //! - `trials.csv`: one row per timed run (columns [`rows::TRIAL_COLUMNS`]), with its phase,
@@ -19,6 +20,8 @@
 //!   of the files it wrote there (`bench-sph-files.json`, [`crate::output::record`]) and the
 //!   lock file (`bench-sph.lock`, [`crate::output::lock`]).
 
+pub mod dir;
+pub mod export;
 pub mod files;
 pub mod intervals;
 pub mod key;

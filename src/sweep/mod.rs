@@ -6,8 +6,9 @@
 //! (the reference run, the checksum guard, [`windows`] of contention, the wait for a quiet
 //! machine, progress, Ctrl-C) and, after the grid, the cells [`confirm`] chooses; [`rows`]
 //! turns a run into its row and [`crate::results::summarize`] a phase's rows into summary
-//! rows (paired speedups, intervals from [`crate::results::intervals`]); [`export`] writes
-//! `trials.csv` and `summary.csv` as runs finish, and `meta.json` records the sessions;
+//! rows (paired speedups, intervals from [`crate::results::intervals`]);
+//! [`crate::results::export`] writes `trials.csv` and `summary.csv` as runs finish, and
+//! `meta.json` records the sessions (the directory itself: [`crate::results::dir`]);
 //! [`resume`] continues an interrupted sweep; [`console`] formats what is printed. The CLI
 //! then draws the report into the directory (`crate::cli::sweep::run`).
 //!
@@ -17,8 +18,6 @@ pub mod confirm;
 pub mod console;
 #[cfg(test)]
 mod coverage;
-pub mod dir;
-pub mod export;
 pub mod input;
 pub mod params;
 pub mod plan;
@@ -42,12 +41,15 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use crate::output::console::plural;
 use crate::output::lock::DirLock;
 use crate::output::record::Command;
+use crate::results::dir as results_dir;
+use crate::results::export::Exporter;
 use crate::results::key::{Cell, Group};
 use crate::results::meta::{Machine, Meta, Session, SweepStatus};
 use crate::results::rows::{Phase, Status, SummaryRow, TrialRow};
 use crate::results::shard::Shard;
 use params::SweepParams;
-use plan::{LabelStyle, Plan};
+use plan::LabelStyle;
+pub use plan::Plan;
 use range::{Axis, compact};
 use runner::{Kept, Runner};
 use schedule::Schedule;
@@ -189,7 +191,7 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
     }
     let run_ms = run_ms(&estimate(&plan, &left, &params, hardware_threads)?);
 
-    let exporter = export::Exporter::new(
+    let exporter = Exporter::new(
         append(&opened.dir.join(TRIALS_FILE))?,
         append(&opened.dir.join(SUMMARY_FILE))?,
         opened.fresh,
@@ -523,9 +525,9 @@ fn start_new(
     check_memory(&Plan::new(params))?;
     let dir = match out {
         Some(dir) => dir.to_path_buf(),
-        None => dir::new_default()?,
+        None => results_dir::new_default()?,
     };
-    let mut claimed = dir::open_new(&dir, force, Command::Sweep)?;
+    let mut claimed = results_dir::open_new(&dir, force, Command::Sweep)?;
     claimed.record(&[TRIALS_FILE, SUMMARY_FILE, META_FILE])?;
     let lock = claimed.lock();
     let plan = Plan::new(params);
@@ -546,7 +548,7 @@ fn start_new(
 /// `remeasure`, without the rows of every group that has a contended cell), and records this
 /// session in its `meta.json`.
 fn reopen(dir: &Path, session: Session, remeasure: bool) -> anyhow::Result<Opened> {
-    let lock = dir::open_existing(dir)?;
+    let lock = results_dir::open_existing(dir)?;
     let meta_path = dir.join(META_FILE);
     let mut meta = Meta::read(&meta_path)?;
     if meta.merge.is_some() {

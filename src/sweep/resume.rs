@@ -25,9 +25,9 @@ use std::path::Path;
 
 use anyhow::Context;
 
-use super::export::to_csv;
 use super::plan::Cell;
 use crate::io::capped;
+use crate::results::export::to_csv;
 use crate::results::key::Group;
 use crate::results::rows::{
     Phase, SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow, is_older_summary_header,
@@ -338,11 +338,11 @@ pub fn write_back(dir: &Path, repaired: &Repaired) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::results::export::Exporter;
     use crate::results::key::test_group;
     use crate::results::rows::Status;
     use crate::results::summarize::{CellContext, fixtures, summary_row};
     use crate::sph::neighbors::NeighborMode;
-    use crate::sweep::export::Exporter;
     use crate::sweep::plan::Cell;
     use sph_strategies::StrategyName;
 

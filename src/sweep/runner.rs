@@ -27,7 +27,6 @@ use indicatif::ProgressBar;
 
 use super::confirm;
 use super::console;
-use super::export::Exporter;
 use super::input::GroupInput;
 use super::plan::{Cell, Group, Plan};
 use super::rows::{Measured, trial_row};
@@ -35,6 +34,7 @@ use super::schedule::{self, Run, Schedule};
 use super::timing::{Timing, Trial, fake_index};
 use super::windows::{Verdict, Windows};
 use crate::contention::Threshold;
+use crate::results::export::Exporter;
 use crate::results::params::SweepParams;
 use crate::results::rows::{Phase, Status, SummaryRow, TrialRow};
 use crate::results::summarize::{CellContext, summary_row};

@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
-use super::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
+use super::files::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
 use crate::output::claim::{self, Claimed, Owner};
 use crate::output::lock::{self, DirLock, LOCK_FILE};
 use crate::output::record::{self, Command, Record};

@@ -3,11 +3,11 @@
 //!
 //! A phase's runs are written before its summary rows: a sweep killed in between leaves runs
 //! without summary rows, which `--resume` keeps as the phase's finished runs and continues
-//! (see [`super::resume`]). A line cut off by a kill is dropped there.
+//! (see [`crate::sweep::resume`]). A line cut off by a kill is dropped there.
 
 use std::io::Write;
 
-use crate::results::rows::{SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow};
+use super::rows::{SUMMARY_COLUMNS, SummaryRow, TRIAL_COLUMNS, TrialRow};
 
 /// Writes cells to the two CSV streams.
 #[derive(Debug)]
