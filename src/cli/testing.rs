@@ -1,5 +1,5 @@
 //! Test hooks: options that exist only in a build with the `testing` cargo feature, which the
-//! integration tests enable (`cargo test --release --workspace --all-features`). The shipped
+//! integration tests enable (`cargo test --profile ci --workspace --all-features`). The shipped
 //! binary (`cargo install --path . --locked`) does not know them: `--fake-timings` there is an
 //! unknown argument, and nothing of them reaches a real sweep's `meta.json`.
 //!

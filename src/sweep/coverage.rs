@@ -11,7 +11,7 @@
 //! With rounds, drift and steps hit a cell and the round's `seq` alike, so their ratio keeps
 //! the truth; cell after cell, `seq` runs first and every later cell inherits the machine's
 //! change: the intervals stop covering, which is why rounds are the default. Run with
-//! `cargo test --release coverage -- --nocapture` to see the table.
+//! `cargo test --profile ci coverage -- --nocapture` to see the table.
 
 use super::schedule::{self, Schedule};
 use crate::results::intervals;

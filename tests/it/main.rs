@@ -1,12 +1,12 @@
-//! The root package's integration tests, in one test binary: one binary links (thin LTO,
-//! one codegen unit under `--release`) once instead of once per file. Each file of this
-//! directory is a module, named as its test binary was (`cargo test --release --test it
+//! The root package's integration tests, in one test binary: one binary links once instead
+//! of once per file. Each file of this
+//! directory is a module, named as its test binary was (`cargo test --profile ci --test it
 //! cli_sweep::` runs what `--test cli_sweep` ran); `common` holds the helpers they share.
 //! The fixtures stay in `tests/fixtures/`, found from `CARGO_MANIFEST_DIR`.
 //!
 //! The binary needs the test hooks of bench-sph (`sweep --fake-timings`, ...), which exist
 //! only with the `testing` cargo feature: Cargo.toml makes it a required feature, so the
-//! README's `cargo test --release --workspace --all-features` runs it, and a plain `cargo test
+//! README's `cargo test --profile ci --workspace --all-features` runs it, and a plain `cargo test
 //! --test it` says which feature to add.
 //!
 //! All modules' tests share one process and its test threads (as many as the machine has
