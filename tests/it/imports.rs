@@ -3,7 +3,7 @@
 //! two files that import each other (directly or through others) are one piece of code split
 //! in two, and belong either together or with the shared part moved below both.
 //!
-//! Read from the sources, not the compiler: each `use` path (`crate::`, `super::`, `self::`,
+//! Read from the sources (parsed with `syn`), not the compiler: each `use` path (`crate::`, `super::`, `self::`,
 //! or a child module's name) is resolved to the deepest module file it names, test modules
 //! included; paths into other crates are the layers' business (`layers.rs`). A re-export
 //! (`pub use`) is a signpost, not an import: a path through it leads to the file that defines
@@ -12,6 +12,9 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
 use std::path::{Path, PathBuf};
+
+use syn::visit::{self, Visit};
+use syn::{ItemMod, ItemUse, UseTree, Visibility};
 
 /// A module, as the path of names from its crate's root.
 type Module = Vec<String>;
@@ -52,176 +55,68 @@ fn rust_files(dir: &Path, skip: &[&str]) -> Vec<PathBuf> {
     out
 }
 
-/// `text` without its comments and with its string and character literals emptied, so that
-/// neither a `use` nor a brace inside them counts.
-fn code_only(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    let mut rest = text;
-    while let Some(c) = rest.chars().next() {
-        let (kept, after) = if let Some(after) = rest.strip_prefix("//") {
-            ("", after.find('\n').map_or("", |i| &after[i..]))
-        } else if let Some(after) = rest.strip_prefix("/*") {
-            ("", after.find("*/").map_or("", |i| &after[i + 2..]))
-        } else if let Some(after) = rest.strip_prefix("r#\"") {
-            ("\"\"", after.find("\"#").map_or("", |i| &after[i + 2..]))
-        } else if let Some(after) = rest.strip_prefix('"') {
-            ("\"\"", after_string(after))
-        } else if let Some(after) = ["'\"'", "'\\''", "'\\\"'", "'{'", "'}'", "';'"]
-            .iter()
-            .find_map(|lit| rest.strip_prefix(lit))
-        {
-            ("' '", after)
-        } else {
-            out.push(c);
-            rest = &rest[c.len_utf8()..];
-            continue;
-        };
-        out.push_str(kept);
-        rest = after;
-    }
-    out
-}
-
-/// What follows the string literal whose body starts `body` (escapes honoured).
-fn after_string(body: &str) -> &str {
-    let mut escaped = false;
-    for (i, c) in body.char_indices() {
-        match c {
-            '\\' if !escaped => escaped = true,
-            '"' if !escaped => return &body[i + 1..],
-            _ => escaped = false,
-        }
-    }
-    ""
-}
-
-/// Whether a statement's words so far open a `use` declaration (`use`, `pub use`,
-/// `pub(crate) use`, after any attributes).
-fn is_use(words: &str) -> bool {
-    let mut rest = words;
-    // Attributes first: `#[cfg(test)]`, `#[allow(a, b)]`.
-    while let Some(at) = rest.find("#[") {
-        rest = rest[at..].find(']').map_or("", |end| &rest[at + end + 1..]);
-    }
-    rest.split_whitespace()
-        .find(|w| !w.starts_with("#[") && !w.starts_with("pub"))
-        .is_some_and(|w| w == "use")
-}
-
-/// The inline module a statement's words open before `{` (`mod tests`), if any.
-fn inline_module(words: &str) -> Option<String> {
-    let mut it = words.split_whitespace().skip_while(|&w| w != "mod");
-    it.next()?;
-    it.next().map(str::to_owned)
-}
-
-/// A use tree's text with the spaces that do not separate words removed: `a::{b, c as d}`
-/// becomes `a::{b,c as d}`.
-fn tidy(tree: &str) -> String {
-    let words = tree.split_whitespace().collect::<Vec<_>>().join(" ");
-    let mut out = String::new();
-    for c in words.chars() {
-        if c == ' ' && out.ends_with([':', '{', ',']) {
-            continue;
-        }
-        if matches!(c, ':' | '{' | '}' | ',') && out.ends_with(' ') {
-            out.pop();
-        }
-        out.push(c);
-    }
-    out
-}
-
-/// One `use` declaration: its tree, the inline modules (`mod tests { ... }`) it sits in, and
-/// whether it is a re-export (`pub use`, any visibility).
+/// One `use` declaration: the paths it imports (`a::{b, c as d}` gives `a::b` and `a::c`),
+/// the inline modules (`mod tests { ... }`) it sits in, and whether it is a re-export
+/// (`pub use`, any visibility).
 struct Use {
     inline: Module,
-    tree: String,
+    paths: Vec<String>,
     public: bool,
 }
 
-/// The `use` declarations of `text`.
-fn use_trees(text: &str) -> Vec<Use> {
-    let text = code_only(text);
-    let mut out = Vec::new();
-    // The inline modules open here, with the brace depth inside each.
-    let mut inline: Vec<(String, usize)> = Vec::new();
-    let mut depth = 0usize;
-    let mut words = String::new();
-    // Braces open inside the use tree being read, once one is.
-    let mut in_use: Option<usize> = None;
-    for c in text.chars() {
-        if let Some(open) = in_use.as_mut() {
-            match c {
-                '{' => *open += 1,
-                '}' => *open -= 1,
-                ';' if *open == 0 => {
-                    let (before, tree) = words.split_once("use ").unwrap_or(("", ""));
-                    out.push(Use {
-                        inline: inline.iter().map(|(n, _)| n.clone()).collect(),
-                        tree: tidy(tree),
-                        public: before.split_whitespace().any(|w| w.starts_with("pub")),
-                    });
-                    words.clear();
-                    in_use = None;
-                    continue;
-                }
-                _ => {}
-            }
-            words.push(c);
-            continue;
-        }
-        match c {
-            '{' | '}' | ';' => {
-                if c == '{' {
-                    depth += 1;
-                    if let Some(name) = inline_module(&words) {
-                        inline.push((name, depth));
-                    }
-                } else if c == '}' {
-                    if inline.last().is_some_and(|&(_, d)| d == depth) {
-                        inline.pop();
-                    }
-                    depth = depth.saturating_sub(1);
-                }
-                words.clear();
-            }
-            _ => {
-                words.push(c);
-                if c.is_whitespace() && is_use(&words) {
-                    in_use = Some(0);
-                }
-            }
-        }
-    }
-    out
+/// The `use` declarations of a file's syntax tree, inline modules and function bodies
+/// included.
+#[derive(Default)]
+struct Uses {
+    inline: Module,
+    found: Vec<Use>,
 }
 
-/// The paths of a use tree: `a::{b, c::{d, e}}` gives `a::b`, `a::c::d`, `a::c::e`.
-fn paths(tree: &str) -> Vec<String> {
-    let Some(open) = tree.find('{') else {
-        return vec![tree.split(" as ").next().unwrap_or(tree).to_owned()];
-    };
-    let (prefix, inner) = (&tree[..open], &tree[open + 1..tree.len() - 1]);
-    let mut parts = Vec::new();
-    let (mut level, mut start) = (0usize, 0usize);
-    for (i, c) in inner.char_indices() {
-        match c {
-            '{' => level += 1,
-            '}' => level -= 1,
-            ',' if level == 0 => {
-                parts.push(&inner[start..i]);
-                start = i + 1;
-            }
-            _ => {}
-        }
+impl<'ast> Visit<'ast> for Uses {
+    fn visit_item_mod(&mut self, m: &'ast ItemMod) {
+        self.inline.push(m.ident.to_string());
+        visit::visit_item_mod(self, m);
+        self.inline.pop();
     }
-    parts.push(&inner[start..]);
-    parts
-        .into_iter()
-        .filter(|p| !p.is_empty())
-        .flat_map(|p| paths(&format!("{prefix}{p}")))
-        .collect()
+
+    fn visit_item_use(&mut self, u: &'ast ItemUse) {
+        let mut paths = Vec::new();
+        flatten(&u.tree, String::new(), &mut paths);
+        self.found.push(Use {
+            inline: self.inline.clone(),
+            paths,
+            public: !matches!(u.vis, Visibility::Inherited),
+        });
+    }
+}
+
+/// The paths of a use tree, each under `prefix`; a rename imports its original name, a glob
+/// ends in `*`.
+fn flatten(tree: &UseTree, prefix: String, out: &mut Vec<String>) {
+    let joined = |name: &dyn std::fmt::Display| {
+        if prefix.is_empty() {
+            name.to_string()
+        } else {
+            format!("{prefix}::{name}")
+        }
+    };
+    match tree {
+        UseTree::Path(p) => flatten(&p.tree, joined(&p.ident), out),
+        UseTree::Name(n) => out.push(joined(&n.ident)),
+        UseTree::Rename(r) => out.push(joined(&r.ident)),
+        UseTree::Glob(_) => out.push(joined(&"*")),
+        UseTree::Group(g) => g.items.iter().for_each(|t| flatten(t, prefix.clone(), out)),
+    }
+}
+
+/// The `use` declarations of the source file `file`.
+fn uses_of(file: &Path) -> Vec<Use> {
+    let text = fs::read_to_string(file).expect("a readable source file");
+    let tree = syn::parse_file(&text)
+        .unwrap_or_else(|e| panic!("{}: not Rust syn can parse: {e}", file.display()));
+    let mut uses = Uses::default();
+    uses.visit_file(&tree);
+    uses.found
 }
 
 /// The module file a use path in module `at` names, if it is in this crate, with the name
@@ -284,16 +179,13 @@ fn resolve(
 fn import_graph(dir: &Path, skip: &[&str]) -> BTreeMap<Module, BTreeSet<Module>> {
     let files: Vec<(Module, Vec<Use>)> = rust_files(dir, skip)
         .into_iter()
-        .map(|f| {
-            let text = fs::read_to_string(&f).expect("a readable source file");
-            (module_of(dir, &f), use_trees(&text))
-        })
+        .map(|f| (module_of(dir, &f), uses_of(&f)))
         .collect();
     let modules: BTreeSet<Module> = files.iter().map(|(m, _)| m.clone()).collect();
     // Each use's paths, resolved from where it sits.
     let resolved = |module: &Module, u: &Use| -> Vec<(Module, Option<String>)> {
         let at: Module = module.iter().chain(&u.inline).cloned().collect();
-        paths(&u.tree)
+        u.paths
             .iter()
             .filter_map(|p| resolve(&modules, &at, p))
             .collect()
