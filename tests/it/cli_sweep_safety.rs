@@ -122,6 +122,11 @@ fn long_sweep(dir: &Path) -> Child {
     wait_until("the sweep never took its lock", || {
         std::fs::read_to_string(&lock).is_ok_and(|s| s.trim() == holder)
     });
+    // Its meta.json follows the lock by a moment, longer when the test threads hold both
+    // cores; killed before it, the directory would not be a sweep's to resume.
+    wait_until("the sweep never wrote its meta.json", || {
+        dir.join("meta.json").is_file()
+    });
     child
 }
 
