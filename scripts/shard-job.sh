@@ -26,7 +26,7 @@ set -euo pipefail
 
 # The most shards a sweep takes (bench-sph sweep --shard I/K: 1 <= I <= K <= 1024).
 MAX_SHARDS=1024
-# The most worker threads a sweep takes (src/limits.rs).
+# The most worker threads a sweep takes (harness/src/limits.rs).
 MAX_CORES=1024
 # The record of a sharded sweep in its results directory: written when it starts, read by -r.
 PLAN_FILE=sharding.txt

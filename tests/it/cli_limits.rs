@@ -1,4 +1,4 @@
-//! Every numeric option has a documented range (`src/limits.rs`), checked when the command
+//! Every numeric option has a documented range (`harness/src/limits.rs`), checked when the command
 //! line is parsed: a value beyond it is a clear error with a non-zero exit, before any thread
 //! is started or any memory allocated — never an abort, a panic or a hang.
 

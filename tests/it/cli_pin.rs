@@ -2,7 +2,7 @@
 //! checksum on `simulate`; `trace` records the placement; `sweep --pin` makes it a cell
 //! dimension with `pin` and `smt` columns; `meta.json` carries the machine's topology; a bad
 //! placement name is a clear error. (This 2-core machine has no SMT: the SMT cases are tested
-//! on injected topologies in `src/topology`.)
+//! on injected topologies in `harness/src/topology`.)
 
 use crate::common::*;
 

@@ -1,6 +1,8 @@
 //! The workspace's crates are its layers, and a lower one never names a higher one:
 //! `sph-strategies` (scheduling) knows nothing of SPH, `sph-solver` (the physics) knows the
-//! strategies and nothing of the harness, the report or the command line. Read from
+//! strategies and nothing of the harness, the report or the command line; `sph-harness`
+//! (measuring and keeping) knows nothing of the report or the command line, `sph-report`
+//! (words and pictures) nothing of the command line. Read from
 //! `cargo metadata`, so a dependency added to the wrong Cargo.toml fails here.
 
 use std::collections::BTreeMap;
@@ -94,4 +96,35 @@ fn no_workspace_crate_depends_on_the_binary_crate() {
         .map(|(k, _)| k)
         .collect();
     assert!(users.is_empty(), "{users:?} depend on bench-sph");
+}
+
+#[test]
+fn the_harness_depends_on_no_report_drawing_or_command_line_crate() {
+    let deps = dependencies();
+    let above = [
+        "sph-report",
+        "bench-sph",
+        "clap",
+        "plotters",
+        "png",
+        "gif",
+        "ab_glyph",
+    ];
+    let named: Vec<&str> = above
+        .into_iter()
+        .filter(|a| deps["sph-harness"].iter().any(|d| d == a))
+        .collect();
+    assert!(named.is_empty(), "sph-harness depends on {named:?}");
+    assert!(deps["sph-harness"].contains(&"sph-solver".to_owned()));
+}
+
+#[test]
+fn the_report_depends_on_the_harness_and_no_command_line_crate() {
+    let deps = dependencies();
+    let named: Vec<&String> = deps["sph-report"]
+        .iter()
+        .filter(|d| ["bench-sph", "clap"].contains(&d.as_str()))
+        .collect();
+    assert!(named.is_empty(), "sph-report depends on {named:?}");
+    assert!(deps["sph-report"].contains(&"sph-harness".to_owned()));
 }
