@@ -100,7 +100,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
         chunks: args.parallel.chunks,
         cores,
         steps: args.steps,
-        passes: Simulation::passes_of(&scene.physics).len(),
+        passes: scene.physics.passes().len(),
         neighbors: args.scene.neighbors,
     }
     .check()?;

@@ -1,27 +1,31 @@
 //! One step = the model's passes over the particles, each handed to a strategy's executor,
 //! plus the grid rebuild before them and the divergence check after them: three passes for
 //! Müller's model (density, forces, integrate), six for WCSPH (max speed, neighbours, walls,
-//! momentum, continuity, integrate). How each pass is cut into kernel calls lives in `schedule`, one
-//! file per model; the one step loop ([`Simulation::advance_with`]) and the [`StepHooks`]
-//! through which a caller wraps each phase's executor (tracing, fault injection) or the
-//! check, in `step`.
+//! momentum, continuity, integrate). What the solver asks of a model is [`model::Model`];
+//! how each model cuts its passes into kernel calls lives in `models`, one file per model;
+//! the one step loop ([`Simulation::advance_with`]) and the [`StepHooks`] through which a
+//! caller wraps each phase's executor (tracing, fault injection) or the check, in `step`.
 
-mod schedule;
+pub mod model;
+mod models;
+pub mod pass;
+mod search;
 mod step;
 
-pub use schedule::wcsph::SPEED_BLOCK;
+pub use models::wcsph::SPEED_BLOCK;
+pub use pass::Pass;
 pub use step::{Phase, PhaseJob, StepHooks};
 
 use sph_strategies::{Executor, KernelPanic};
 
 use crate::simd::{self, AnyLanes, SimdPath};
+use crate::solver::model::{AnyScratch, Model, Particles};
+use crate::solver::search::with_search;
 use crate::sph::neighbors::{
-    self, AnyNeighbors, CellOrderNeedsGrid, GridKeys, NeighborMode, Neighbors, SLOTS, Searched,
-    SumOrder, WCSPH_SLOTS,
+    self, AnyNeighbors, CellOrderNeedsGrid, GridKeys, NeighborMode, Neighbors, SumOrder,
 };
-use crate::sph::physics::Physics;
+use crate::sph::physics::{Physics, with_model};
 use crate::sph::state::{Domain, Positions, State};
-use crate::with_lanes;
 
 /// Why a step failed.
 #[derive(Debug, thiserror::Error)]
@@ -75,125 +79,7 @@ pub struct Simulation {
     pub time_s: f64,
     neighbors: AnyNeighbors,
     lanes: AnyLanes,
-    wcsph: schedule::wcsph::Scratch,
-}
-
-/// One pass of a step, for benchmarks and traces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Pass {
-    /// Müller: density and pressure (and each particle's neighbour list).
-    Density,
-    /// Müller: pressure, viscosity and gravity forces.
-    Forces,
-    /// Both: each particle's own update (Müller: symplectic Euler and the walls; WCSPH: kick,
-    /// density, drift).
-    Integrate,
-    /// WCSPH: the largest fluid speed, a reduction, and from it the time step.
-    MaxSpeed,
-    /// WCSPH: every particle's neighbour list.
-    Neighbors,
-    /// WCSPH: the walls' pressure and density from the fluid.
-    Walls,
-    /// WCSPH: each fluid particle's acceleration (and its neighbour list).
-    Momentum,
-    /// WCSPH: each fluid particle's density rate.
-    Continuity,
-}
-
-impl Pass {
-    /// Müller's three passes in step order.
-    pub const MUELLER: [Pass; 3] = [Pass::Density, Pass::Forces, Pass::Integrate];
-
-    /// The WCSPH step's six passes in step order.
-    pub const WCSPH: [Pass; 6] = [
-        Pass::MaxSpeed,
-        Pass::Neighbors,
-        Pass::Walls,
-        Pass::Momentum,
-        Pass::Continuity,
-        Pass::Integrate,
-    ];
-
-    /// Every pass: Müller's, then those only WCSPH has.
-    pub const ALL: [Pass; 8] = [
-        Pass::Density,
-        Pass::Forces,
-        Pass::Integrate,
-        Pass::MaxSpeed,
-        Pass::Neighbors,
-        Pass::Walls,
-        Pass::Momentum,
-        Pass::Continuity,
-    ];
-
-    /// Lower-case name, as in bench ids and traces.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Pass::Density => "density",
-            Pass::Forces => "forces",
-            Pass::Integrate => "integrate",
-            Pass::MaxSpeed => "max speed",
-            Pass::Neighbors => "neighbours",
-            Pass::Walls => "walls",
-            Pass::Momentum => "momentum",
-            Pass::Continuity => "continuity",
-        }
-    }
-}
-
-/// Runs `$body` with `$nb` bound to the concrete search inside `$any` (a `&mut AnyNeighbors`)
-/// and `$lists` to its lists, so that the code in `$body` is monomorphised per search (picked
-/// once per call, not per particle).
-macro_rules! with_search {
-    ($any:expr, ($nb:ident, $lists:ident) => $body:expr) => {
-        match $any {
-            AnyNeighbors::AllPairs(Searched {
-                search: $nb,
-                lists: $lists,
-            }) => $body,
-            AnyNeighbors::GridByPosition(Searched {
-                search: $nb,
-                lists: $lists,
-            }) => $body,
-            AnyNeighbors::GridByIndex(Searched {
-                search: $nb,
-                lists: $lists,
-            }) => $body,
-            AnyNeighbors::GridInCellOrder(Searched {
-                search: $nb,
-                lists: $lists,
-            }) => $body,
-            AnyNeighbors::GridByIndexInCellOrder(Searched {
-                search: $nb,
-                lists: $lists,
-            }) => $body,
-        }
-    };
-}
-
-/// [`with_search!`], and `$l` bound to the lanes the search tests candidates in: the run's
-/// SIMD path for all-pairs; for the grid AVX-512's, which packs a row's hits eight candidates
-/// at a time (where the grid's `scans_packed` says so), and otherwise the portable lanes: the
-/// grid tests its few candidates per row one by one there, compiled for the target. Müller's
-/// force pass, which searches only for a pile, gets the run's path on every search.
-macro_rules! with_search_lanes {
-    ($any:expr, $lanes:expr, ($nb:ident, $lists:ident, $l:ident) => $body:expr) => {
-        match $any {
-            AnyNeighbors::AllPairs(Searched { search: $nb, lists: $lists }) => {
-                with_lanes!($lanes, $l => $body)
-            }
-            // Every grid (`with_search!`'s all-pairs arm is never taken here).
-            #[cfg(target_arch = "x86_64")]
-            grid if matches!($lanes, simd::AnyLanes::Avx512(_)) => {
-                let simd::AnyLanes::Avx512($l) = $lanes else { unreachable!() };
-                with_search!(grid, ($nb, $lists) => $body)
-            }
-            grid => {
-                let $l = simd::Portable;
-                with_search!(grid, ($nb, $lists) => $body)
-            }
-        }
-    };
+    scratch: AnyScratch,
 }
 
 impl Simulation {
@@ -205,18 +91,12 @@ impl Simulation {
         mode: NeighborMode,
     ) -> Self {
         let physics = physics.into();
-        let (fluid, state_len) = (physics.fluid(state.len()), state.len());
+        let n = state.len();
         let bounds = physics.search_bounds(domain);
-        let lists = match physics {
-            Physics::Mueller(_) => (fluid, SLOTS),
-            Physics::Wcsph(_) => (state_len, WCSPH_SLOTS),
-        };
+        let lists = with_model!(physics, m => m.lists(n));
         let radius = physics.search_radius();
-        let neighbors = neighbors::build(mode, bounds, radius, state_len, lists);
-        let wcsph = match physics {
-            Physics::Mueller(_) => schedule::wcsph::Scratch::new(0),
-            Physics::Wcsph(_) => schedule::wcsph::Scratch::new(fluid),
-        };
+        let neighbors = neighbors::build(mode, bounds, radius, n, lists);
+        let scratch = with_model!(&physics, m => AnyScratch::of_model(m, n));
         Simulation {
             physics,
             domain,
@@ -227,7 +107,7 @@ impl Simulation {
             lanes: simd::current()
                 .lanes()
                 .expect("the current SIMD path was checked available"),
-            wcsph,
+            scratch,
         }
     }
 
@@ -287,9 +167,10 @@ impl Simulation {
     /// run on the grid on another path, which uses none of them (the grid then tests its few
     /// candidates per row one by one).
     pub fn simd(&self) -> SimdPath {
-        match (&self.neighbors, &self.physics, self.lanes.path()) {
+        let on_grid = with_model!(self.physics, m => lanes_on_grid(&m));
+        match (&self.neighbors, on_grid, self.lanes.path()) {
             (AnyNeighbors::AllPairs(_), _, path)
-            | (_, Physics::Mueller(_), path)
+            | (_, true, path)
             | (_, _, path @ SimdPath::Avx512) => path,
             _ => SimdPath::Portable,
         }
@@ -297,15 +178,7 @@ impl Simulation {
 
     /// The model's passes, in step order.
     pub fn passes(&self) -> &'static [Pass] {
-        Self::passes_of(&self.physics)
-    }
-
-    /// The passes of `physics`' model, in step order.
-    pub fn passes_of(physics: &Physics) -> &'static [Pass] {
-        match physics {
-            Physics::Mueller(_) => &Pass::MUELLER,
-            Physics::Wcsph(_) => &Pass::WCSPH,
-        }
+        self.physics.passes()
     }
 
     /// Particles that move: the first `fluid()` of the state (the rest are walls).
@@ -315,10 +188,7 @@ impl Simulation {
 
     /// The time step of the last step (WCSPH's adapts to the flow), s.
     pub fn last_dt(&self) -> f64 {
-        match self.physics {
-            Physics::Mueller(p) => p.dt,
-            Physics::Wcsph(_) => self.wcsph.dt,
-        }
+        with_model!(&self.physics, m => m.last_dt(self.scratch.of()))
     }
 
     /// Brings the neighbour search up to date with the current positions, on `exec`.
@@ -344,45 +214,24 @@ impl Simulation {
     /// # Panics
     /// If `pass` is not one of the model's passes.
     pub fn run_pass<E: Executor>(&mut self, exec: &E, pass: Pass) -> Result<(), KernelPanic> {
-        use schedule::{mueller, wcsph};
-        let (s, nb, lanes) = (&mut self.state, &mut self.neighbors, self.lanes);
-        match (&self.physics, pass) {
-            (Physics::Mueller(prm), Pass::Density) => {
-                with_search_lanes!(nb, lanes, (nb, lists, l) => mueller::density(exec, l, &*nb, lists, s, prm))
-            }
-            (Physics::Mueller(prm), Pass::Forces) => {
-                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => mueller::forces(exec, l, &*nb, lists, s, prm)))
-            }
-            (Physics::Mueller(prm), Pass::Integrate) => {
-                with_lanes!(lanes, l => mueller::integrate(exec, l, s, prm, self.domain))
-            }
-            (Physics::Wcsph(prm), Pass::MaxSpeed) => {
-                wcsph::max_speed(exec, s, &mut self.wcsph, prm)
-            }
-            (Physics::Wcsph(prm), Pass::Neighbors) => {
-                with_search_lanes!(nb, lanes, (nb, lists, l) => wcsph::neighbors(exec, l, &*nb, lists, s, prm))
-            }
-            (Physics::Wcsph(prm), Pass::Walls) => {
-                with_search!(nb, (nb, lists) => wcsph::walls(exec, &*nb, lists, s, prm))
-            }
-            (Physics::Wcsph(prm), Pass::Momentum) => {
-                with_search!(nb, (nb, lists) => wcsph::momentum(exec, &*nb, lists, s, prm))
-            }
-            (Physics::Wcsph(prm), Pass::Continuity) => {
-                with_search!(nb, (nb, lists) => wcsph::continuity(exec, &*nb, lists, s, &mut self.wcsph, prm))
-            }
-            (Physics::Wcsph(prm), Pass::Integrate) => wcsph::integrate(exec, s, &self.wcsph, prm),
-            (physics, pass) => panic!(
-                "the {} preset has no {} pass",
-                physics.preset(),
-                pass.as_str()
-            ),
-        }
+        let on = Particles {
+            state: &mut self.state,
+            neighbors: &mut self.neighbors,
+            lanes: self.lanes,
+            domain: self.domain,
+        };
+        let scratch = &mut self.scratch;
+        with_model!(&self.physics, m => m.run_pass(exec, pass, on, scratch.of_mut()))
     }
 
     /// Bytes held by the neighbour search, lists and the model's scratch arrays, for memory
     /// reports.
     pub fn neighbor_heap_bytes(&self) -> usize {
-        self.neighbors.heap_bytes() + self.wcsph.heap_bytes()
+        self.neighbors.heap_bytes() + self.scratch.heap_bytes()
     }
+}
+
+/// Whether `M`'s passes run on the run's SIMD path on the grid too ([`Model::LANES_ON_GRID`]).
+fn lanes_on_grid<M: Model>(_: &M) -> bool {
+    M::LANES_ON_GRID
 }

@@ -10,9 +10,10 @@
 
 use sph_strategies::{Executor, KernelPanic};
 
+use super::model::Model;
 use super::{Pass, Simulation, StepError};
 use crate::simd::Lanes;
-use crate::sph::physics::Physics;
+use crate::sph::physics::with_model;
 use crate::with_lanes;
 
 /// What a kernel call computes: part of the neighbour search's rebuild (the grid's, which
@@ -216,22 +217,8 @@ impl Simulation {
         Ok(if finite { None } else { s.first_non_finite() })
     }
 
-    /// For WCSPH, the first fluid particle that left the tank (beyond a wall's outer face:
-    /// over the top of a wall and down outside it) or whose density is not positive, and why.
-    /// Either ends the dam break the model describes (the tank is open at the top), so the
-    /// run stops rather than go on with a wrong number.
+    /// The first particle that left what the model describes ([`Model::first_unphysical`]).
     fn first_unphysical(&self) -> Option<(usize, &'static str)> {
-        let Physics::Wcsph(prm) = &self.physics else {
-            return None;
-        };
-        let wall = prm.wall_layers() as f64 * prm.dx;
-        let (x_max, s) = (self.domain.width + wall, &self.state);
-        let fluid = prm.fluid;
-        let outside = |k: usize| s.x[k] < -wall || s.x[k] > x_max || s.y[k] < -wall;
-        if let Some(k) = (0..fluid).find(|&k| outside(k)) {
-            return Some((k, "left the tank over a wall"));
-        }
-        let k = s.rho[..fluid].iter().position(|&rho| rho <= 0.0)?;
-        Some((k, "has a density of zero or less"))
+        with_model!(&self.physics, m => m.first_unphysical(&self.state, self.domain))
     }
 }

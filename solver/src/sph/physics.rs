@@ -1,9 +1,13 @@
-//! Which model a simulation steps: Müller's pixel-unit fluid or weakly compressible SPH.
+//! Which model a simulation steps: the registry of models, one line each. Everything a model
+//! is — its preset, search, passes and schedule — it says through
+//! [`Model`](crate::solver::model::Model); this file only names them.
 
 use super::neighbors::Bounds;
 use super::params::{Params, Preset};
 use super::state::Domain;
 use super::wcsph::params::WcParams;
+use crate::solver::model::Model;
+use crate::solver::pass::Pass;
 
 /// The constants of a run, and with them the model and its passes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -13,6 +17,19 @@ pub enum Physics {
     /// Weakly compressible SPH in SI units (`wcsph`).
     Wcsph(WcParams),
 }
+
+/// Runs `$body` with `$m` bound to the model's constants inside `$physics` (a `Physics`, or
+/// a reference to one): a type that implements [`Model`], so that `$body` is compiled per
+/// model.
+macro_rules! with_model {
+    ($physics:expr, $m:ident => $body:expr) => {
+        match $physics {
+            $crate::sph::physics::Physics::Mueller($m) => $body,
+            $crate::sph::physics::Physics::Wcsph($m) => $body,
+        }
+    };
+}
+pub(crate) use with_model;
 
 impl From<Params> for Physics {
     fn from(p: Params) -> Self {
@@ -29,35 +46,31 @@ impl From<WcParams> for Physics {
 impl Physics {
     /// The preset these constants belong to.
     pub fn preset(&self) -> Preset {
-        match self {
-            Physics::Mueller(p) => p.preset(),
-            Physics::Wcsph(_) => Preset::Wcsph,
-        }
+        with_model!(self, m => m.preset())
     }
 
     /// The neighbour search radius: H (px) for Müller, the kernel support 2h (m) for WCSPH.
     pub fn search_radius(&self) -> f64 {
-        match self {
-            Physics::Mueller(p) => p.h,
-            Physics::Wcsph(p) => p.support,
-        }
+        with_model!(self, m => m.search_radius())
     }
 
     /// Particles that move (the rest are fixed walls): all of `n` for Müller.
     pub fn fluid(&self, n: usize) -> usize {
-        match self {
-            Physics::Mueller(_) => n,
-            Physics::Wcsph(p) => p.fluid.min(n),
+        with_model!(self, m => m.fluid(n))
+    }
+
+    /// The model's passes, in step order.
+    pub fn passes(&self) -> &'static [Pass] {
+        fn of<M: Model>(_: &M) -> &'static [Pass] {
+            M::PASSES
         }
+        with_model!(self, m => of(m))
     }
 
     /// The rectangle the grid covers: the domain, and for WCSPH the walls' particle layers
     /// outside it (left, right and below).
     pub fn search_bounds(&self, domain: Domain) -> Bounds {
-        let walls = match self {
-            Physics::Mueller(_) => 0.0,
-            Physics::Wcsph(p) => p.wall_layers() as f64 * p.dx,
-        };
+        let walls = with_model!(self, m => m.wall_depth());
         let inner = Bounds::of(domain);
         Bounds {
             min_x: inner.min_x - walls,

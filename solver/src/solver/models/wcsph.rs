@@ -5,8 +5,12 @@ use glam::DVec2;
 use sph_strategies::{Executor, KernelPanic};
 
 use crate::simd::Lanes;
-use crate::sph::neighbors::{NeighborLists, Neighbors};
-use crate::sph::state::{Fields, Positions, State};
+use crate::solver::model::{self, Model, Particles, no_such_pass};
+use crate::solver::pass::Pass;
+use crate::solver::search::{with_search, with_search_lanes};
+use crate::sph::neighbors::{NeighborLists, Neighbors, WCSPH_SLOTS};
+use crate::sph::params::Preset;
+use crate::sph::state::{Domain, Fields, Positions, State};
 use crate::sph::wcsph::params::WcParams;
 use crate::sph::wcsph::passes::{self, ContinuityInputs};
 
@@ -33,10 +37,92 @@ impl Scratch {
             dt: 0.0,
         }
     }
+}
 
-    /// Heap bytes held (capacity).
-    pub fn heap_bytes(&self) -> usize {
+impl model::Scratch for Scratch {
+    fn heap_bytes(&self) -> usize {
         8 * (self.drho.capacity() + self.block_max.capacity())
+    }
+}
+
+impl Model for WcParams {
+    type Scratch = Scratch;
+
+    const PASSES: &'static [Pass] = &Pass::WCSPH;
+
+    const LANES_ON_GRID: bool = false;
+
+    fn preset(&self) -> Preset {
+        Preset::Wcsph
+    }
+
+    fn search_radius(&self) -> f64 {
+        self.support
+    }
+
+    fn fluid(&self, n: usize) -> usize {
+        self.fluid.min(n)
+    }
+
+    fn wall_depth(&self) -> f64 {
+        self.wall_layers() as f64 * self.dx
+    }
+
+    // Walls need lists too (of their fluid neighbours).
+    fn lists(&self, n: usize) -> (usize, usize) {
+        (n, WCSPH_SLOTS)
+    }
+
+    fn scratch(&self, n: usize) -> Scratch {
+        Scratch::new(self.fluid(n))
+    }
+
+    fn run_pass<E: Executor>(
+        &self,
+        exec: &E,
+        pass: Pass,
+        on: Particles<'_>,
+        scratch: &mut Scratch,
+    ) -> Result<(), KernelPanic> {
+        let Particles {
+            state: s,
+            neighbors: nb,
+            lanes,
+            ..
+        } = on;
+        match pass {
+            Pass::MaxSpeed => max_speed(exec, s, scratch, self),
+            Pass::Neighbors => {
+                with_search_lanes!(nb, lanes, (nb, lists, l) => neighbors(exec, l, &*nb, lists, s, self))
+            }
+            Pass::Walls => with_search!(nb, (nb, lists) => walls(exec, &*nb, lists, s, self)),
+            Pass::Momentum => with_search!(nb, (nb, lists) => momentum(exec, &*nb, lists, s, self)),
+            Pass::Continuity => {
+                with_search!(nb, (nb, lists) => continuity(exec, &*nb, lists, s, scratch, self))
+            }
+            Pass::Integrate => integrate(exec, s, scratch, self),
+            other => no_such_pass(self.preset(), other),
+        }
+    }
+
+    fn last_dt(&self, scratch: &Scratch) -> f64 {
+        scratch.dt
+    }
+
+    /// The first fluid particle that left the tank (beyond a wall's outer face: over the top
+    /// of a wall and down outside it) or whose density is not positive, and why. Either ends
+    /// the dam break the model describes (the tank is open at the top), so the run stops
+    /// rather than go on with a wrong number.
+    fn first_unphysical(&self, s: &State, domain: Domain) -> Option<(usize, &'static str)> {
+        let wall = self.wall_depth();
+        let x_max = domain.width + wall;
+        let fluid = self.fluid;
+        let outside = |k: usize| s.x[k] < -wall || s.x[k] > x_max || s.y[k] < -wall;
+        if let Some(k) = (0..fluid).find(|&k| outside(k)) {
+            return Some((k, "left the tank over a wall"));
+        }
+        let k = s.rho[..fluid].iter().position(|&rho| rho <= 0.0)?;
+        Some((k, "has a density of zero or less"))
     }
 }
 

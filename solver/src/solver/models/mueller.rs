@@ -1,13 +1,78 @@
-//! The passes of Müller's step (the `seed` and `cpp` presets).
+//! Müller's model (the `seed` and `cpp` presets) as the solver runs it: its constants
+//! ([`Params`]) as a [`Model`], and its step's three passes.
 
 use glam::DVec2;
 use sph_strategies::{Executor, KernelPanic};
 
 use crate::simd::Lanes;
-use crate::sph::neighbors::{NeighborLists, Neighbors};
-use crate::sph::params::Params;
+use crate::solver::model::{Model, Particles, no_such_pass};
+use crate::solver::pass::Pass;
+use crate::solver::search::{with_search, with_search_lanes};
+use crate::sph::neighbors::{NeighborLists, Neighbors, SLOTS};
+use crate::sph::params::{Params, Preset};
 use crate::sph::passes;
 use crate::sph::state::{Domain, Fields, Positions, State};
+use crate::with_lanes;
+
+impl Model for Params {
+    type Scratch = ();
+
+    const PASSES: &'static [Pass] = &Pass::MUELLER;
+
+    // The force pass searches only for a pile, and takes two neighbours at once on any search.
+    const LANES_ON_GRID: bool = true;
+
+    fn preset(&self) -> Preset {
+        Params::preset(self)
+    }
+
+    fn search_radius(&self) -> f64 {
+        self.h
+    }
+
+    fn fluid(&self, n: usize) -> usize {
+        n
+    }
+
+    fn wall_depth(&self) -> f64 {
+        0.0
+    }
+
+    fn lists(&self, n: usize) -> (usize, usize) {
+        (n, SLOTS)
+    }
+
+    fn scratch(&self, _: usize) {}
+
+    fn run_pass<E: Executor>(
+        &self,
+        exec: &E,
+        pass: Pass,
+        on: Particles<'_>,
+        _: &mut (),
+    ) -> Result<(), KernelPanic> {
+        let Particles {
+            state: s,
+            neighbors: nb,
+            lanes,
+            domain,
+        } = on;
+        match pass {
+            Pass::Density => {
+                with_search_lanes!(nb, lanes, (nb, lists, l) => density(exec, l, &*nb, lists, s, self))
+            }
+            Pass::Forces => {
+                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => forces(exec, l, &*nb, lists, s, self)))
+            }
+            Pass::Integrate => with_lanes!(lanes, l => integrate(exec, l, s, self, domain)),
+            other => no_such_pass(self.preset(), other),
+        }
+    }
+
+    fn last_dt(&self, _: &()) -> f64 {
+        self.dt
+    }
+}
 
 /// Writes rho, p and the neighbour lists; reads positions.
 pub fn density<E: Executor, N: Neighbors, L: Lanes>(
