@@ -6,7 +6,6 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use serde::Serialize;
 use sph_strategies::Config;
 
 use crate::checksum::checksum_hex;
@@ -15,10 +14,8 @@ use crate::output::claim::{self, Claimed, Owner};
 use crate::output::console;
 use crate::output::record::Command;
 use crate::plot::timeline;
-use crate::simd::SimdPath;
 use crate::solver::Simulation;
-use crate::topology::Pin;
-use crate::trace::files::{self, TOOL};
+use crate::trace::files::{self, TOOL, TraceMeta};
 use crate::trace::size::{self, Plan};
 use crate::trace::stats::{self, Stats};
 use crate::trace::{TraceConfig, TracedRun, chrome, run_traced, run_untraced};
@@ -57,24 +54,6 @@ pub struct TraceArgs {
     /// from the last traced run.
     #[arg(long, value_name = "REPS", value_parser = super::repetitions)]
     pub compare: Option<usize>,
-}
-
-/// What `meta.json` holds: the tool, the configuration, the run's timing and its totals.
-#[derive(Debug, Serialize)]
-struct Meta<'a> {
-    tool: &'static str,
-    #[serde(flatten)]
-    config: &'a TraceConfig,
-    warmup_steps: usize,
-    wall_s: f64,
-    cpu_s: f64,
-    kernel_calls: usize,
-    worker_threads: usize,
-    workers_used: usize,
-    checksum: String,
-    timeline_steps: [usize; 2],
-    simd: SimdPath,
-    pin: Pin,
 }
 
 /// Minimum and median of untraced and traced wall times.
@@ -116,9 +95,9 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
     )?;
     let stats = stats::compute(&run.trace);
     let shown = args.timeline_steps.unwrap_or(3).min(args.steps);
-    let meta = Meta {
-        tool: TOOL,
-        config: &config,
+    let meta = TraceMeta {
+        tool: Some(TOOL.to_owned()),
+        config,
         warmup_steps: args.warmup,
         wall_s: run.elapsed.wall_s,
         cpu_s: run.elapsed.cpu_s,
@@ -134,7 +113,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<()> {
     write_files(&paths, &run, &stats, &meta)?;
     let removed = claimed.remove_stale(&paths)?;
 
-    let mut lines = summary(&config, args.warmup, &stats, run.elapsed.wall_s);
+    let mut lines = summary(&meta.config, args.warmup, &stats, run.elapsed.wall_s);
     if args.compare.is_some() {
         let cost_ns = crate::trace::executor::recording_cost_ns(200_000);
         lines.extend(comparison_lines(&comparison, &stats, cost_ns));
@@ -248,10 +227,10 @@ fn write_files(
     paths: &[PathBuf; 4],
     run: &TracedRun,
     stats: &Stats,
-    meta: &Meta<'_>,
+    meta: &TraceMeta,
 ) -> anyhow::Result<()> {
     let [trace_json, timeline_png, stats_csv, meta_json] = paths;
-    let config = meta.config;
+    let config = &meta.config;
     let mut out = AtomicFile::create(trace_json)?;
     chrome::write(&run.trace, &stats.workers, config, &mut out)
         .context("cannot write trace.json")?;

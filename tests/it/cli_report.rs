@@ -260,7 +260,11 @@ fn trace_directories_under_the_results_or_given_with_trace_are_embedded() {
     let stats = "kind,name,threads,kernel_calls,busy_ms,span_ms,idle_pct,imbalance\n\
                  worker,0,1,90,10.0,12.0,16.7,\nworker,1,1,90,9.0,12.0,25.0,\n\
                  pass,density,,90,9.5,5.0,5.0,1.10\ntotal,all,2,180,19.0,12.0,20.8,\n";
-    let meta = r#"{"tool":"bench-sph trace","strategy":"rayon-chunks","cores":2,"chunks":45,"n":1000,"steps":3}"#;
+    let meta = r#"{"tool":"bench-sph trace","strategy":"rayon-chunks","cores":2,"chunks":45,
+        "n":1000,"steps":3,"preset":"seed","neighbors":"all-pairs","seed":2019,"init":null,
+        "warmup_steps":5,"wall_s":0.1,"cpu_s":0.2,"kernel_calls":180,"worker_threads":2,
+        "workers_used":2,"checksum":"00000000000000aa","timeline_steps":[1,3],"simd":"portable",
+        "pin":"none"}"#;
     for t in [dir.join("trace-inside"), tmp.path().join("trace-outside")] {
         std::fs::create_dir_all(&t).unwrap();
         // Only the PNG header is read: the signature, and the size (a timeline is 1600 wide).

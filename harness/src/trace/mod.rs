@@ -15,7 +15,8 @@
 //!
 //! The [`Trace`] then becomes `trace.json` ([`chrome`], for Perfetto or `chrome://tracing`),
 //! `timeline.png` (`sph_report::plot::timeline`, a Gantt chart) and `stats.csv` ([`stats`]), all written by
-//! pure exporters to `impl Write`; [`files`] names them and recognises a trace directory.
+//! pure exporters to `impl Write`; [`files`] is the directory's schema: the files' names, `meta.json`
+//! and the rows of `stats.csv`, written and read through the same types.
 
 pub mod chrome;
 pub mod executor;
@@ -25,52 +26,7 @@ pub mod session;
 pub mod size;
 pub mod stats;
 
-use serde::Serialize;
-
-use sph_solver::sph::neighbors::NeighborMode;
-use sph_solver::sph::params::Preset;
-
 pub use executor::TracingExecutor;
+pub use files::TraceConfig;
 pub use recorder::{KernelEvent, Recorder, SerialEvent, SerialWork, ThreadInfo, Trace};
 pub use session::{TracedRun, run_traced, run_untraced};
-
-/// What was traced: shown in titles and written to `trace.json`'s `otherData` and `meta.json`.
-#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
-pub struct TraceConfig {
-    /// The strategy's name.
-    pub strategy: String,
-    /// Worker threads (1 for `seq`).
-    pub cores: usize,
-    /// Requested chunks per pass, for strategies that use chunks.
-    pub chunks: Option<usize>,
-    /// Particles.
-    pub n: usize,
-    /// Steps traced.
-    pub steps: usize,
-    /// Constants.
-    pub preset: Preset,
-    /// Neighbour search.
-    pub neighbors: NeighborMode,
-    /// Seed of the initial jitter (none with an init file).
-    pub seed: Option<u64>,
-    /// The init file the state came from, if any.
-    pub init: Option<String>,
-}
-
-impl TraceConfig {
-    /// One line: `rayon-chunks, 2 cores, 45 chunks, N = 1000 (seed, all-pairs)`.
-    pub fn title(&self) -> String {
-        let cores = if self.cores == 1 { "core" } else { "cores" };
-        let chunks = self
-            .chunks
-            .map_or_else(String::new, |c| format!(", {c} chunks"));
-        format!(
-            "{}, {} {cores}{chunks}, N = {} ({}, {})",
-            self.strategy,
-            self.cores,
-            self.n,
-            self.preset.as_str(),
-            self.neighbors.as_str()
-        )
-    }
-}

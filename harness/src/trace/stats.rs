@@ -5,8 +5,7 @@
 use std::collections::BTreeMap;
 use std::io::Write;
 
-use serde::Serialize;
-
+use super::files::StatsRow;
 use super::recorder::{Phase, Trace};
 
 /// The header of `stats.csv`.
@@ -209,19 +208,6 @@ fn pass_stats(trace: &Trace, phase: Phase) -> PassStats {
     }
 }
 
-/// One row of `stats.csv`: `kind` is `worker`, `pass` or `total`.
-#[derive(Debug, Serialize)]
-struct Row {
-    kind: &'static str,
-    name: String,
-    threads: Option<usize>,
-    kernel_calls: usize,
-    busy_ms: f64,
-    span_ms: f64,
-    idle_pct: f64,
-    imbalance: Option<f64>,
-}
-
 fn ms(ns: u64) -> f64 {
     ns as f64 / 1e6
 }
@@ -236,8 +222,8 @@ fn ms(ns: u64) -> f64 {
 pub fn write_csv<W: Write>(stats: &Stats, out: W) -> Result<(), csv::Error> {
     let mut w = csv::Writer::from_writer(out);
     for s in &stats.workers {
-        w.serialize(Row {
-            kind: "worker",
+        w.serialize(StatsRow {
+            kind: "worker".to_owned(),
             name: s.worker.to_string(),
             threads: Some(s.threads.len()),
             kernel_calls: s.kernel_calls,
@@ -248,8 +234,8 @@ pub fn write_csv<W: Write>(stats: &Stats, out: W) -> Result<(), csv::Error> {
         })?;
     }
     for p in &stats.passes {
-        w.serialize(Row {
-            kind: "pass",
+        w.serialize(StatsRow {
+            kind: "pass".to_owned(),
             name: p.phase.as_str().to_owned(),
             threads: None,
             kernel_calls: p.kernel_calls,
@@ -260,8 +246,8 @@ pub fn write_csv<W: Write>(stats: &Stats, out: W) -> Result<(), csv::Error> {
         })?;
     }
     let t = &stats.total;
-    w.serialize(Row {
-        kind: "total",
+    w.serialize(StatsRow {
+        kind: "total".to_owned(),
         name: "all".to_owned(),
         threads: Some(t.worker_threads),
         kernel_calls: t.kernel_calls,

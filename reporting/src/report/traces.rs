@@ -15,38 +15,16 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use serde::Deserialize;
 
 use sph_harness::io::capped;
 use sph_harness::output::{atomic, console, sniff};
-use sph_harness::trace::files::{self, META_JSON};
+use sph_harness::trace::files::{self, META_JSON, StatsRow, TraceMeta};
 use sph_harness::trace::stats::{CSV_HEADER, idle_workers_note};
 
 /// The files that make a directory a trace directory.
 pub const TIMELINE: &str = files::TIMELINE_PNG;
 /// See [`TIMELINE`].
 pub const STATS: &str = files::STATS_CSV;
-
-/// One row of a trace's `stats.csv`.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-pub struct StatsRow {
-    /// `worker`, `pass` or `total`.
-    pub kind: String,
-    /// Worker index, pass name or `all`.
-    pub name: String,
-    /// OS threads (workers and total only).
-    pub threads: Option<usize>,
-    /// Kernel calls (tasks).
-    pub kernel_calls: usize,
-    /// Milliseconds inside kernel calls.
-    pub busy_ms: f64,
-    /// Milliseconds of the span (the loop, or the pass summed over steps).
-    pub span_ms: f64,
-    /// Percent idle.
-    pub idle_pct: f64,
-    /// Busiest worker over the mean worker, per pass.
-    pub imbalance: Option<f64>,
-}
 
 /// A trace directory, read and validated.
 #[derive(Debug, Clone, PartialEq)]
@@ -74,17 +52,6 @@ impl TraceDir {
             .filter(|r| r.kind == "worker" && r.kernel_calls > 0)
             .count()
     }
-}
-
-#[derive(Debug, Deserialize)]
-struct TraceMeta {
-    strategy: String,
-    cores: usize,
-    chunks: Option<usize>,
-    n: usize,
-    steps: usize,
-    preset: Option<String>,
-    neighbors: Option<String>,
 }
 
 /// What a valid trace directory holds (before its image is placed).
@@ -230,8 +197,12 @@ fn check_meta(path: &Path) -> anyhow::Result<String> {
             ),
         }
     }
-    let meta: TraceMeta = serde_json::from_value(value)
-        .with_context(|| format!("{META_JSON} lacks the trace's configuration"))?;
+    let meta: TraceMeta = serde_json::from_value(value).with_context(|| {
+        format!(
+            "{META_JSON} lacks the trace's configuration or totals (a trace written by an \
+                 older bench-sph: run `bench-sph trace` again)"
+        )
+    })?;
     Ok(meta_title(&meta))
 }
 
@@ -305,14 +276,12 @@ fn link(p: &Path) -> String {
         .join("/")
 }
 
-fn meta_title(m: &TraceMeta) -> String {
+fn meta_title(meta: &TraceMeta) -> String {
+    let m = &meta.config;
     let chunks = m
         .chunks
         .map_or_else(String::new, |k| format!(", {k} chunks"));
-    let extra = match (&m.preset, &m.neighbors) {
-        (Some(p), Some(nb)) => format!(" ({p}, {nb})"),
-        _ => String::new(),
-    };
+    let extra = format!(" ({}, {})", m.preset.as_str(), m.neighbors.as_str());
     format!(
         "{}, {} {}{chunks}, N = {}, {} steps{extra}",
         m.strategy,
@@ -430,13 +399,57 @@ mod tests {
     const STATS_TEXT: &str = "kind,name,threads,kernel_calls,busy_ms,span_ms,idle_pct,imbalance\n\
          worker,0,1,3,0.5,1.0,50.0,\nworker,1,1,2,0.3,1.0,70.0,\n\
          pass,density,,2,0.4,0.3,33.3,1.5\ntotal,all,2,5,0.8,1.0,60.0,\n";
-    const META: &str = r#"{"tool":"bench-sph trace","strategy":"rayon-chunks","cores":2,"chunks":45,"n":1000,"steps":3,"preset":"seed","neighbors":"all-pairs","seed":2019,"wall_s":0.1,"kernel_calls":5,"timeline_steps":[1,3]}"#;
+    /// A trace's `meta.json`, as `trace` writes it.
+    fn meta() -> TraceMeta {
+        TraceMeta {
+            tool: Some(files::TOOL.to_owned()),
+            config: sph_harness::trace::TraceConfig {
+                strategy: "rayon-chunks".to_owned(),
+                cores: 2,
+                chunks: Some(45),
+                n: 1000,
+                steps: 3,
+                preset: sph_solver::sph::params::Preset::Seed,
+                neighbors: sph_solver::sph::neighbors::NeighborMode::AllPairs,
+                seed: Some(2019),
+                init: None,
+            },
+            warmup_steps: 5,
+            wall_s: 0.1,
+            cpu_s: 0.2,
+            kernel_calls: 5,
+            worker_threads: 2,
+            workers_used: 2,
+            checksum: "00000000000000aa".to_owned(),
+            timeline_steps: [1, 3],
+            simd: sph_solver::simd::SimdPath::Portable,
+            pin: sph_harness::topology::Pin::None,
+        }
+    }
 
     fn fake_trace(dir: &Path) {
         std::fs::create_dir_all(dir).unwrap();
         std::fs::write(dir.join(TIMELINE), PNG_SIGNATURE).unwrap();
         std::fs::write(dir.join(STATS), STATS_TEXT).unwrap();
-        std::fs::write(dir.join(META_JSON), META).unwrap();
+        let text = serde_json::to_string_pretty(&meta()).unwrap();
+        std::fs::write(dir.join(META_JSON), text).unwrap();
+    }
+
+    #[test]
+    fn a_trace_s_meta_json_reads_back_as_written_and_an_older_one_is_refused_saying_so() {
+        let text = serde_json::to_string_pretty(&meta()).unwrap();
+        assert_eq!(serde_json::from_str::<TraceMeta>(&text).unwrap(), meta());
+        let tmp = tempfile::tempdir().unwrap();
+        fake_trace(tmp.path());
+        assert_eq!(
+            check(tmp.path()).unwrap().title,
+            "rayon-chunks, 2 cores, 45 chunks, N = 1000, 3 steps (seed, all-pairs)"
+        );
+        // Written before the totals were: the configuration alone.
+        let older = r#"{"tool":"bench-sph trace","strategy":"rayon-chunks","cores":2,"chunks":45,"n":1000,"steps":3,"kernel_calls":5,"timeline_steps":[1,3]}"#;
+        std::fs::write(tmp.path().join(META_JSON), older).unwrap();
+        let why = format!("{:#}", check(tmp.path()).unwrap_err());
+        assert!(why.contains("an older bench-sph"), "{why}");
     }
 
     /// Why `check` refuses `dir` after `spoil` has changed one of its files.
@@ -567,11 +580,10 @@ mod tests {
         assert!(missing.starts_with("no readable meta.json"), "{missing}");
         let tmp = tempfile::tempdir().unwrap();
         fake_trace(tmp.path());
-        std::fs::write(
-            tmp.path().join(META_JSON),
-            META.replace(r#""tool":"bench-sph trace","#, ""),
-        )
-        .unwrap();
+        // Written before the `tool` field was.
+        let mut older = serde_json::to_value(meta()).unwrap();
+        older.as_object_mut().unwrap().remove("tool");
+        std::fs::write(tmp.path().join(META_JSON), older.to_string()).unwrap();
         assert!(check(tmp.path()).is_ok());
     }
 

@@ -2,11 +2,11 @@
 //! book/src/physics.md). Units: pixels (px), seconds (s), mass units (mu).
 
 use glam::DVec2;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 /// Which source program's constants and integration order to reproduce.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Preset {
     /// The seed paper's Haskell program (`schuermannator/sph`), all f64.

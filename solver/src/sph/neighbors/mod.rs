@@ -14,7 +14,7 @@ pub use grid::keys::{GridKeys, INDEX_KEYS_MAX_BYTES};
 pub use grid::{Grid, GridScratch, InCellOrder, InIndexOrder, PARALLEL_SORT, VisitOrder};
 pub use list::{ListKey, ListWriter, NeighborLists, SLOTS, SlotsMut, WCSPH_SLOTS};
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use sph_strategies::{Executor, KernelPanic};
 
 use crate::simd::Lanes;
@@ -70,7 +70,7 @@ impl std::fmt::Display for SumOrder {
 }
 
 /// How candidates are found.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum NeighborMode {
     /// Every particle against every particle, O(N²) per pass: the sources' loops.
