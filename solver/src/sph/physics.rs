@@ -1,6 +1,6 @@
 //! Which model a simulation steps: the registry of models, one line each. Everything a model
-//! is — its preset, search, passes and schedule — it says through
-//! [`Model`](crate::solver::model::Model); this file only names them.
+//! is — its preset, search, passes and schedule — it says through [`Model`]; this file only
+//! names them.
 
 use super::neighbors::Bounds;
 use super::params::{Params, Preset};
