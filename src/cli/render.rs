@@ -23,7 +23,7 @@ use crate::output::console;
 use crate::render::frame::{Caption, MAX_WIDTH, MIN_WIDTH, Painter, View};
 use crate::render::output::Output;
 use crate::render::scale::{ColorBy, Scale};
-use crate::run::{Observer, Steps, run_observed};
+use crate::run::{Observer, Steps, run_steps};
 use crate::solver::Simulation;
 use crate::sph::physics::Physics;
 
@@ -125,7 +125,14 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         failed: None,
     };
     // All frames in one session: one thread pool for the whole animation.
-    let outcome = run_observed(&mut sim, args.parallel.strategy, &config, steps, &mut drawn);
+    let outcome = run_steps(
+        &mut sim,
+        args.parallel.strategy,
+        &config,
+        steps,
+        &mut (),
+        &mut drawn,
+    );
     let (frames, shown, simulating_s) = (drawn.frames, drawn.shown, drawn.simulating_s);
     if let Some(err) = drawn.failed {
         return Err(err);

@@ -12,7 +12,7 @@ use crate::io::sink::Sink;
 use crate::limits;
 use crate::output::console;
 use crate::run::fault::PanicAt;
-use crate::run::{RunError, Steps, run_timed_faulty};
+use crate::run::{RunError, Steps, run_timed_steps};
 use crate::simd::SimdPath;
 use crate::solver::{Simulation, StepError};
 use crate::sph::neighbors::{NeighborMode, SumOrder};
@@ -98,8 +98,12 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         },
     };
     let strategy = args.parallel.strategy;
-    let fault = args.hooks().inject_panic_at.map(PanicAt);
-    let outcome = run_timed_faulty(&mut sim, strategy, &config, steps, fault);
+    let outcome = match args.hooks().inject_panic_at {
+        None => run_timed_steps(&mut sim, strategy, &config, steps, &mut ()),
+        Some(particle) => {
+            run_timed_steps(&mut sim, strategy, &config, steps, &mut PanicAt(particle))
+        }
+    };
 
     let diverged = matches!(
         outcome,

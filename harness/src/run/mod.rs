@@ -90,7 +90,7 @@ impl Observer for LastSegment {
     }
 }
 
-struct Segments<'a, H, O: ?Sized> {
+struct Segments<'a, H, O> {
     sim: &'a mut Simulation,
     /// The CPUs the strategy's threads may use (see [`sph_strategies::wake()`]).
     cpus: usize,
@@ -99,7 +99,7 @@ struct Segments<'a, H, O: ?Sized> {
     observer: &'a mut O,
 }
 
-impl<H: StepHooks + Send, O: Observer + ?Sized> Session for Segments<'_, H, O> {
+impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
     type Output = Result<(), StepError>;
 
     fn run<E: Executor>(self, exec: &E) -> Self::Output {
@@ -144,7 +144,7 @@ impl<H: StepHooks + Send, O: Observer + ?Sized> Session for Segments<'_, H, O> {
 /// steps (and its warm-up) the session wakes the strategy's threads
 /// ([`sph_strategies::wake()`]): untimed passes that spin until the threads run on their cores,
 /// at most 0.15 s.
-pub fn run_steps<H: StepHooks + Send, O: Observer + ?Sized>(
+pub fn run_steps<H: StepHooks + Send, O: Observer>(
     sim: &mut Simulation,
     strategy: StrategyName,
     config: &Config,
@@ -161,19 +161,6 @@ pub fn run_steps<H: StepHooks + Send, O: Observer + ?Sized>(
         observer,
     };
     Ok(in_session(strategy, config, session)??)
-}
-
-/// [`run_steps`] without hooks, the observer behind a pointer: compiled once, here, for every
-/// command and crate that shows a run as it goes (render, the viewer), rather than once per
-/// observer type in each crate that calls it (every strategy's step loop is in it).
-pub fn run_observed(
-    sim: &mut Simulation,
-    strategy: StrategyName,
-    config: &Config,
-    steps: Steps,
-    observer: &mut dyn Observer,
-) -> Result<(), RunError> {
-    run_steps(sim, strategy, config, steps, &mut (), observer)
 }
 
 /// Runs `session` in one session of `strategy`, the calling thread pinned for it as
@@ -213,22 +200,6 @@ pub fn run_timed_with<H: StepHooks + Send>(
         ..Steps::timed(steps)
     };
     run_timed_steps(sim, strategy, config, steps, hooks)
-}
-
-/// Runs `steps` of `sim` with `strategy` as one timed segment (`steps.every` is ignored),
-/// with the fault `fault` injected when one is given (`simulate --inject-panic-at`, a test
-/// hook), and returns the time they took (zero for none). Not generic, so compiled once, here.
-pub fn run_timed_faulty(
-    sim: &mut Simulation,
-    strategy: StrategyName,
-    config: &Config,
-    steps: Steps,
-    fault: Option<fault::PanicAt>,
-) -> Result<Elapsed, RunError> {
-    match fault {
-        None => run_timed_steps(sim, strategy, config, steps, &mut ()),
-        Some(mut at) => run_timed_steps(sim, strategy, config, steps, &mut at),
-    }
 }
 
 /// Runs `steps` of `sim` with `strategy` as one timed segment (`steps.every` is ignored),

@@ -15,7 +15,7 @@ use std::thread::JoinHandle;
 use sph_strategies::{BuildError, Config, StrategyName};
 
 use sph_harness::clock::Elapsed;
-use sph_harness::run::{Observer, RunError, Steps, run_observed};
+use sph_harness::run::{Observer, RunError, Steps, run_steps};
 use sph_solver::solver::Simulation;
 use sph_solver::sph::state::State;
 
@@ -141,7 +141,7 @@ impl Stepper {
                     ask: ask_rx,
                     done: done_tx,
                 };
-                let result = run_observed(&mut sim, strategy, &config, steps, &mut relay);
+                let result = run_steps(&mut sim, strategy, &config, steps, &mut (), &mut relay);
                 (sim, result)
             });
         let thread = match spawned {
