@@ -4,7 +4,11 @@
 //! a git checkout or without git).
 //!
 //! Git runs with `--no-optional-locks`: a plain `git status` refreshes `.git/index`, which
-//! would make the next build run this script (and recompile bench-sph) again for nothing.
+//! would make the next build run this script (and recompile the crates) again for nothing.
+//!
+//! The script watches every crate's sources, not only this one's: the commit it records
+//! must say `-dirty` when any of the binary's sources changed, so an edit of the command line
+//! or the report reruns it and recompiles this crate too. Provenance over build time.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -64,10 +64,10 @@ outputs() {
     "$bin" render --n 300 --steps 20 --every 10 --frames frames > frames.stdout 2>&1
     "$bin" list > list.txt
     # A trace: its meta.json but the measured times, and stats.csv's counts per pass and in all
-    # (not its times, nor which worker ran how many calls: that is the scheduler's).
+    # (not its times, nor which and how many threads ran the calls: that is the scheduler's).
     "$bin" trace --n 300 --steps 3 --strategy rayon-chunks --cores 2 --chunks 4 --out tr > trace.stdout 2>&1
-    sed -i -E 's/"(wall_s|cpu_s)": [^,]*/"\1": X/' tr/meta.json
-    grep -v '^worker,' tr/stats.csv | cut -d, -f1-4 > tr/stats-counts.csv
+    sed -i -E 's/"(wall_s|cpu_s|worker_threads|workers_used)": [^,]*/"\1": X/' tr/meta.json
+    grep -v '^worker,' tr/stats.csv | cut -d, -f1,2,4 > tr/stats-counts.csv
     rm -f tr/stats.csv tr/timeline.png tr/trace.json trace.stdout
     { "$bin" simulate --n 0; echo "rc=$?"; } > err1.txt 2>&1
     { "$bin" simulate --n 100 --steps 200000000000; echo "rc=$?"; } > err2.txt 2>&1

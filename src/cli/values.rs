@@ -1,7 +1,8 @@
 //! The command line's names for the domain's enums, in one place: the solver's `sph` and the
-//! report's `render` know nothing of clap. Each CLI enum carries the help text of its values and maps onto its
-//! domain type; an option keeps the domain type, parsed by [`preset`], [`neighbors`], [`order`],
-//! [`color`] or [`strategy`] (the strategies' names come from their registry).
+//! report's `render` know nothing of clap. Each CLI enum carries the help text of its values
+//! and maps onto its domain type; an option keeps the domain type, parsed by [`preset`],
+//! [`neighbors`], [`order`], [`color`] or [`strategy`] (the strategies' names come from their
+//! registry).
 
 use std::ffi::OsStr;
 

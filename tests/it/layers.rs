@@ -109,6 +109,7 @@ fn the_harness_depends_on_no_report_drawing_or_command_line_crate() {
         "png",
         "gif",
         "ab_glyph",
+        "minifb",
     ];
     let named: Vec<&str> = above
         .into_iter()

@@ -10,7 +10,8 @@
 //!   1-minute load of f × hardware threads; the busy-machine check before the plan reads the
 //!   first item.
 //!
-//! Both exist only in a build with the `testing` cargo feature (`bench_sph::cli`'s test hooks).
+//! The options that set them exist only in a `bench-sph` built with its `testing` cargo
+//! feature (`bench_sph::cli`'s test hooks).
 //! `--fake-timings` alone implies `--fake-contention 0` (a quiet machine), so a test's files do
 //! not depend on what else the machine was doing.
 //!

@@ -65,7 +65,9 @@ impl TraceConfig {
 /// A trace's `meta.json`: the tool, the configuration, the run's timing and its totals.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TraceMeta {
-    /// [`TOOL`]; absent in traces written before the field existed.
+    /// [`TOOL`]. Traces written before the field existed lack it, and with it the totals
+    /// that came later: [`is_trace_meta`] still recognises them, and the report refuses them
+    /// saying to run `trace` again.
     pub tool: Option<String>,
     /// What was traced.
     #[serde(flatten)]
@@ -114,7 +116,8 @@ pub struct StatsRow {
 }
 
 /// Whether a `meta.json` text is a trace's: `"tool": "bench-sph trace"`, or, written before
-/// that field existed, no `tool` but the trace's own `timeline_steps` and `kernel_calls`.
+/// that field existed, no `tool` but the trace's own `timeline_steps` and `kernel_calls` (so
+/// that such a trace is named as an older trace's, not as another tool's file).
 pub fn is_trace_meta(text: &str) -> bool {
     let Ok(serde_json::Value::Object(meta)) = serde_json::from_str(text) else {
         return false;

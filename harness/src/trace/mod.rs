@@ -14,9 +14,10 @@
 //! before anything runs, the trace's size is estimated and capped ([`size::MAX_EVENTS`]).
 //!
 //! The [`Trace`] then becomes `trace.json` ([`chrome`], for Perfetto or `chrome://tracing`),
-//! `timeline.png` (`sph_report::plot::timeline`, a Gantt chart) and `stats.csv` ([`stats`]), all written by
-//! pure exporters to `impl Write`; [`files`] is the directory's schema: the files' names, `meta.json`
-//! and the rows of `stats.csv`, written and read through the same types.
+//! `timeline.png` (`sph_report::plot::timeline`, a Gantt chart) and `stats.csv` ([`stats`]),
+//! all written by pure exporters to `impl Write`; [`files`] is the directory's schema: the
+//! files' names, `meta.json` and the rows of `stats.csv`, written and read through the same
+//! types.
 
 pub mod chrome;
 pub mod executor;

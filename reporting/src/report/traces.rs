@@ -5,10 +5,10 @@
 //! A directory holding `timeline.png` and `stats.csv` is a candidate; it is embedded only if
 //! it validates (`check`): `stats.csv` has the trace's columns, at least one worker row and
 //! a total row last whose kernel calls are the workers' sum, and only finite, non-negative
-//! numbers; `timeline.png` is a PNG; `meta.json` parses and says `"tool": "bench-sph trace"`
-//! (a trace written before that field existed is accepted when the rest validates). A
-//! `--trace DIR` that fails is an error; a candidate found by scanning is skipped with a
-//! one-line warning on standard error.
+//! numbers; `timeline.png` is a PNG; `meta.json` says `"tool": "bench-sph trace"` and reads
+//! as a [`TraceMeta`], the type `trace` wrote it from (a trace of an older bench-sph, which
+//! lacks fields, is refused saying to run `trace` again). A `--trace DIR` that fails is an
+//! error; a candidate found by scanning is skipped with a one-line warning on standard error.
 
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
@@ -580,11 +580,12 @@ mod tests {
         assert!(missing.starts_with("no readable meta.json"), "{missing}");
         let tmp = tempfile::tempdir().unwrap();
         fake_trace(tmp.path());
-        // Written before the `tool` field was.
-        let mut older = serde_json::to_value(meta()).unwrap();
-        older.as_object_mut().unwrap().remove("tool");
-        std::fs::write(tmp.path().join(META_JSON), older.to_string()).unwrap();
-        assert!(check(tmp.path()).is_ok());
+        // Written before the `tool` field (and the totals after it) existed: recognised as a
+        // trace, refused as an older one.
+        let older = r#"{"strategy":"rayon-chunks","cores":2,"chunks":45,"n":1000,"steps":3,"kernel_calls":5,"timeline_steps":[1,3]}"#;
+        std::fs::write(tmp.path().join(META_JSON), older).unwrap();
+        let why = format!("{:#}", check(tmp.path()).unwrap_err());
+        assert!(why.contains("an older bench-sph"), "{why}");
     }
 
     #[test]

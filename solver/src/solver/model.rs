@@ -2,7 +2,7 @@
 //! implements [`Model`]: Müller's `Params`, WCSPH's `WcParams`), its per-particle passes
 //! (`sph::passes`, `sph::wcsph::passes`) and its schedule (`models/`, one file per model: which
 //! arrays each pass writes, and the pass handed to the strategy's executor). The solver runs a
-//! step through this trait and never names a model; `Physics` lists the models, one line each.
+//! step through this trait and never names a model; `Physics` lists the models.
 
 use std::any::Any;
 use std::fmt::Debug;

@@ -1,4 +1,5 @@
-//! Which model a simulation steps: the registry of models, one line each. Everything a model
+//! Which model a simulation steps: the registry of models (a variant of [`Physics`], its
+//! `From` and its arm of `with_model!` each). Everything a model
 //! is — its preset, search, passes and schedule — it says through [`Model`]; this file only
 //! names them.
 

@@ -1,5 +1,7 @@
-//! The weakly compressible step's passes (see [`crate::sph::wcsph`]). Fluid particles are
-//! `0..fluid`, walls the rest; each pass writes its own arrays over one of the two ranges.
+//! The weakly compressible model (the `wcsph` preset, see [`crate::sph::wcsph`]) as the solver
+//! runs it: its constants ([`WcParams`]) as a [`Model`], and its step's six passes. Fluid
+//! particles are `0..fluid`, walls the rest; each pass writes its own arrays over one of the
+//! two ranges.
 
 use glam::DVec2;
 use sph_strategies::{Executor, KernelPanic};
