@@ -167,7 +167,7 @@ impl Simulation {
     /// run on the grid on another path, which uses none of them (the grid then tests its few
     /// candidates per row one by one).
     pub fn simd(&self) -> SimdPath {
-        let on_grid = with_model!(self.physics, m => lanes_on_grid(&m));
+        let on_grid = with_model!(&self.physics, m => m.lanes_on_grid());
         match (&self.neighbors, on_grid, self.lanes.path()) {
             (AnyNeighbors::AllPairs(_), _, path)
             | (_, true, path)
@@ -229,9 +229,4 @@ impl Simulation {
     pub fn neighbor_heap_bytes(&self) -> usize {
         self.neighbors.heap_bytes() + self.scratch.heap_bytes()
     }
-}
-
-/// Whether `M`'s passes run on the run's SIMD path on the grid too ([`Model::LANES_ON_GRID`]).
-fn lanes_on_grid<M: Model>(_: &M) -> bool {
-    M::LANES_ON_GRID
 }

@@ -21,11 +21,11 @@ pub trait Model: Copy + Debug {
     type Scratch: Scratch;
 
     /// The passes of one step, in step order.
-    const PASSES: &'static [Pass];
+    fn passes(&self) -> &'static [Pass];
 
     /// Whether every pass runs on the run's SIMD path on the grid as well (Müller's force
     /// pass does), rather than only all-pairs' neighbour tests and AVX-512's packed scan.
-    const LANES_ON_GRID: bool;
+    fn lanes_on_grid(&self) -> bool;
 
     /// The preset these constants belong to.
     fn preset(&self) -> Preset;
@@ -49,7 +49,7 @@ pub trait Model: Copy + Debug {
     /// passes before it in the step wrote.
     ///
     /// # Panics
-    /// If `pass` is not one of [`Model::PASSES`].
+    /// If `pass` is not one of [`Model::passes`].
     fn run_pass<E: Executor>(
         &self,
         exec: &E,

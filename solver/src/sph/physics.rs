@@ -62,10 +62,7 @@ impl Physics {
 
     /// The model's passes, in step order.
     pub fn passes(&self) -> &'static [Pass] {
-        fn of<M: Model>(_: &M) -> &'static [Pass] {
-            M::PASSES
-        }
-        with_model!(self, m => of(m))
+        with_model!(self, m => m.passes())
     }
 
     /// The rectangle the grid covers: the domain, and for WCSPH the walls' particle layers

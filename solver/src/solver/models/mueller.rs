@@ -17,10 +17,14 @@ use crate::with_lanes;
 impl Model for Params {
     type Scratch = ();
 
-    const PASSES: &'static [Pass] = &Pass::MUELLER;
+    fn passes(&self) -> &'static [Pass] {
+        &Pass::MUELLER
+    }
 
     // The force pass searches only for a pile, and takes two neighbours at once on any search.
-    const LANES_ON_GRID: bool = true;
+    fn lanes_on_grid(&self) -> bool {
+        true
+    }
 
     fn preset(&self) -> Preset {
         Params::preset(self)

@@ -50,9 +50,13 @@ impl model::Scratch for Scratch {
 impl Model for WcParams {
     type Scratch = Scratch;
 
-    const PASSES: &'static [Pass] = &Pass::WCSPH;
+    fn passes(&self) -> &'static [Pass] {
+        &Pass::WCSPH
+    }
 
-    const LANES_ON_GRID: bool = false;
+    fn lanes_on_grid(&self) -> bool {
+        false
+    }
 
     fn preset(&self) -> Preset {
         Preset::Wcsph
