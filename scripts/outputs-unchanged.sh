@@ -6,7 +6,8 @@
 # Usage: scripts/outputs-unchanged.sh [BASE]
 #   BASE_BIN=path  use this binary for BASE instead of building it (in target/outputs-base/).
 #
-# The commands: the committed report regenerated from the committed results (traces included),
+# The commands: the committed reports regenerated from the committed results (traces included;
+# the comparisons, the placement study, and a comparison of two machines),
 # two sweeps under the test hooks --fake-timings/--fake-contention (one contended, one
 # oversubscribed cell) and their report, a third interrupted and resumed, simulate
 # --json/--dump on three strategies and from an --init file, render to a GIF and to PNG
@@ -42,7 +43,13 @@ outputs() {
     mkdir -p "$out" && cd "$out"
     ln -s "$repo/results" results
     mkdir report && cp -r "$repo"/report/trace-* report/
-    { "$bin" report results/paper results/grid results/all-pairs-small --out report; echo "rc=$?"; } > report.stdout 2>&1
+    { "$bin" report results/paper results/grid results/all-pairs-small results/wcsph --out report; echo "rc=$?"; } > report.stdout 2>&1
+    # The committed comparisons (two runs set apart with --compare), a placement study, and
+    # two machines (sides by meta.json's machine).
+    { "$bin" report --compare results/grid results/grid-50steps --out compare; echo "rc=$?"; } > compare.stdout 2>&1
+    { "$bin" report --compare results/paper results/paper-again --out reproducibility; echo "rc=$?"; } > reproducibility.stdout 2>&1
+    { "$bin" report results/pin --out pin; echo "rc=$?"; } > pin.stdout 2>&1
+    { "$bin" report results/paper results/xeon-16-all-pairs --out machines; echo "rc=$?"; } > machines.stdout 2>&1
     { "$bin" sweep --preset seed --neighbors grid,all-pairs --n 200,300 --steps 5 --cores 1..3 \
         --chunks 2,7 --trials 3 --warmup 0 --seed 7 --fake-timings 1.0:1.1,0.5:0.9,0.6,0.7:1.3,0.4 \
         --fake-contention 0,0,0,0.6,0 --out sw1; echo "rc=$?"; } > sw1.stdout 2>&1

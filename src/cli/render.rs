@@ -125,14 +125,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         failed: None,
     };
     // All frames in one session: one thread pool for the whole animation.
-    let outcome = run_steps(
-        &mut sim,
-        args.parallel.strategy,
-        &config,
-        steps,
-        &mut (),
-        &mut drawn,
-    );
+    let outcome = run_steps(&mut sim, args.parallel.strategy, &config, steps, &mut drawn);
     let (frames, shown, simulating_s) = (drawn.frames, drawn.shown, drawn.simulating_s);
     if let Some(err) = drawn.failed {
         return Err(err);

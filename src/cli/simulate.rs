@@ -11,7 +11,7 @@ use crate::io::dump_csv::{self, DumpInfo};
 use crate::io::sink::Sink;
 use crate::limits;
 use crate::output::console;
-use crate::run::fault::PanicAt;
+use crate::run::fault::run_timed_steps_panicking_at;
 use crate::run::{RunError, Steps, run_timed_steps};
 use crate::simd::SimdPath;
 use crate::solver::{Simulation, StepError};
@@ -99,9 +99,9 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
     };
     let strategy = args.parallel.strategy;
     let outcome = match args.hooks().inject_panic_at {
-        None => run_timed_steps(&mut sim, strategy, &config, steps, &mut ()),
+        None => run_timed_steps(&mut sim, strategy, &config, steps),
         Some(particle) => {
-            run_timed_steps(&mut sim, strategy, &config, steps, &mut PanicAt(particle))
+            run_timed_steps_panicking_at(&mut sim, strategy, &config, steps, particle)
         }
     };
 

@@ -1,9 +1,22 @@
 //! Fault injection for tests (the hidden `simulate --inject-panic-at`): a wrapping executor,
 //! like the trace's, so the solver carries no test flag and runs without it pay nothing.
 
-use sph_strategies::{Executor, KernelPanic, Split};
+use sph_strategies::{Config, Executor, KernelPanic, Split, StrategyName};
 
-use sph_solver::solver::{Pass, Phase, PhaseJob, StepHooks};
+use super::{RunError, Steps};
+use crate::clock::Elapsed;
+use sph_solver::solver::{Pass, Phase, PhaseJob, Simulation, StepHooks};
+
+/// [`super::run_timed_steps`] with [`PanicAt`]`(particle)`'s fault in every step.
+pub fn run_timed_steps_panicking_at(
+    sim: &mut Simulation,
+    strategy: StrategyName,
+    config: &Config,
+    steps: Steps,
+    particle: usize,
+) -> Result<Elapsed, RunError> {
+    super::run_timed_steps_with(sim, strategy, config, steps, &mut PanicAt(particle))
+}
 
 /// Step hooks that make the density pass's kernel panic with `injected fault at particle I`
 /// in the call whose chunk holds particle `I`, before it computes anything, in every step.

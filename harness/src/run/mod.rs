@@ -90,16 +90,20 @@ impl Observer for LastSegment {
     }
 }
 
-struct Segments<'a, H, O> {
+/// The session of a run. Generic over the hooks only, which are the harness's own (none, the
+/// trace's, the injected fault's): every public function of this module is monomorphic, so the
+/// solver is compiled for each strategy's executor here, once, and not again in every crate
+/// that runs a simulation (a release build does not share generic instances between crates).
+struct Segments<'a, H> {
     sim: &'a mut Simulation,
     /// The CPUs the strategy's threads may use (see [`sph_strategies::wake()`]).
     cpus: usize,
     steps: Steps,
     hooks: &'a mut H,
-    observer: &'a mut O,
+    observer: &'a mut dyn Observer,
 }
 
-impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
+impl<H: StepHooks + Send> Session for Segments<'_, H> {
     type Output = Result<(), StepError>;
 
     fn run<E: Executor>(self, exec: &E) -> Self::Output {
@@ -138,19 +142,29 @@ impl<H: StepHooks + Send, O: Observer> Session for Segments<'_, H, O> {
     }
 }
 
-/// Runs `steps` of `sim` in one session of `strategy`, each phase and check through `hooks`,
-/// showing the simulation to `observer` after every segment. With a placement other than the
-/// operating system's, the calling thread is pinned for the run too ([`Pinned`]). Before its
-/// steps (and its warm-up) the session wakes the strategy's threads
-/// ([`sph_strategies::wake()`]): untimed passes that spin until the threads run on their cores,
-/// at most 0.15 s.
-pub fn run_steps<H: StepHooks + Send, O: Observer>(
+/// Runs `steps` of `sim` in one session of `strategy`, showing the simulation to `observer`
+/// after every segment. With a placement other than the operating system's, the calling
+/// thread is pinned for the run too ([`Pinned`]). Before its steps (and its warm-up) the
+/// session wakes the strategy's threads ([`sph_strategies::wake()`]): untimed passes that spin
+/// until the threads run on their cores, at most 0.15 s.
+pub fn run_steps(
+    sim: &mut Simulation,
+    strategy: StrategyName,
+    config: &Config,
+    steps: Steps,
+    observer: &mut dyn Observer,
+) -> Result<(), RunError> {
+    run_steps_with(sim, strategy, config, steps, &mut (), observer)
+}
+
+/// [`run_steps`] with each phase and check through `hooks`.
+fn run_steps_with<H: StepHooks + Send>(
     sim: &mut Simulation,
     strategy: StrategyName,
     config: &Config,
     steps: Steps,
     hooks: &mut H,
-    observer: &mut O,
+    observer: &mut dyn Observer,
 ) -> Result<(), RunError> {
     let session = Segments {
         sim,
@@ -187,7 +201,7 @@ fn wake_threads<E: Executor>(exec: &E, cpus: usize, step: usize) -> Result<(), S
 /// Runs `warmup` untimed steps on a copy of `sim` (see [`Steps::warmup`]), then `steps` steps
 /// of `sim` with `strategy`, each phase and check through `hooks`, and returns the time the
 /// `steps` took (zero for zero steps).
-pub fn run_timed_with<H: StepHooks + Send>(
+pub(crate) fn run_timed_with<H: StepHooks + Send>(
     sim: &mut Simulation,
     strategy: StrategyName,
     config: &Config,
@@ -199,12 +213,22 @@ pub fn run_timed_with<H: StepHooks + Send>(
         warmup,
         ..Steps::timed(steps)
     };
-    run_timed_steps(sim, strategy, config, steps, hooks)
+    run_timed_steps_with(sim, strategy, config, steps, hooks)
 }
 
-/// Runs `steps` of `sim` with `strategy` as one timed segment (`steps.every` is ignored),
-/// each phase and check through `hooks`, and returns the time they took (zero for none).
-pub fn run_timed_steps<H: StepHooks + Send>(
+/// Runs `steps` of `sim` with `strategy` as one timed segment (`steps.every` is ignored) and
+/// returns the time they took (zero for none).
+pub fn run_timed_steps(
+    sim: &mut Simulation,
+    strategy: StrategyName,
+    config: &Config,
+    steps: Steps,
+) -> Result<Elapsed, RunError> {
+    run_timed_steps_with(sim, strategy, config, steps, &mut ())
+}
+
+/// [`run_timed_steps`] with each phase and check through `hooks`.
+pub(crate) fn run_timed_steps_with<H: StepHooks + Send>(
     sim: &mut Simulation,
     strategy: StrategyName,
     config: &Config,
@@ -216,7 +240,7 @@ pub fn run_timed_steps<H: StepHooks + Send>(
         ..steps
     };
     let mut last = LastSegment(None);
-    run_steps(sim, strategy, config, steps, hooks, &mut last)?;
+    run_steps_with(sim, strategy, config, steps, hooks, &mut last)?;
     Ok(last.0.unwrap_or(Elapsed {
         wall_s: 0.0,
         cpu_s: 0.0,
@@ -299,7 +323,7 @@ mod tests {
                 ..Steps::timed(7)
             };
             let mut observer = seen(usize::MAX);
-            run_steps(&mut cut, strategy, &CONFIG, steps, &mut (), &mut observer).unwrap();
+            run_steps(&mut cut, strategy, &CONFIG, steps, &mut observer).unwrap();
             assert_eq!(observer.steps, [3, 6, 7], "{strategy}");
             let first = observer.threads[0];
             assert!(
@@ -318,7 +342,7 @@ mod tests {
             until_s: Some(10.5 * dt),
             ..Steps::timed(1000)
         };
-        run_timed_steps(&mut s, StrategyName::Seq, &CONFIG, steps, &mut ()).unwrap();
+        run_timed_steps(&mut s, StrategyName::Seq, &CONFIG, steps).unwrap();
         assert_eq!(s.steps_done, 11);
         assert!(s.time_s >= 10.5 * dt && s.time_s < 11.5 * dt);
         // The step cap still holds.
@@ -327,7 +351,7 @@ mod tests {
             until_s: Some(1.0),
             ..Steps::timed(4)
         };
-        run_timed_steps(&mut capped, StrategyName::Seq, &CONFIG, steps, &mut ()).unwrap();
+        run_timed_steps(&mut capped, StrategyName::Seq, &CONFIG, steps).unwrap();
         assert_eq!(capped.steps_done, 4);
     }
 
@@ -339,15 +363,7 @@ mod tests {
             ..Steps::timed(usize::MAX)
         };
         let mut observer = seen(3);
-        run_steps(
-            &mut s,
-            StrategyName::Seq,
-            &CONFIG,
-            steps,
-            &mut (),
-            &mut observer,
-        )
-        .unwrap();
+        run_steps(&mut s, StrategyName::Seq, &CONFIG, steps, &mut observer).unwrap();
         assert_eq!((observer.steps, s.steps_done), (vec![2, 4, 6], 6));
     }
 

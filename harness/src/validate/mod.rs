@@ -89,7 +89,7 @@ pub fn validate(
         warmup: 0,
         until_s: Some(t_end_s),
     };
-    run_steps(&mut sim, strategy, config, steps, &mut (), &mut probe)?;
+    run_steps(&mut sim, strategy, config, steps, &mut probe)?;
     let front: Vec<Point> = probe
         .samples
         .iter()

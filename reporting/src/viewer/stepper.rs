@@ -141,7 +141,7 @@ impl Stepper {
                     ask: ask_rx,
                     done: done_tx,
                 };
-                let result = run_steps(&mut sim, strategy, &config, steps, &mut (), &mut relay);
+                let result = run_steps(&mut sim, strategy, &config, steps, &mut relay);
                 (sim, result)
             });
         let thread = match spawned {
