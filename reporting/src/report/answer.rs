@@ -16,6 +16,7 @@ use super::cell::Best;
 use super::findings::{AtCores, Finding, Withheld};
 use super::numbers::{faster, plus_minus};
 use super::select;
+use super::table::{Column, Table};
 use super::verdict::{Entry, Verdict, and_list};
 use super::view::{Design, GroupView};
 use sph_harness::results::intervals::MIN_ROUNDS;
@@ -121,10 +122,13 @@ pub fn markdown(groups: &[GroupAnswer]) -> String {
          fastest strategy did not beat `seq` (its speedup's interval holds 1, or lies below \
          it), the speedup says so.\n\n",
     );
-    md.push_str(
-        "| workload | cores | fastest | speedup (95 % CI) | vs runner-up |\n\
-         |---|---:|---|---:|---|\n",
-    );
+    let mut t = Table::new([
+        Column::left("workload"),
+        Column::right("cores"),
+        Column::left("fastest"),
+        Column::right("speedup (95 % CI)"),
+        Column::left("vs runner-up"),
+    ]);
     let rows: usize = groups.iter().map(|g| g.said.len()).sum();
     let shown = if rows > MAX_ROWS {
         (MAX_ROWS / groups.len()).max(1)
@@ -140,14 +144,14 @@ pub fn markdown(groups: &[GroupAnswer]) -> String {
             format!("{} ⚠ not confirmed", g.label)
         };
         for s in &g.said[from..] {
-            let _ = writeln!(md, "| {label} | {} |", cells(s));
+            t.row(std::iter::once(label.clone()).chain(cells(s)));
         }
         if from > 0 {
             let hidden: Vec<String> = g.said[..from].iter().map(cores_of).collect();
             left.push((&g.label, and_list(&hidden)));
         }
     }
-    md.push('\n');
+    let _ = writeln!(md, "{t}");
     if let Some((_, first)) = left.first() {
         let others = if left.iter().all(|(_, c)| c == first) {
             format!("{first} cores")
@@ -176,12 +180,14 @@ fn cores_of(s: &Said) -> String {
 }
 
 /// A row's cells after the workload: cores, fastest, speedup, against the runner-up.
-fn cells(s: &Said) -> String {
+fn cells(s: &Said) -> [String; 4] {
+    // A row without a fastest cell: its cores (or a dash), dashes, and why.
+    let none = |cores: String, why: &str| [cores, "—".into(), "—".into(), format!("— {why}")];
     let (at, seq_trusted) = match s {
-        Said::Withheld(why) => return format!("— | — | — | — {}", reason(*why)),
-        Said::Nothing => return "— | — | — | — no parallel strategy has a usable cell".to_owned(),
+        Said::Withheld(why) => return none("—".into(), &reason(*why)),
+        Said::Nothing => return none("—".into(), "no parallel strategy has a usable cell"),
         Said::AllContended(c) => {
-            return format!("{c} | — | — | — every cell contended, none enters a finding");
+            return none(c.to_string(), "every cell contended, none enters a finding");
         }
         Said::At { at, seq_trusted } => (at, *seq_trusted),
     };
@@ -216,16 +222,17 @@ fn cells(s: &Said) -> String {
         Verdict::Only(w) => (w, cell(&w.1), "the only strategy measured".to_owned()),
         Verdict::Unknown(w, why) => (w, cell(&w.1), format!("no order: {}", why.phrase())),
     };
-    format!(
-        "{}{} | {first} | {} | {against}{left_out}",
-        at.cores,
-        if at.oversubscribed {
-            " ⚠ oversubscribed"
-        } else {
-            ""
-        },
+    let flag = if at.oversubscribed {
+        " ⚠ oversubscribed"
+    } else {
+        ""
+    };
+    [
+        format!("{}{flag}", at.cores),
+        first,
         speedup(winner),
-    )
+        format!("{against}{left_out}"),
+    ]
 }
 
 /// What the fastest cell's speedup interval says against `seq` where it did not beat it:

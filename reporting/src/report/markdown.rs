@@ -13,6 +13,7 @@ use super::paper;
 use super::plan::{ChartPlan, Skipped};
 use super::select;
 use super::series::{self, Group, SmtBand};
+use super::table::{Column, Table};
 use super::traces::TraceDir;
 use super::view::{Design, GroupView};
 use sph_harness::results::key::LabelStyle;
@@ -328,25 +329,18 @@ fn dropped_banner(md: &mut String, sweeps: &[Sweep]) {
 
 fn machine(md: &mut String, sweeps: &[Sweep]) {
     let _ = writeln!(md, "## Machine and build\n");
-    let mut header = "| |".to_owned();
-    let mut rule = "|---|".to_owned();
-    for s in sweeps {
-        let _ = write!(header, " `{}` |", s.dir.display());
-        rule.push_str("---|");
-    }
-    let _ = writeln!(md, "{header}\n{rule}");
+    let dirs = sweeps
+        .iter()
+        .map(|s| Column::left(format!("`{}`", s.dir.display())));
+    let mut t = Table::new(std::iter::once(Column::left("")).chain(dirs));
     let recorded = sweeps
         .iter()
         .any(|s| s.meta.machine.topology.logical_cpus > 0);
     let topology = recorded.then(topology_fields).into_iter().flatten();
     for (name, f) in machine_fields().into_iter().chain(topology) {
-        let mut line = format!("| {name} |");
-        for s in sweeps {
-            let _ = write!(line, " {} |", f(s));
-        }
-        let _ = writeln!(md, "{line}");
+        t.row(std::iter::once(name.to_owned()).chain(sweeps.iter().map(f)));
     }
-    md.push('\n');
+    let _ = writeln!(md, "{t}");
     smt_note(md, sweeps);
 }
 
@@ -682,8 +676,9 @@ fn smt_paragraph(md: &mut String, band: &SmtBand) {
     );
 }
 
-// Over ~60 lines on purpose: the table with and without the paper's, the placement and the
-// physical-core columns, row by row; the layouts share every row.
+/// One strategy's Table 1 analogue: a row per best cell (`best`, by cores and placement)
+/// and, `with_paper`, the paper's columns and a row per core count of its table that was not
+/// measured.
 fn table(
     md: &mut String,
     strategy: StrategyName,
@@ -692,27 +687,18 @@ fn table(
     columns: Columns<'_>,
 ) {
     let _ = writeln!(md, "**{strategy}**\n");
-    let pin_head = if columns.pin { " pin |" } else { "" };
-    let pin_rule = if columns.pin { "---|" } else { "" };
-    let (smt_head, smt_rule) = match columns.smt {
-        Some(_) => (" efficiency per physical core |", "---:|"),
-        None => ("", ""),
-    };
-    let (paper_head, paper_rule) = if with_paper {
-        (
-            " paper: best chunks | paper: time (s) | paper: speedup |",
-            "---:|---:|---:|",
-        )
-    } else {
-        ("", "")
-    };
-    let _ = writeln!(
-        md,
-        "| cores |{pin_head} {BEST_HEAD} |{smt_head}{paper_head}\n\
-         |---:|{pin_rule}{BEST_RULE}|{smt_rule}{paper_rule}"
-    );
-    // One row per measured (cores, placement), and with the paper's columns one per core
-    // count of its table that was not measured.
+    let mut head = vec![Column::right("cores")];
+    if columns.pin {
+        head.push(Column::left("pin"));
+    }
+    head.extend(best_columns());
+    if columns.smt.is_some() {
+        head.push(Column::right("efficiency per physical core"));
+    }
+    if with_paper {
+        head.extend(["paper: best chunks", "paper: time (s)", "paper: speedup"].map(Column::right));
+    }
+    let mut t = Table::new(head);
     let mut cells: Vec<(usize, Option<&Best>)> = best.iter().map(|b| (b.cores, Some(b))).collect();
     if with_paper {
         for r in paper::TABLE {
@@ -724,56 +710,45 @@ fn table(
     }
     let dash = || "—".to_owned();
     for (c, ours) in cells {
-        let pin = match ours {
-            Some(b) if columns.pin => format!(" {} |", b.pin),
-            None if columns.pin => " — |".to_owned(),
-            _ => String::new(),
-        };
-        let physical = match (columns.smt, ours) {
-            (Some(band), Some(b)) => format!(
-                " {} |",
-                b.speedup
-                    .map_or_else(dash, |s| sig(band.physical_efficiency(s, b.cores)))
-            ),
-            (Some(_), None) => " — |".to_owned(),
-            (None, _) => String::new(),
-        };
-        let mut line = match ours {
-            Some(b) => {
-                let flags = [
-                    (b.oversubscribed, OVERSUBSCRIBED),
-                    (b.contended, CONTENDED),
-                    (columns.confirmed && !b.confirmed, UNCONFIRMED),
-                ];
-                let flags: String = flags
-                    .iter()
-                    .filter(|(on, _)| *on)
-                    .map(|(_, f)| format!(" {f}"))
-                    .collect();
-                format!("| {}{flags} |{pin} {} |{physical}", b.cores, best_cells(b))
-            }
-            None => format!("| {c} |{pin} — | — | — | — | — | — |{physical}"),
-        };
-        if with_paper {
-            match paper::at(c) {
-                Some(p) => {
-                    let _ = write!(
-                        line,
-                        " {} | {} | {} |",
-                        p.chunks,
-                        sig(p.time_s),
-                        times(p.speedup)
-                    );
-                }
-                None if c == 1 => {
-                    let _ = write!(line, " — | {} (serial) | 1.00× |", sig(paper::SERIAL_S));
-                }
-                None => line.push_str(" — | — | — |"),
-            }
+        let mut row = vec![ours.map_or_else(|| c.to_string(), |b| flagged_cores(b, columns))];
+        if columns.pin {
+            row.push(ours.map_or_else(dash, |b| b.pin.to_string()));
         }
-        let _ = writeln!(md, "{line}");
+        match ours {
+            Some(b) => row.extend(best_cells(b)),
+            None => row.extend(best_columns().map(|_| dash())),
+        }
+        if let Some(band) = columns.smt {
+            let physical = ours.and_then(|b| Some(band.physical_efficiency(b.speedup?, b.cores)));
+            row.push(physical.map_or_else(dash, sig));
+        }
+        if with_paper {
+            row.extend(match paper::at(c) {
+                Some(p) => [p.chunks.to_string(), sig(p.time_s), times(p.speedup)],
+                None if c == 1 => [
+                    dash(),
+                    format!("{} (serial)", sig(paper::SERIAL_S)),
+                    "1.00×".to_owned(),
+                ],
+                None => [dash(), dash(), dash()],
+            });
+        }
+        t.row(row);
     }
-    md.push('\n');
+    let _ = writeln!(md, "{t}");
+}
+
+/// A best cell's cores with its flags: `3 ⚠ oversubscribed ⚠ not confirmed`.
+fn flagged_cores(b: &Best, columns: Columns<'_>) -> String {
+    let flags = [
+        (b.oversubscribed, OVERSUBSCRIBED),
+        (b.contended, CONTENDED),
+        (columns.confirmed && !b.confirmed, UNCONFIRMED),
+    ];
+    flags
+        .iter()
+        .filter(|(on, _)| *on)
+        .fold(b.cores.to_string(), |cores, (_, f)| format!("{cores} {f}"))
 }
 
 /// An image's alt text: its caption up to the first `;` or `,`.
@@ -808,47 +783,53 @@ fn failed(md: &mut String, rows: &[SummaryRow]) {
         return;
     }
     let _ = writeln!(md, "Excluded from every table and chart.\n");
-    let _ = writeln!(
-        md,
-        "| group | strategy | cores | chunks | reason |\n|---|---|---:|---:|---|"
-    );
+    let mut t = Table::new([
+        Column::left("group"),
+        Column::left("strategy"),
+        Column::right("cores"),
+        Column::right("chunks"),
+        Column::left("reason"),
+    ]);
     for r in bad {
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {} | {} |",
+        t.row([
             r.group().label(LabelStyle::Report),
-            r.strategy,
-            r.cores,
+            r.strategy.to_string(),
+            r.cores.to_string(),
             r.chunks.map_or_else(|| "—".to_owned(), |k| k.to_string()),
-            r.reason.replace('|', "\\|")
-        );
+            r.reason.replace('|', "\\|"),
+        ]);
     }
-    md.push('\n');
+    let _ = writeln!(md, "{t}");
 }
 
-/// The head of the columns [`best_cells`] fills, shared by the study's tables and the
-/// comparison's.
-pub(super) const BEST_HEAD: &str = "best chunks | mean time (s) [95 % CI] | median (s) | min (s) \
-                                    | speedup (± 95 % CI) | efficiency";
-/// The alignment row of [`BEST_HEAD`].
-pub(super) const BEST_RULE: &str = "---:|---:|---:|---:|---:|---:";
+/// The columns [`best_cells`] fills, shared by the study's tables and the comparison's.
+pub(super) fn best_columns() -> [Column; 6] {
+    [
+        "best chunks",
+        "mean time (s) [95 % CI]",
+        "median (s)",
+        "min (s)",
+        "speedup (± 95 % CI)",
+        "efficiency",
+    ]
+    .map(Column::right)
+}
 
 /// A best cell's chunks, mean time, median, fastest trial, speedup and efficiency as table
-/// cells (`10 | 0.0430 [0.0425–0.0437] | 0.0429 | 0.0421 | 1.82 ± 0.03× | 0.912`; a dash
-/// where undefined), under [`BEST_HEAD`].
-pub(super) fn best_cells(b: &Best) -> String {
+/// cells (`10`, `0.0430 [0.0425–0.0437]`, `0.0429`, `0.0421`, `1.82 ± 0.03×`, `0.912`; a dash
+/// where undefined), under [`best_columns`].
+pub(super) fn best_cells(b: &Best) -> [String; 6] {
     let dash = || "—".to_owned();
-    format!(
-        "{} | {}{} | {} | {} | {} | {}",
+    [
         b.chunks.map_or_else(dash, |k| k.to_string()),
-        secs(b.mean_s),
-        interval(b.mean_ci),
+        format!("{}{}", secs(b.mean_s), interval(b.mean_ci)),
         secs(b.median_s),
         secs(b.min_s),
         b.speedup.map_or_else(dash, |s| plus_minus(s, b.speedup_ci)),
         b.efficiency.map_or_else(dash, sig),
-    )
+    ]
 }
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -10,7 +10,8 @@
 //! them (one file per chart kind, [`charts::WIDTH`] × [`charts::HEIGHT`] PNGs in the bundled
 //! font); [`traces`] finds trace directories to embed; [`markdown`] writes the report's text
 //! (pure), opening with [`answer`] (per group and core count, the fastest strategy as the
-//! group's findings decide it); [`paper`] holds the seed paper's published numbers.
+//! group's findings decide it), every table through [`table`]; [`paper`] holds the seed
+//! paper's published numbers.
 //!
 //! Charts, per group (preset, neighbours, N, steps):
 //! 1. runtime against chunks, one line per core count, each line's minimum crossed, each trial
@@ -52,6 +53,7 @@ pub mod plan;
 pub mod rank_shift;
 pub mod select;
 pub mod series;
+pub mod table;
 pub mod traces;
 pub mod verdict;
 pub mod view;

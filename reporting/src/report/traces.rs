@@ -21,6 +21,8 @@ use sph_harness::output::{atomic, console, sniff};
 use sph_harness::trace::files::{self, META_JSON, StatsRow, TraceMeta};
 use sph_harness::trace::stats::{CSV_HEADER, idle_workers_note};
 
+use super::table::{Column, Table};
+
 /// The files that make a directory a trace directory.
 pub const TIMELINE: &str = files::TIMELINE_PNG;
 /// See [`TIMELINE`].
@@ -321,23 +323,25 @@ pub fn markdown(traces: &[TraceDir]) -> String {
     for t in traces {
         let _ = writeln!(md, "### {}\n", t.title);
         let _ = writeln!(md, "![timeline: {}]({})\n", t.title, t.image);
-        let _ = writeln!(
-            md,
-            "| pass | kernel calls | busy (ms) | span (ms) | idle % | imbalance |\n\
-             |---|---:|---:|---:|---:|---:|"
-        );
+        let mut table = Table::new([
+            Column::left("pass"),
+            Column::right("kernel calls"),
+            Column::right("busy (ms)"),
+            Column::right("span (ms)"),
+            Column::right("idle %"),
+            Column::right("imbalance"),
+        ]);
         for r in t.stats.iter().filter(|r| r.kind == "pass") {
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} | {} | {} | {} |",
-                r.name,
-                r.kernel_calls,
+            table.row([
+                r.name.clone(),
+                r.kernel_calls.to_string(),
                 sig3(r.busy_ms),
                 sig3(r.span_ms),
                 sig3(r.idle_pct),
-                r.imbalance.map_or_else(|| "—".to_owned(), sig3)
-            );
+                r.imbalance.map_or_else(|| "—".to_owned(), sig3),
+            ]);
         }
+        let _ = write!(md, "{table}");
         if let Some(total) = t.stats.iter().find(|r| r.kind == "total") {
             let (used, workers) = (t.workers_used(), t.workers());
             let _ = writeln!(

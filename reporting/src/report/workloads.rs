@@ -26,6 +26,7 @@ use super::numbers::{interval, plus_minus, sig, times};
 use super::rank_shift::rank_shift;
 use super::select;
 use super::series::{self, Group};
+use super::table::{Column, Table};
 use super::verdict::Entry;
 use super::view::GroupView;
 use sph_harness::results::key::LabelStyle;
@@ -236,25 +237,26 @@ fn pairing(md: &mut String, p: &Pairing) {
         );
     }
     for at in &p.at {
-        let _ = writeln!(
-            md,
-            "**{}**\n\n| strategy | toy ({} preset, N = {}): rank, speedup (± 95 % CI) | wcsph \
-             (N = {}): rank, speedup (± 95 % CI) |\n|---|---|---|",
-            series::cores_label(at.cores),
-            toy.group.preset,
-            toy.group.n,
-            p.real.group.n
-        );
+        let _ = writeln!(md, "**{}**\n", series::cores_label(at.cores));
+        let mut t = Table::new([
+            Column::left("strategy"),
+            Column::left(format!(
+                "toy ({} preset, N = {}): rank, speedup (± 95 % CI)",
+                toy.group.preset, toy.group.n
+            )),
+            Column::left(format!(
+                "wcsph (N = {}): rank, speedup (± 95 % CI)",
+                p.real.group.n
+            )),
+        ]);
         for r in &at.rows {
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} |",
-                r.strategy,
+            t.row([
+                r.strategy.to_string(),
                 place(r.toy.as_ref()),
-                place(r.real.as_ref())
-            );
+                place(r.real.as_ref()),
+            ]);
         }
-        let _ = writeln!(md, "\n- {}\n", at.finding.sentence());
+        let _ = writeln!(md, "{t}\n- {}\n", at.finding.sentence());
     }
 }
 

@@ -18,10 +18,11 @@ use super::sides::{Side, SideRule, same_hardware_sets};
 use crate::report::cell::Best;
 use crate::report::load::Sweep;
 use crate::report::markdown::{
-    BEST_HEAD, BEST_RULE, CONTENDED, OVERSUBSCRIBED, banners, method, test_data_banner,
+    CONTENDED, OVERSUBSCRIBED, banners, best_cells, best_columns, method, test_data_banner,
 };
 use crate::report::numbers::faster;
 use crate::report::series::Group;
+use crate::report::table::{Column, Table};
 use crate::report::verdict::{Entry, and_list, describe};
 use sph_harness::results::key::LabelStyle;
 use sph_harness::results::rows::{Status, SummaryRow};
@@ -142,11 +143,15 @@ fn distinct(side: &Side<'_>, f: impl Fn(&Sweep) -> String) -> String {
 
 fn machines(md: &mut String, sides: &[Side<'_>]) {
     let _ = writeln!(md, "## Machines\n");
-    let _ = writeln!(
-        md,
-        "| side | machine | OS | kernel | arch | bench-sph commit | directories |\n\
-         |---|---|---|---|---|---|---|"
-    );
+    let mut t = Table::new([
+        Column::left("side"),
+        Column::left("machine"),
+        Column::left("OS"),
+        Column::left("kernel"),
+        Column::left("arch"),
+        Column::left("bench-sph commit"),
+        Column::left("directories"),
+    ]);
     for side in sides {
         let commit = distinct(side, |s| {
             let dirty = s.meta.git_dirty || s.meta.git_commit.ends_with("-dirty");
@@ -161,19 +166,17 @@ fn machines(md: &mut String, sides: &[Side<'_>]) {
             .iter()
             .map(|d| format!("`{}`", d.display()))
             .collect();
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {} | {} | {} | {} |",
-            side.tag,
+        t.row([
+            side.tag.clone(),
             side.machine().label(),
             distinct(side, |s| s.meta.machine.os.clone()),
             distinct(side, |s| s.meta.machine.kernel.clone()),
             distinct(side, |s| s.meta.machine.arch.clone()),
             commit,
-            dirs.join(", ")
-        );
+            dirs.join(", "),
+        ]);
     }
-    md.push('\n');
+    let _ = writeln!(md, "{t}");
 }
 
 /// One matched workload: the steps note, the best strategy per machine, the charts, the notes.
@@ -189,15 +192,19 @@ fn compared(md: &mut String, sides: &[Side<'_>], c: &Compared) {
         );
     }
     let _ = writeln!(md, "**Best strategy per machine**\n");
-    let _ = writeln!(
-        md,
-        "| machine | steps | best strategy | cores | {BEST_HEAD} | flags | ranking |\n\
-         |---|---:|---|---:|{BEST_RULE}|---|---|"
-    );
+    let mut head = vec![
+        Column::left("machine"),
+        Column::right("steps"),
+        Column::left("best strategy"),
+        Column::right("cores"),
+    ];
+    head.extend(best_columns());
+    head.extend([Column::left("flags"), Column::left("ranking")]);
+    let mut t = Table::new(head);
     for b in &c.best {
-        best_row(md, &sides[b.side].tag, b);
+        t.row(best_row(&sides[b.side].tag, b));
     }
-    md.push('\n');
+    let _ = writeln!(md, "{t}");
     let _ = writeln!(md, "{}\n", verdict_across(sides, &c.best));
     for chart in &c.charts {
         embed(md, chart);
@@ -211,29 +218,24 @@ fn compared(md: &mut String, sides: &[Side<'_>], c: &Compared) {
 }
 
 /// A row of the best-strategy table.
-fn best_row(md: &mut String, tag: &str, b: &MachineBest) {
-    let Some((s, best)) = &b.best else {
-        let _ = writeln!(
-            md,
-            "| {tag} | {} | — | — | — | — | — | — | — | — | — | {} |",
-            b.group.steps,
-            ranking(b)
-        );
-        return;
-    };
-    let _ = writeln!(
-        md,
-        "| {tag} | {} | {s} | {} | {} | {} |",
-        b.group.steps,
-        cells(best),
-        flags(best),
-        ranking(b)
-    );
+fn best_row(tag: &str, b: &MachineBest) -> Vec<String> {
+    let mut row = vec![tag.to_owned(), b.group.steps.to_string()];
+    match &b.best {
+        Some((s, best)) => {
+            row.push(s.to_string());
+            row.extend(cells(best));
+            row.push(flags(best));
+        }
+        // A dash under the strategy, the cores, the best cell's columns and the flags.
+        None => row.extend(std::iter::repeat_n("—".to_owned(), 9)),
+    }
+    row.push(ranking(b));
+    row
 }
 
 /// The cores, chunks, time, speedup and efficiency columns of a best cell.
-fn cells(b: &Best) -> String {
-    format!("{} | {}", b.cores, crate::report::markdown::best_cells(b))
+fn cells(b: &Best) -> impl Iterator<Item = String> {
+    std::iter::once(b.cores.to_string()).chain(best_cells(b))
 }
 
 /// `⚠ oversubscribed`, `⚠ contended`, both, or `—`.
@@ -366,29 +368,28 @@ fn side_summary(md: &mut String, side: &Side<'_>, name: &str, groups: &[(Group, 
          this machine's full study (chunk charts, findings, traces) run `bench-sph report {}`.\n",
         dirs.join(" ")
     );
-    let _ = writeln!(
-        md,
-        "| group | strategy | cores | {BEST_HEAD} | flags |\n|---|---|---:|{BEST_RULE}|---|"
-    );
+    let mut head = vec![
+        Column::left("group"),
+        Column::left("strategy"),
+        Column::right("cores"),
+    ];
+    head.extend(best_columns());
+    head.push(Column::left("flags"));
+    let mut t = Table::new(head);
     for (g, entries) in groups {
+        let group = g.label(LabelStyle::Report);
         if entries.is_empty() {
-            let _ = writeln!(
-                md,
-                "| {} | — | — | — | — | — | — | — | — | no usable parallel cell |",
-                g.label(LabelStyle::Report)
-            );
+            // A dash under the strategy, the cores and the best cell's columns.
+            let dashes = std::iter::repeat_n("—".to_owned(), 8);
+            let none = "no usable parallel cell".to_owned();
+            t.row([group.clone()].into_iter().chain(dashes).chain([none]));
         }
         for (s, b) in entries {
-            let _ = writeln!(
-                md,
-                "| {} | {s} | {} | {} |",
-                g.label(LabelStyle::Report),
-                cells(b),
-                flags(b)
-            );
+            let row = [group.clone(), s.to_string()].into_iter();
+            t.row(row.chain(cells(b)).chain([flags(b)]));
         }
     }
-    md.push('\n');
+    let _ = writeln!(md, "{t}");
     let failed = side
         .rows
         .iter()

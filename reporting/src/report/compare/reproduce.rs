@@ -19,6 +19,7 @@ use crate::report::numbers::{faster, percent, plus_minus};
 use crate::report::select;
 use crate::report::select::SeriesKey;
 use crate::report::series::Group;
+use crate::report::table::{Column, Table};
 use crate::report::verdict;
 use crate::report::verdict::Order;
 use sph_harness::results::key::{Cell, LabelStyle};
@@ -213,27 +214,30 @@ pub fn markdown(reproduced: &[Reproduced], tags: &[&str]) -> String {
         if r.changed.is_empty() {
             continue;
         }
-        let _ = writeln!(
-            md,
-            "| workload | cores | strategy | on {a} | on {b} | |\n|---|---:|---|---|---|---|"
-        );
+        let mut t = Table::new([
+            Column::left("workload"),
+            Column::right("cores"),
+            Column::left("strategy"),
+            Column::left(format!("on {a}")),
+            Column::left(format!("on {b}")),
+            Column::left(""),
+        ]);
         for c in &r.changed {
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} | {} | {} | {} |",
+            let how = if c.reversed() {
+                "**reversed**"
+            } else {
+                "resolved on one side only"
+            };
+            t.row([
                 c.group.label(LabelStyle::Report),
-                c.cores,
-                c.a,
+                c.cores.to_string(),
+                c.a.to_string(),
                 said(&c.first, c),
                 said(&c.second, c),
-                if c.reversed() {
-                    "**reversed**"
-                } else {
-                    "resolved on one side only"
-                }
-            );
+                how.to_owned(),
+            ]);
         }
-        md.push('\n');
+        let _ = writeln!(md, "{t}");
     }
     md
 }
