@@ -9,10 +9,10 @@ use std::sync::Mutex;
 use std::thread::ThreadId;
 use std::time::Duration;
 
-use bench_sph::run::run_timed;
+use bench_sph::run::{self, run_timed};
 use bench_sph::scene::{Scene, dam_break};
 use bench_sph::simd::SimdPath;
-use bench_sph::solver::{Simulation, StepError};
+use bench_sph::solver::Simulation;
 use bench_sph::sph::neighbors::{GridKeys, NeighborMode, SumOrder};
 use bench_sph::sph::params::Preset;
 use bench_sph::sph::state::{FIELD_NAMES, State};
@@ -58,8 +58,9 @@ fn run(
 }
 
 /// [`run`] without what `run_timed` does around the steps: `STEPS` steps of the simulation in
-/// one session of `strategy` on `cores` threads and `chunks` chunks, the same `advance` on
-/// the same executor, so the same bits to compare. What it leaves out is the wake
+/// one session of `strategy` on `cores` threads and `chunks` chunks
+/// (`run::run_steps_only`), the same `advance` on the same executor, so the same bits to
+/// compare. What it leaves out is the wake
 /// (`sph_strategies::wake`): untimed passes on a scratch buffer that spin until the threads
 /// hold their cores, at least 10 ms on a quiet machine and up to 0.15 s on a busy one (as
 /// beside the suite's other test thread), before every run on more than one thread: 2 250 of
@@ -75,18 +76,10 @@ fn run_steps_only(
     cores: usize,
     chunks: usize,
 ) -> State {
-    struct Advance<'a>(&'a mut Simulation);
-    impl Session for Advance<'_> {
-        type Output = Result<(), StepError>;
-        fn run<E: Executor>(self, exec: &E) -> Self::Output {
-            self.0.advance(exec, STEPS)
-        }
-    }
     let what = format!("{strategy} cores={cores} chunks={chunks}");
     let mut sim = simulation(preset, search).with_simd(simd).unwrap();
-    sph_strategies::run(strategy, &Config::new(cores, chunks), Advance(&mut sim))
-        .unwrap_or_else(|e| panic!("{what}: {e}"))
-        .unwrap_or_else(|e| panic!("{what}: {e}"));
+    run::run_steps_only(&mut sim, strategy, &Config::new(cores, chunks), STEPS)
+        .unwrap_or_else(|e| panic!("{what}: {e:#}"));
     sim.state
 }
 

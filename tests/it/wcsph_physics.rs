@@ -1,16 +1,31 @@
 //! The `wcsph` preset's physics as a whole: a tank at rest stays at rest, and a dam break
 //! keeps its mass and its walls.
 
+use bench_sph::run::{RunError, Steps, run_timed, run_timed_steps};
 use bench_sph::scene::Scene;
 use bench_sph::scene::tank::{self, Fill};
 use bench_sph::solver::{Simulation, StepError};
 use bench_sph::sph::neighbors::NeighborMode;
 use bench_sph::sph::physics::Physics;
-use sph_strategies::seq::SeqExecutor;
+use sph_strategies::{Config, StrategyName};
+
+const SEQ: Config = Config::new(1, 1);
+
+/// Steps `sim` with `seq` until `t_end` seconds of simulated time.
+fn advance_until(sim: &mut Simulation, t_end: f64) -> Result<(), StepError> {
+    let steps = Steps {
+        until_s: Some(t_end),
+        ..Steps::timed(usize::MAX)
+    };
+    match run_timed_steps(sim, StrategyName::Seq, &SEQ, steps) {
+        Ok(_) => Ok(()),
+        Err(RunError::Step(e)) => Err(e),
+        Err(e) => panic!("seq runs: {e:#}"),
+    }
+}
 
 fn run_until(sim: &mut Simulation, t_end: f64) {
-    sim.advance_until(&SeqExecutor, usize::MAX, t_end, &mut ())
-        .expect("the run stays finite");
+    advance_until(sim, t_end).expect("the run stays finite");
 }
 
 fn params(sim: &Simulation) -> bench_sph::sph::wcsph::params::WcParams {
@@ -90,8 +105,11 @@ fn a_non_finite_density_stops_the_run_in_the_step_it_appears() {
         .unwrap()
         .simulate(NeighborMode::Grid);
     sim.state.rho[5] = f64::NAN;
-    let err = sim.advance(&SeqExecutor, 3).unwrap_err();
-    assert!(matches!(err, StepError::Diverged { step: 1, .. }), "{err}");
+    let err = run_timed(&mut sim, StrategyName::Seq, &SEQ, 3).unwrap_err();
+    assert!(
+        matches!(err, RunError::Step(StepError::Diverged { step: 1, .. })),
+        "{err}"
+    );
 }
 
 #[test]
@@ -99,9 +117,7 @@ fn fluid_that_splashes_out_of_the_open_tank_ends_the_run_with_an_error() {
     let mut sim = Scene::tank(Fill::DamBreak, 6)
         .unwrap()
         .simulate(NeighborMode::Grid);
-    let err = sim
-        .advance_until(&SeqExecutor, usize::MAX, 3.0, &mut ())
-        .unwrap_err();
+    let err = advance_until(&mut sim, 3.0).unwrap_err();
     assert!(matches!(err, StepError::Unphysical { .. }), "{err}");
     assert!(err.to_string().contains("left the tank"), "{err}");
     // It happened after the surge hit the far wall, not before.

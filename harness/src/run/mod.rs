@@ -258,6 +258,29 @@ pub fn run_timed(
     run_timed_with(sim, strategy, config, steps, 0, &mut ())
 }
 
+/// `steps` steps of `sim` in one session of `strategy`, and nothing around them: no wake of
+/// the threads, no pinning, no timing. What the tests' strategy matrix runs (thousands of short
+/// runs, for which the wake's spinning would be most of the time); the solver's code is the
+/// same that every run steps with, compiled here once.
+#[cfg(any(test, feature = "testing"))]
+pub fn run_steps_only(
+    sim: &mut Simulation,
+    strategy: StrategyName,
+    config: &Config,
+    steps: usize,
+) -> Result<(), RunError> {
+    struct Advance<'a>(&'a mut Simulation, usize);
+    impl Session for Advance<'_> {
+        type Output = Result<(), StepError>;
+        fn run<E: Executor>(self, exec: &E) -> Self::Output {
+            self.0.advance(exec, self.1)
+        }
+    }
+    let output = sph_strategies::run(strategy, config, Advance(sim, steps))
+        .map_err(|source| RunError::Build { strategy, source })?;
+    Ok(output?)
+}
+
 /// The seed preset's dam break of `n` particles (jitter seed `seed`) with the grid search:
 /// the simulation that the unit tests above the solver run.
 #[cfg(any(test, feature = "testing"))]
