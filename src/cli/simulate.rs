@@ -11,8 +11,7 @@ use crate::io::dump_csv::{self, DumpInfo};
 use crate::io::sink::Sink;
 use crate::limits;
 use crate::output::console;
-use crate::run::fault::run_timed_steps_panicking_at;
-use crate::run::{RunError, Steps, run_timed_steps};
+use crate::run::{RunError, Steps};
 use crate::simd::SimdPath;
 use crate::solver::{Simulation, StepError};
 use crate::sph::neighbors::{NeighborMode, SumOrder};
@@ -98,12 +97,9 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         },
     };
     let strategy = args.parallel.strategy;
-    let outcome = match args.hooks().inject_panic_at {
-        None => run_timed_steps(&mut sim, strategy, &config, steps),
-        Some(particle) => {
-            run_timed_steps_panicking_at(&mut sim, strategy, &config, steps, particle)
-        }
-    };
+    let outcome = args
+        .hooks()
+        .run_timed_steps(&mut sim, strategy, &config, steps);
 
     let diverged = matches!(
         outcome,

@@ -8,6 +8,11 @@
 //! the same in both builds.
 
 use clap::Args;
+use sph_strategies::{Config, StrategyName};
+
+use crate::clock::Elapsed;
+use crate::run::{RunError, Steps, run_timed_steps};
+use crate::solver::Simulation;
 
 /// `sweep`'s hooks.
 #[derive(Debug, Clone, Default, Args)]
@@ -32,4 +37,25 @@ pub struct SimulateHooks {
     /// becomes an error of the run on every strategy.
     #[arg(long, value_name = "PARTICLE")]
     pub inject_panic_at: Option<usize>,
+}
+
+impl SimulateHooks {
+    /// `simulate`'s run ([`run_timed_steps`]), with the kernel panic injected where asked. Only
+    /// a build with the `testing` feature compiles the injecting run (a step loop of its own
+    /// for every strategy); the shipped binary runs the plain one.
+    pub fn run_timed_steps(
+        &self,
+        sim: &mut Simulation,
+        strategy: StrategyName,
+        config: &Config,
+        steps: Steps,
+    ) -> Result<Elapsed, RunError> {
+        #[cfg(feature = "testing")]
+        if let Some(particle) = self.inject_panic_at {
+            return crate::run::fault::run_timed_steps_panicking_at(
+                sim, strategy, config, steps, particle,
+            );
+        }
+        run_timed_steps(sim, strategy, config, steps)
+    }
 }

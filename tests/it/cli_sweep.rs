@@ -640,14 +640,15 @@ fn a_shard_runs_its_own_rounds_with_its_own_seq_and_no_confirmation() {
     fails_with(&args, &["Error:", "--confirm-rounds 2 with --shard 1/2"]);
 }
 
-/// A sweep that runs for a second or two: 1 + 3 × 2 + 2 × 2 × 17 = 75 cells of 2 rounds, no
-/// confirmation.
+/// A sweep that runs for a second or so, in many runs: 1 + 3 × 2 + 2 × 2 × 2 = 15 cells of 2
+/// rounds, no confirmation (each run at least a few milliseconds of steps and its threads'
+/// wake, so a signal sent once the first runs are written finds it running).
 const SLOW: &[&str] = &[
     "sweep",
     "--n",
     "300",
     "--steps",
-    "50",
+    "200",
     "--trials",
     "2",
     "--warmup",
@@ -655,12 +656,12 @@ const SLOW: &[&str] = &[
     "--cores",
     "1..2",
     "--chunks",
-    "paper",
+    "2,7",
     "--confirm-rounds",
     "0",
     "--no-plots",
 ];
-const SLOW_CELLS: usize = 75;
+const SLOW_CELLS: usize = 15;
 
 /// Starts a sweep big enough to still be running when the first runs are written, and
 /// returns it once `trials.csv` holds `runs` rows (or it has ended).

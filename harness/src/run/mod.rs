@@ -7,6 +7,7 @@
 //! its own and shows the simulation to an [`Observer`] between them, outside the timing; all
 //! segments run in the one session, on the one pool.
 
+#[cfg(any(test, feature = "testing"))]
 pub mod fault;
 pub mod paired;
 
