@@ -408,20 +408,4 @@ mod tests {
         assert_eq!(warmed.steps_done, 4);
         assert_eq!(checksum_hex(&warmed.state), checksum_hex(&plain.state));
     }
-
-    #[test]
-    fn an_injected_fault_fails_the_first_step_naming_the_particle_on_every_strategy() {
-        for &strategy in StrategyName::ALL {
-            let mut s = sim(40);
-            let err = run_timed_with(&mut s, strategy, &CONFIG, 3, 0, &mut fault::PanicAt(17))
-                .unwrap_err();
-            let RunError::Step(StepError::Kernel { step: 1, source }) = err else {
-                panic!("{strategy}: {err}");
-            };
-            assert!(
-                source.message.contains("injected fault at particle 17"),
-                "{strategy}: {source}"
-            );
-        }
-    }
 }
