@@ -695,6 +695,8 @@ fn a_sweep_killed_outright_resumes_without_duplicating_rows() {
             "{kept} runs before the kill"
         );
         eprintln!("killed after {kept} runs");
+    } else {
+        eprintln!("the sweep ended before the kill: only the resume was checked");
     }
     let d = dir.to_str().unwrap();
     let o = run(&["sweep", "--resume", d, "--no-plots"]);
@@ -716,6 +718,8 @@ fn a_signal_keeps_the_runs_measured_and_resume_finishes(signal: &str) {
     if still_running && sent {
         assert!(!out.status.success());
         common::assert_interrupted(&dir, &common::text(&out.stderr));
+    } else {
+        eprintln!("SIG{signal} not delivered to a running sweep: only the resume was checked");
     }
     // Every run written once, in whole rounds and the start of the next.
     let trials = rows(&dir.join("trials.csv"));

@@ -79,7 +79,7 @@ fn run_steps_only(
     let what = format!("{strategy} cores={cores} chunks={chunks}");
     let mut sim = simulation(preset, search).with_simd(simd).unwrap();
     run::run_steps_only(&mut sim, strategy, &Config::new(cores, chunks), STEPS)
-        .unwrap_or_else(|e| panic!("{what}: {e:#}"));
+        .unwrap_or_else(|e| panic!("{what}: {:#}", anyhow::Error::new(e)));
     sim.state
 }
 

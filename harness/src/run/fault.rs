@@ -1,7 +1,7 @@
 //! Fault injection for tests (`simulate --inject-panic-at`): a wrapping executor, like the
 //! trace's, so the solver carries no test flag and runs without it pay nothing. Compiled only
-//! with the `testing` feature (and for the harness's own tests): its step loop is a copy of the
-//! solver for every strategy, which the shipped binary does not carry.
+//! with the `testing` feature: its step loop is a copy of the solver for every strategy, which
+//! the shipped binary does not carry.
 
 use sph_strategies::{Config, Executor, KernelPanic, Split, StrategyName};
 

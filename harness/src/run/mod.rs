@@ -7,7 +7,7 @@
 //! its own and shows the simulation to an [`Observer`] between them, outside the timing; all
 //! segments run in the one session, on the one pool.
 
-#[cfg(any(test, feature = "testing"))]
+#[cfg(feature = "testing")]
 pub mod fault;
 pub mod paired;
 
@@ -263,7 +263,7 @@ pub fn run_timed(
 /// the threads, no pinning, no timing. What the tests' strategy matrix runs (thousands of short
 /// runs, for which the wake's spinning would be most of the time); the solver's code is the
 /// same that every run steps with, compiled here once.
-#[cfg(any(test, feature = "testing"))]
+#[cfg(feature = "testing")]
 pub fn run_steps_only(
     sim: &mut Simulation,
     strategy: StrategyName,

@@ -5,7 +5,8 @@
 //! right-aligned one) and one line per row, each line ending in `\n`; nothing follows the last
 //! row, so `writeln!(md, "{table}")` leaves the blank line that ends it. A line is `|`, then
 //! ` {cell} |` per cell. A column without a head (the machine table's names) is written `| |`;
-//! a row's cells are written as given, an empty one `|  |`: both as the reports always had them.
+//! a row's cells are written verbatim, an empty one `|  |`: both as the reports always had them.
+//! A cell holding a `|` is the caller's to escape (`\|`).
 
 use std::fmt;
 
@@ -78,7 +79,8 @@ impl Table {
         }
     }
 
-    /// Adds a row of `cells`, one per column, in order.
+    /// Adds a row of `cells`, one per column, in order. Panics on a row of another width: a
+    /// table that lost a cell would shift every cell after it into the wrong column.
     pub fn row<S: AsRef<str>>(&mut self, cells: impl IntoIterator<Item = S>) -> &mut Table {
         self.md.push('|');
         let mut n = 0;
@@ -89,7 +91,7 @@ impl Table {
             n += 1;
         }
         self.md.push('\n');
-        debug_assert_eq!(
+        assert_eq!(
             n, self.width,
             "a row of {n} cells in a table of {} columns",
             self.width
@@ -134,9 +136,8 @@ mod tests {
     }
 
     #[test]
-    #[cfg(debug_assertions)]
     #[should_panic(expected = "a row of 1 cells in a table of 2 columns")]
-    fn a_row_short_of_cells_is_refused_in_debug_builds() {
+    fn a_row_short_of_cells_is_refused() {
         Table::new([Column::left("a"), Column::left("b")]).row(["x"]);
     }
 }
