@@ -137,8 +137,8 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         anyhow::bail!("{err} (the frames up to step {shown} are in {place})");
     }
     // Müller's captions count steps of a fixed dt; wcsph's time is worth saying.
-    let time = match (sim.physics, args.t_end) {
-        (Physics::Mueller(_), None) => String::new(),
+    let time = match (sim.physics.fixed_dt(), args.t_end) {
+        (Some(_), None) => String::new(),
         _ => format!(", simulated time 0 to {:.4} s", Caption::of(&sim).time_s),
     };
     say(&format!(
@@ -203,10 +203,9 @@ impl Observer for Frames<'_> {
 /// stderr is not a terminal or the render is tiny (estimated from the first time step for
 /// `--t-end`: wcsph's shrinks by at most a tenth as the flow speeds up).
 fn progress_bar(args: &RenderArgs, physics: &Physics, fluid: usize) -> ProgressBar {
-    let steps = match (args.t_end, physics) {
-        (None, _) => args.steps,
-        (Some(t), Physics::Mueller(p)) => (t / p.dt) as usize,
-        (Some(t), Physics::Wcsph(p)) => (t / p.time_step(0.0)) as usize,
+    let steps = match args.t_end {
+        None => args.steps,
+        Some(t) => (t / physics.first_dt()) as usize,
     };
     if fluid.saturating_mul(steps) < PROGRESS_FROM_PARTICLE_STEPS
         || !std::io::stderr().is_terminal()

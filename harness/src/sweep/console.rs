@@ -10,7 +10,7 @@ use crate::output::console::plural;
 use crate::results::params::SweepParams;
 use crate::results::rows::{Contended, Phase, Status, SummaryRow, fastest};
 use crate::topology::Pin;
-use sph_solver::scene::tank;
+use sph_solver::scene::{Scene, tank};
 use sph_solver::sph::params::Preset;
 use sph_strategies::StrategyName;
 
@@ -124,7 +124,7 @@ pub fn resolution_note(params: &SweepParams) -> Option<String> {
     let mapped: Vec<String> = params
         .n
         .iter()
-        .filter(|&&n| plan::particles(Preset::Wcsph, n) != n)
+        .filter(|&&n| Scene::dam_break_fluid(Preset::Wcsph, n) != n)
         .map(|&n| {
             let r = tank::resolution_for(n);
             format!(

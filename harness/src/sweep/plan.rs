@@ -24,8 +24,7 @@ use sph_strategies::StrategyName;
 pub use crate::results::key::{Cell, Group, LabelStyle};
 use crate::results::params::SweepParams;
 use crate::results::shard::Shard;
-use sph_solver::scene::tank;
-use sph_solver::sph::params::Preset;
+use sph_solver::scene::Scene;
 
 /// Every cell of a sweep, grouped, in the order they run.
 #[derive(Debug, Clone, PartialEq)]
@@ -55,7 +54,7 @@ impl Plan {
                     let group = Group {
                         preset,
                         neighbors,
-                        n: particles(preset, n),
+                        n: Scene::dam_break_fluid(preset, n),
                         steps: params.steps,
                     };
                     if !groups.contains(&group) {
@@ -137,15 +136,6 @@ impl Plan {
     /// Cells that are not a group's reference.
     pub fn non_reference_cells(&self) -> usize {
         self.cells.iter().filter(|c| !c.is_reference()).count()
-    }
-}
-
-/// The particles a group of `preset` has for `--n` `n`: `n`, or for `wcsph` the fluid
-/// particles of the nearest resolution.
-pub fn particles(preset: Preset, n: usize) -> usize {
-    match preset {
-        Preset::Wcsph => tank::dam_break_particles(tank::resolution_for(n)),
-        _ => n,
     }
 }
 

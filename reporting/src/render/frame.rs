@@ -77,10 +77,7 @@ impl Caption {
     /// `step` steps that simulated `time_s` seconds. Müller's time is `step · DT` (exactly
     /// as the seed program shows it); `wcsph`'s time step adapts, so its time is `time_s`.
     pub fn new(physics: &Physics, step: usize, time_s: f64, n: usize) -> Caption {
-        let time_s = match physics {
-            Physics::Mueller(p) => step as f64 * p.dt,
-            Physics::Wcsph(_) => time_s,
-        };
+        let time_s = physics.fixed_dt().map_or(time_s, |dt| step as f64 * dt);
         Caption {
             step,
             time_s,

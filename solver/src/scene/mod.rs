@@ -41,6 +41,15 @@ impl Scene {
         }
     }
 
+    /// The fluid particles of [`Scene::dam_break`]`(preset, n, _)` (without building it): `n`,
+    /// or for `wcsph` those of the resolution nearest `n`. A sweep's group is named by it.
+    pub fn dam_break_fluid(preset: Preset, n: usize) -> usize {
+        match preset {
+            Preset::Wcsph => tank::dam_break_particles(tank::resolution_for(n)),
+            _ => n,
+        }
+    }
+
     /// The `wcsph` tank holding `fill` at resolution R.
     pub fn tank(fill: tank::Fill, resolution: usize) -> Result<Scene, TryReserveError> {
         let (prm, state) = tank::build(fill, resolution)?;

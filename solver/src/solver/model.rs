@@ -61,6 +61,14 @@ pub trait Model: Copy + Debug {
     /// The time step of the last step, s or the model's unit.
     fn last_dt(&self, scratch: &Self::Scratch) -> f64;
 
+    /// The time step when the model fixes it (every step the same); `None` where it adapts to
+    /// the flow, so that only the sum of the steps says the simulated time.
+    fn fixed_dt(&self) -> Option<f64>;
+
+    /// The first step's time step, from fluid at rest: the longest a step of the model takes
+    /// in simulated time, for estimates of how many steps a simulated time needs.
+    fn first_dt(&self) -> f64;
+
     /// The first particle that left what the model describes after a step, and how; `None`
     /// for a model without such a limit.
     fn first_unphysical(&self, state: &State, domain: Domain) -> Option<(usize, &'static str)> {

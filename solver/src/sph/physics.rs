@@ -60,6 +60,16 @@ impl Physics {
         with_model!(self, m => m.fluid(n))
     }
 
+    /// The time step when the model fixes it (Müller's `dt`); `None` where it adapts (WCSPH).
+    pub fn fixed_dt(&self) -> Option<f64> {
+        with_model!(self, m => m.fixed_dt())
+    }
+
+    /// The first step's time step, from fluid at rest (see [`Model::first_dt`]).
+    pub fn first_dt(&self) -> f64 {
+        with_model!(self, m => m.first_dt())
+    }
+
     /// The model's passes, in step order.
     pub fn passes(&self) -> &'static [Pass] {
         with_model!(self, m => m.passes())

@@ -76,6 +76,14 @@ impl Model for Params {
     fn last_dt(&self, _: &()) -> f64 {
         self.dt
     }
+
+    fn fixed_dt(&self) -> Option<f64> {
+        Some(self.dt)
+    }
+
+    fn first_dt(&self) -> f64 {
+        self.dt
+    }
 }
 
 /// Writes rho, p and the neighbour lists; reads positions.

@@ -115,6 +115,14 @@ impl Model for WcParams {
         scratch.dt
     }
 
+    fn fixed_dt(&self) -> Option<f64> {
+        None
+    }
+
+    fn first_dt(&self) -> f64 {
+        self.time_step(0.0)
+    }
+
     /// The first fluid particle that left the tank (beyond a wall's outer face: over the top
     /// of a wall and down outside it) or whose density is not positive, and why. Either ends
     /// the dam break the model describes (the tank is open at the top), so the run stops
