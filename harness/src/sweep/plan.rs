@@ -2,8 +2,9 @@
 //!
 //! A **group** is one (preset, neighbours, N, steps): the same initial state and the same
 //! final checksum for every strategy. For `wcsph`, N is the fluid-particle count 2R² of the
-//! resolution R nearest each `--n` ([`tank::resolution_for`]); `--n` values that share a
-//! resolution make one group. Each group starts with its **reference cell**, `seq` at
+//! resolution R nearest each `--n`
+//! ([`tank::resolution_for`](sph_solver::scene::tank::resolution_for)); `--n` values that
+//! share a resolution make one group. Each group starts with its **reference cell**, `seq` at
 //! 1 core, measured whatever `--strategies` says: its mean is the denominator of speedup and
 //! its first run's checksum the one every other run of the group must reproduce. Then, for each
 //! other strategy in registry order and each cores value, one cell per chunks value for the
