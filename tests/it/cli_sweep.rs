@@ -640,15 +640,16 @@ fn a_shard_runs_its_own_rounds_with_its_own_seq_and_no_confirmation() {
     fails_with(&args, &["Error:", "--confirm-rounds 2 with --shard 1/2"]);
 }
 
-/// A sweep that runs for a second or so, in many runs: 1 + 3 × 2 + 2 × 2 × 2 = 15 cells of 2
-/// rounds, no confirmation (each run at least a few milliseconds of steps and its threads'
-/// wake, so a signal sent once the first runs are written finds it running).
+/// A sweep that runs for two seconds or so: 1 + 3 × 2 + 2 × 2 × 2 = 15 cells of 2 rounds, no
+/// confirmation, each run about 50 ms of steps besides its threads' start and wake, so that a
+/// signal sent once the first runs are written finds it running with seconds to spare (with
+/// 200 steps a run, about a tenth of that, SIGINT once came after the last run).
 const SLOW: &[&str] = &[
     "sweep",
     "--n",
     "300",
     "--steps",
-    "200",
+    "2000",
     "--trials",
     "2",
     "--warmup",
