@@ -25,7 +25,7 @@ use crate::render::output::Output;
 use crate::render::scale::{ColorBy, Scale};
 use crate::run::{Observer, Steps, run_steps};
 use crate::solver::Simulation;
-use crate::sph::physics::Physics;
+use crate::solver::physics::Physics;
 
 /// Where the GIF goes when neither `--out` nor `--frames` is given.
 const DEFAULT_OUT: &str = "dambreak.gif";

@@ -4,9 +4,9 @@
 use bench_sph::run::{RunError, Steps, run_timed, run_timed_steps};
 use bench_sph::scene::Scene;
 use bench_sph::scene::tank::{self, Fill};
+use bench_sph::solver::physics::Physics;
 use bench_sph::solver::{Simulation, StepError};
 use bench_sph::sph::neighbors::NeighborMode;
-use bench_sph::sph::physics::Physics;
 use sph_strategies::{Config, StrategyName};
 
 const SEQ: Config = Config::new(1, 1);

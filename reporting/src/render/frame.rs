@@ -40,8 +40,8 @@ use crate::render::image::{Image, Rect};
 use crate::render::scale::Scale;
 use crate::render::text;
 use sph_solver::solver::Simulation;
+use sph_solver::solver::physics::Physics;
 use sph_solver::sph::params::Preset;
-use sph_solver::sph::physics::Physics;
 use sph_solver::sph::state::{Domain, State};
 
 /// Narrowest frame, px: the caption and the legend need this much.

@@ -18,8 +18,8 @@
 
 use serde::Serialize;
 
+use sph_solver::solver::physics::Physics;
 use sph_solver::sph::params::Params;
-use sph_solver::sph::physics::Physics;
 use sph_solver::sph::state::State;
 use sph_solver::sph::wcsph::params::{COLUMN_WIDTH, WcParams};
 

@@ -21,9 +21,9 @@ use std::mem::size_of;
 use crate::MAX_PARTICLES;
 use crate::scene::{dam_break, tank};
 use crate::solver::SPEED_BLOCK;
+use crate::solver::physics::Physics;
 use crate::sph::neighbors::{Grid, GridKeys, NeighborMode, SLOTS, WCSPH_SLOTS};
 use crate::sph::params::Preset;
-use crate::sph::physics::Physics;
 use crate::sph::state::FIELD_NAMES;
 use crate::sph::wcsph::params::WcParams;
 

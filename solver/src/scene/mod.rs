@@ -10,9 +10,9 @@ pub mod tank;
 use std::collections::TryReserveError;
 
 use crate::solver::Simulation;
+use crate::solver::physics::Physics;
 use crate::sph::neighbors::NeighborMode;
 use crate::sph::params::Preset;
-use crate::sph::physics::Physics;
 use crate::sph::state::{Domain, State};
 
 /// A preset's initial state, ready to simulate.

@@ -2,13 +2,15 @@
 //! plus the grid rebuild before them and the divergence check after them: three passes for
 //! Müller's model (density, forces, integrate), six for WCSPH (max speed, neighbours, walls,
 //! momentum, continuity, integrate). What the solver asks of a model is [`model::Model`];
-//! how each model cuts its passes into kernel calls lives in `models`, one file per model;
+//! the registry of models is [`physics::Physics`]; how each model cuts its passes into kernel
+//! calls lives in `models`, one file per model;
 //! the one step loop ([`Simulation::advance_with`]) and the [`StepHooks`] through which a
 //! caller wraps each phase's executor (tracing, fault injection) or the check, in `step`.
 
 pub mod model;
 mod models;
 pub mod pass;
+pub mod physics;
 mod search;
 mod step;
 
@@ -24,8 +26,8 @@ use crate::solver::search::with_search;
 use crate::sph::neighbors::{
     self, AnyNeighbors, CellOrderNeedsGrid, GridKeys, NeighborMode, Neighbors, SumOrder,
 };
-use crate::sph::physics::{Physics, with_model};
 use crate::sph::state::{Domain, Positions, State};
+use physics::{Physics, with_model};
 
 /// Why a step failed.
 #[derive(Debug, thiserror::Error)]

@@ -11,9 +11,9 @@
 use sph_strategies::{Executor, KernelPanic};
 
 use super::model::Model;
+use super::physics::with_model;
 use super::{Pass, Simulation, StepError};
 use crate::simd::Lanes;
-use crate::sph::physics::with_model;
 use crate::with_lanes;
 
 /// What a kernel call computes: part of the neighbour search's rebuild (the grid's, which

@@ -6,6 +6,5 @@
 pub mod neighbors;
 pub mod params;
 pub mod passes;
-pub mod physics;
 pub mod state;
 pub mod wcsph;

@@ -3,12 +3,12 @@
 //! is — its preset, search, passes and schedule — it says through [`Model`]; this file only
 //! names them.
 
-use super::neighbors::Bounds;
-use super::params::{Params, Preset};
-use super::state::Domain;
-use super::wcsph::params::WcParams;
-use crate::solver::model::Model;
-use crate::solver::pass::Pass;
+use super::model::Model;
+use super::pass::Pass;
+use crate::sph::neighbors::Bounds;
+use crate::sph::params::{Params, Preset};
+use crate::sph::state::Domain;
+use crate::sph::wcsph::params::WcParams;
 
 /// The constants of a run, and with them the model and its passes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,8 +25,8 @@ pub enum Physics {
 macro_rules! with_model {
     ($physics:expr, $m:ident => $body:expr) => {
         match $physics {
-            $crate::sph::physics::Physics::Mueller($m) => $body,
-            $crate::sph::physics::Physics::Wcsph($m) => $body,
+            $crate::solver::physics::Physics::Mueller($m) => $body,
+            $crate::solver::physics::Physics::Wcsph($m) => $body,
         }
     };
 }
