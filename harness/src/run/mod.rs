@@ -259,10 +259,10 @@ pub fn run_timed(
     run_timed_with(sim, strategy, config, steps, 0, &mut ())
 }
 
-/// `steps` steps of `sim` in one session of `strategy`, and nothing around them: no wake of
-/// the threads, no pinning, no timing. What the tests' strategy matrix runs (thousands of short
-/// runs, for which the wake's spinning would be most of the time); the solver's code is the
-/// same that every run steps with, compiled here once.
+/// `steps` steps of `sim` in one session of `strategy` (placed as `config` asks), and nothing
+/// else around them: no wake of the threads, no timing. What the tests' strategy matrix runs
+/// (thousands of short runs, for which the wake's spinning would be most of the time); the
+/// solver's code is the same that every run steps with, compiled here once.
 #[cfg(feature = "testing")]
 pub fn run_steps_only(
     sim: &mut Simulation,
@@ -277,9 +277,7 @@ pub fn run_steps_only(
             self.0.advance(exec, self.1)
         }
     }
-    let output = sph_strategies::run(strategy, config, Advance(sim, steps))
-        .map_err(|source| RunError::Build { strategy, source })?;
-    Ok(output?)
+    Ok(in_session(strategy, config, Advance(sim, steps))??)
 }
 
 /// The seed preset's dam break of `n` particles (jitter seed `seed`) with the grid search:
