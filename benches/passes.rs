@@ -8,11 +8,11 @@
 
 use std::time::{Duration, Instant};
 
-use bench_sph::scene::dam_break;
+use bench_sph::models::Preset;
+use bench_sph::models::mueller::scene;
 use bench_sph::simd::SimdPath;
 use bench_sph::solver::{Pass, Simulation};
 use bench_sph::sph::neighbors::{NeighborMode, SumOrder};
-use bench_sph::sph::params::Preset;
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use sph_strategies::seq::SeqExecutor;
 use sph_strategies::{Config, Executor, Session, StrategyName};
@@ -102,8 +102,8 @@ fn time_iters(
 fn settled(mode: NeighborMode, n: usize) -> Simulation {
     let mut sim = Simulation::new(
         Preset::Seed.params(),
-        dam_break::domain(Preset::Seed, n),
-        dam_break::initial_state(Preset::Seed, n, 2019),
+        scene::domain(Preset::Seed, n),
+        scene::initial_state(Preset::Seed, n, 2019),
         mode,
     );
     sim.advance(&SeqExecutor, SETTLE_STEPS)

@@ -20,6 +20,6 @@ pub use sph_harness::{
 #[cfg(feature = "viewer")]
 pub use sph_report::viewer;
 pub use sph_report::{plot, render, report};
-pub use sph_solver::{checksum, scene, simd, solver, sph, with_lanes};
+pub use sph_solver::{checksum, models, scene, simd, solver, sph, with_lanes};
 
 pub mod cli;

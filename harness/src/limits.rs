@@ -7,7 +7,7 @@
 //! | `--chunks` | 1 ..= [`MAX_CHUNKS`] | a pass makes min(K, N) chunks, so more than N never changes anything |
 //! | `--n` | 1 ..= [`MAX_PARTICLES`], and within the machine's memory | see [`sph_solver::scene::memory`] for the per-particle estimate |
 //! | `--steps` | 1 ..= [`MAX_STEPS`] | |
-//! | `--resolution` (`wcsph`) | 4 ..= 400 ([`sph_solver::sph::wcsph::params::RESOLUTIONS`]) | below 4 the column has no interior; 400 is 320 000 fluid particles |
+//! | `--resolution` (`wcsph`) | 4 ..= 400 ([`sph_solver::models::wcsph::params::RESOLUTIONS`]) | below 4 the column has no interior; 400 is 320 000 fluid particles |
 //! | `--t-end` | 0 < t ≤ [`MAX_T_END_S`] s | far beyond the dam breaks (Martin & Moyce's data ends at 0.77 s; `wcsph`'s fluid splashes over the 2.5a walls after about 1.3 s, which ends the run with an error) |
 //! | `--trials` | 1 ..= [`MAX_TRIALS`] | the grid's rounds |
 //! | `--confirm-rounds` | 0 ..= [`MAX_TRIALS`] | |

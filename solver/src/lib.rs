@@ -2,10 +2,12 @@
 //! ports it (`seed`, `cpp`) and a weakly compressible SPH validated against experiment
 //! (`wcsph`) — run by any of the strategies of `sph-strategies`.
 //!
-//! - [`sph`]: the pure physics (constants, state, neighbour search, per-particle passes);
+//! - [`models`]: each model in its folder (constants, pure per-particle passes, the
+//!   solver's view of it, its dam break) and the registry of models;
+//! - [`sph`]: what the models share: the particle state and the neighbour search;
 //! - [`simd`]: the instruction sets the neighbour tests run on, picked at start-up;
 //! - [`solver`]: one step as the model's passes run by a strategy's executor;
-//! - [`scene`]: initial dam-break states and their memory;
+//! - [`scene`]: a preset and a size → an initial state, and the memory its run needs;
 //! - [`io`]: a state from CSV (`--init`) and to CSV (`--dump`);
 //! - [`checksum`]: a state's bits in one number, to compare strategies.
 //!
@@ -14,6 +16,7 @@
 
 pub mod checksum;
 pub mod io;
+pub mod models;
 pub mod scene;
 pub mod simd;
 pub mod solver;

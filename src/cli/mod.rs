@@ -226,9 +226,9 @@ fn particles(s: &str) -> Result<usize, String> {
     count(s, "particles", limits::MAX_PARTICLES)
 }
 
-/// A `wcsph` resolution R = a/dx: within [`RESOLUTIONS`](crate::sph::wcsph::params::RESOLUTIONS).
+/// A `wcsph` resolution R = a/dx: within [`RESOLUTIONS`](crate::models::wcsph::params::RESOLUTIONS).
 fn resolution(s: &str) -> Result<usize, String> {
-    let range = crate::sph::wcsph::params::RESOLUTIONS;
+    let range = crate::models::wcsph::params::RESOLUTIONS;
     in_range(s, "resolution", *range.start(), *range.end())
 }
 

@@ -19,13 +19,13 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use super::simulate::say;
 use crate::clock::Elapsed;
 use crate::limits;
+use crate::models::Physics;
 use crate::output::console;
 use crate::render::frame::{Caption, MAX_WIDTH, MIN_WIDTH, Painter, View};
 use crate::render::output::Output;
 use crate::render::scale::{ColorBy, Scale};
 use crate::run::{Observer, Steps, run_steps};
 use crate::solver::Simulation;
-use crate::solver::physics::Physics;
 
 /// Where the GIF goes when neither `--out` nor `--frames` is given.
 const DEFAULT_OUT: &str = "dambreak.gif";

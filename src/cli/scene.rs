@@ -8,10 +8,11 @@ use clap::parser::ValueSource;
 use clap::{ArgMatches, Args, FromArgMatches};
 
 use crate::io::init_csv;
-use crate::scene::{Scene, dam_break, memory, tank};
+use crate::models::Preset;
+use crate::models::{mueller, wcsph};
+use crate::scene::{Scene, memory};
 use crate::solver::Simulation;
 use crate::sph::neighbors::{NeighborMode, SumOrder};
-use crate::sph::params::Preset;
 
 /// Which scene to simulate, and with which neighbour search.
 #[derive(Debug, Clone)]
@@ -106,7 +107,7 @@ impl SceneArgs {
     pub fn wcsph_resolution(&self) -> Option<usize> {
         (self.preset == Preset::Wcsph).then(|| {
             self.resolution
-                .unwrap_or_else(|| tank::resolution_for(self.n.unwrap_or(1000)))
+                .unwrap_or_else(|| wcsph::scene::resolution_for(self.n.unwrap_or(1000)))
         })
     }
 
@@ -131,7 +132,7 @@ impl SceneArgs {
     pub fn resolution_note(&self) -> Option<String> {
         let r = self.wcsph_resolution()?;
         let asked = self.n.filter(|_| self.resolution.is_none())?;
-        let fluid = tank::dam_break_particles(r);
+        let fluid = wcsph::scene::dam_break_particles(r);
         (asked != fluid).then(|| {
             format!(
                 "note: --preset wcsph runs at resolution R = {r} ({fluid} fluid particles), \
@@ -176,7 +177,7 @@ impl SceneArgs {
         }
         let Some(path) = &self.init else {
             let n = match self.wcsph_resolution() {
-                Some(r) => tank::dam_break_particles(r),
+                Some(r) => wcsph::scene::dam_break_particles(r),
                 None => self.n.unwrap_or(1000),
             };
             memory::check(self.preset, self.neighbors, n, memory_available())?;
@@ -212,7 +213,7 @@ impl SceneArgs {
             );
         }
         memory::check(self.preset, self.neighbors, count, memory_available())?;
-        let domain = dam_break::domain(self.preset, count);
+        let domain = mueller::scene::domain(self.preset, count);
         init_csv::check_walls(path, &rows, domain)?;
         Ok(Scene {
             physics: self.preset.params().into(),

@@ -10,12 +10,12 @@ use crate::checksum::checksum_hex;
 use crate::io::dump_csv::{self, DumpInfo};
 use crate::io::sink::Sink;
 use crate::limits;
+use crate::models::Preset;
 use crate::output::console;
 use crate::run::{RunError, Steps};
 use crate::simd::SimdPath;
 use crate::solver::{Simulation, StepError};
 use crate::sph::neighbors::{NeighborMode, SumOrder};
-use crate::sph::params::Preset;
 use crate::topology::Pin;
 
 /// Options of `simulate`.

@@ -7,11 +7,11 @@ use clap::Args;
 use serde::Serialize;
 
 use crate::checksum::checksum_hex;
+use crate::models::Preset;
 use crate::output::console;
 use crate::run::paired::{PairedTimes, run_paired};
 use crate::simd::SimdPath;
 use crate::sph::neighbors::{NeighborMode, SumOrder};
-use crate::sph::params::Preset;
 use crate::topology::Pin;
 
 /// Options of `speedup`.

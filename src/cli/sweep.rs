@@ -6,9 +6,9 @@ use anyhow::Context;
 use clap::{Arg, Args};
 use sph_strategies::StrategyName;
 
+use crate::models::Preset;
 use crate::results::shard::Shard;
 use crate::sph::neighbors::NeighborMode;
-use crate::sph::params::Preset;
 use crate::sweep::params::SweepParams;
 use crate::sweep::range::{self, Axis};
 use crate::sweep::schedule::Schedule;

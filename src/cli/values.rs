@@ -10,11 +10,11 @@ use clap::builder::{EnumValueParser, PossibleValue, TypedValueParser};
 use clap::{Arg, ValueEnum};
 use sph_strategies::StrategyName;
 
+use crate::models::Preset;
 use crate::render::scale::ColorBy;
 use crate::results::params::Schedule;
 use crate::simd::SimdPath;
 use crate::sph::neighbors::{NeighborMode, SumOrder};
-use crate::sph::params::Preset;
 use crate::topology::Pin;
 
 /// `--preset`'s values.

@@ -2,11 +2,11 @@
 
 use clap::Args;
 
+use crate::models::Preset;
 use crate::render::frame::{MAX_WIDTH, MIN_WIDTH};
 use crate::render::scale::ColorBy;
 use crate::scene::memory;
 use crate::sph::neighbors::NeighborMode;
-use crate::sph::params::Preset;
 use crate::viewer::scene::Settings;
 
 /// Options of `view`.

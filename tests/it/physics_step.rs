@@ -2,10 +2,10 @@
 //! formulas of the step (density with self term, forces over j != i, symplectic Euler, wall
 //! clamps), with plain scalar f64 arithmetic in the sources' evaluation order.
 
+use bench_sph::models::{Preset, mueller::params::Params};
 use bench_sph::run::run_timed;
 use bench_sph::solver::Simulation;
 use bench_sph::sph::neighbors::NeighborMode;
-use bench_sph::sph::params::{Params, Preset};
 use bench_sph::sph::state::{Domain, State};
 use sph_strategies::{Config, StrategyName};
 

@@ -1,11 +1,12 @@
 //! Whole runs of the solver: the two neighbour searches agree, the reference run stays finite
 //! and inside the walls, and a diverging run stops with an error naming step and particle.
 
+use bench_sph::models::Preset;
+use bench_sph::models::mueller;
 use bench_sph::run::{RunError, run_timed};
-use bench_sph::scene::{Scene, dam_break};
+use bench_sph::scene::Scene;
 use bench_sph::solver::{Simulation, StepError};
 use bench_sph::sph::neighbors::{GridKeys, NeighborMode, SumOrder};
-use bench_sph::sph::params::Preset;
 use bench_sph::sph::state::{Domain, FIELD_NAMES, State};
 use sph_strategies::{Config, StrategyName};
 
@@ -253,7 +254,7 @@ fn neighbours_behind_a_pile_of_more_candidates_than_a_grid_key_counts_give_all_p
 
 #[test]
 fn the_reference_run_stays_finite_and_inside_the_walls() {
-    let domain = dam_break::domain(Preset::Seed, 1000);
+    let domain = mueller::scene::domain(Preset::Seed, 1000);
     let s = run(Preset::Seed, 1000, 1000, NeighborMode::AllPairs);
     assert_eq!(s.first_non_finite(), None);
     let eps = 16.0;
@@ -277,7 +278,7 @@ fn the_reference_run_stays_finite_and_inside_the_walls() {
 #[test]
 fn a_run_past_the_layout_capacity_grows_the_tank_and_stays_inside_it() {
     let n = 3000; // more than the seed layout's 1406
-    let domain = dam_break::domain(Preset::Seed, n);
+    let domain = mueller::scene::domain(Preset::Seed, n);
     assert!(domain.width > 1200.0);
     let s = run(Preset::Seed, n, 20, NeighborMode::Grid);
     assert_eq!(s.first_non_finite(), None);
@@ -325,8 +326,8 @@ fn a_large_run_checked_in_parallel_blocks_stops_at_the_same_step_and_particle() 
     // 80 000 particles: the divergence check runs on the executor in blocks. The same two
     // overflowing particles as above, placed last, away from the dam.
     let n = 80_000;
-    let domain = dam_break::domain(Preset::Seed, n);
-    let mut init = dam_break::initial_state(Preset::Seed, n, 1);
+    let domain = mueller::scene::domain(Preset::Seed, n);
+    let mut init = mueller::scene::initial_state(Preset::Seed, n, 1);
     let last = n - 2;
     (init.x[last], init.x[last + 1]) = (domain.width - 100.0, domain.width - 95.0);
     (init.y[last], init.y[last + 1]) = (100.0, 100.0);

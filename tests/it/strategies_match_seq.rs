@@ -9,12 +9,13 @@ use std::sync::Mutex;
 use std::thread::ThreadId;
 use std::time::Duration;
 
+use bench_sph::models::Preset;
+use bench_sph::models::mueller;
 use bench_sph::run::{self, run_timed};
-use bench_sph::scene::{Scene, dam_break};
+use bench_sph::scene::Scene;
 use bench_sph::simd::SimdPath;
 use bench_sph::solver::Simulation;
 use bench_sph::sph::neighbors::{GridKeys, NeighborMode, SumOrder};
-use bench_sph::sph::params::Preset;
 use bench_sph::sph::state::{FIELD_NAMES, State};
 use sph_strategies::{Config, Executor, KernelPanic, Session, Split, StrategyName};
 
@@ -365,10 +366,10 @@ fn a_path_this_cpu_lacks_is_refused() {
 #[test]
 fn more_cores_and_chunks_than_particles_still_match_the_sequential_run() {
     let tiny = |strategy, cores, chunks| {
-        let init = dam_break::initial_state(Preset::Seed, 3, 1);
+        let init = mueller::scene::initial_state(Preset::Seed, 3, 1);
         let mut sim = Simulation::new(
             Preset::Seed.params(),
-            dam_break::domain(Preset::Seed, 3),
+            mueller::scene::domain(Preset::Seed, 3),
             init,
             NeighborMode::Grid,
         );

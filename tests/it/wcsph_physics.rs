@@ -1,10 +1,10 @@
 //! The `wcsph` preset's physics as a whole: a tank at rest stays at rest, and a dam break
 //! keeps its mass and its walls.
 
+use bench_sph::models::Physics;
+use bench_sph::models::wcsph::scene::{self, Fill};
 use bench_sph::run::{RunError, Steps, run_timed, run_timed_steps};
 use bench_sph::scene::Scene;
-use bench_sph::scene::tank::{self, Fill};
-use bench_sph::solver::physics::Physics;
 use bench_sph::solver::{Simulation, StepError};
 use bench_sph::sph::neighbors::NeighborMode;
 use sph_strategies::{Config, StrategyName};
@@ -28,7 +28,7 @@ fn run_until(sim: &mut Simulation, t_end: f64) {
     advance_until(sim, t_end).expect("the run stays finite");
 }
 
-fn params(sim: &Simulation) -> bench_sph::sph::wcsph::params::WcParams {
+fn params(sim: &Simulation) -> bench_sph::models::wcsph::params::WcParams {
     match sim.physics {
         Physics::Wcsph(p) => p,
         Physics::Mueller(_) => unreachable!("a tank is wcsph"),
@@ -79,7 +79,7 @@ fn the_dam_break_keeps_its_fluid_inside_the_walls_and_the_walls_fixed() {
     let mut sim = scene.simulate(NeighborMode::Grid);
     run_until(&mut sim, 0.4);
     let fluid = sim.fluid();
-    let d = tank::domain();
+    let d = scene::domain();
     for k in 0..fluid {
         let (x, y) = (sim.state.x[k], sim.state.y[k]);
         assert!(

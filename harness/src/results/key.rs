@@ -10,8 +10,8 @@ use sph_strategies::{Config, StrategyName};
 
 use crate::topology::Pin;
 
+use sph_solver::models::Preset;
 use sph_solver::sph::neighbors::NeighborMode;
-use sph_solver::sph::params::Preset;
 
 /// The keys shared by every cell of a group.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -147,7 +147,7 @@ impl Cell {
 #[cfg(any(test, feature = "testing"))]
 pub fn test_group(neighbors: sph_solver::sph::neighbors::NeighborMode) -> Group {
     Group {
-        preset: sph_solver::sph::params::Preset::Seed,
+        preset: sph_solver::models::Preset::Seed,
         neighbors,
         n: 60,
         steps: 3,

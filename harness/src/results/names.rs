@@ -3,8 +3,8 @@
 
 use sph_strategies::StrategyName;
 
+use sph_solver::models::Preset;
 use sph_solver::sph::neighbors::NeighborMode;
-use sph_solver::sph::params::Preset;
 
 /// A type written by name in `meta.json` (the same name as on the command line and in CSVs).
 pub trait Named: Sized + Copy + 'static {

@@ -7,9 +7,9 @@ use sph_strategies::StrategyName;
 use super::names::name_list;
 use super::shard::Shard;
 use crate::topology::Pin;
+use sph_solver::models::Preset;
 use sph_solver::simd::SimdPath;
 use sph_solver::sph::neighbors::NeighborMode;
-use sph_solver::sph::params::Preset;
 
 /// The parameters of a sweep, after parsing and expansion: the lists are sorted and free of
 /// repeats, so two sweeps with equal parameters have the same plan.

@@ -25,8 +25,8 @@ use sph_strategies::StrategyName;
 
 use super::key::{Cell, Group};
 use crate::topology::Pin;
+use sph_solver::models::Preset;
 use sph_solver::sph::neighbors::NeighborMode;
-use sph_solver::sph::params::Preset;
 
 /// The columns of `trials.csv`, in order.
 pub const TRIAL_COLUMNS: [&str; 23] = [

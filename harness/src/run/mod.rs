@@ -284,12 +284,12 @@ pub fn run_steps_only(
 /// the simulation that the unit tests above the solver run.
 #[cfg(any(test, feature = "testing"))]
 pub fn test_simulation(n: usize, seed: u64) -> Simulation {
-    use sph_solver::scene::dam_break;
-    let preset = sph_solver::sph::params::Preset::Seed;
+    use sph_solver::models::mueller::scene;
+    let preset = sph_solver::models::Preset::Seed;
     Simulation::new(
         preset.params(),
-        dam_break::domain(preset, n),
-        dam_break::initial_state(preset, n, seed),
+        scene::domain(preset, n),
+        scene::initial_state(preset, n, seed),
         sph_solver::sph::neighbors::NeighborMode::Grid,
     )
 }

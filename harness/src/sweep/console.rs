@@ -10,8 +10,9 @@ use crate::output::console::plural;
 use crate::results::params::SweepParams;
 use crate::results::rows::{Contended, Phase, Status, SummaryRow, fastest};
 use crate::topology::Pin;
-use sph_solver::scene::{Scene, tank};
-use sph_solver::sph::params::Preset;
+use sph_solver::models::Preset;
+use sph_solver::models::wcsph;
+use sph_solver::scene::Scene;
 use sph_strategies::StrategyName;
 
 /// A duration for people: `0.25 ms`, `12 ms`, `4.2 s`, `42 s`, `3 min 20 s`, `1 h 05 min`.
@@ -126,10 +127,10 @@ pub fn resolution_note(params: &SweepParams) -> Option<String> {
         .iter()
         .filter(|&&n| Scene::dam_break_fluid(Preset::Wcsph, n) != n)
         .map(|&n| {
-            let r = tank::resolution_for(n);
+            let r = wcsph::scene::resolution_for(n);
             format!(
                 "--n {n} → R = {r} ({} fluid particles)",
-                tank::dam_break_particles(r)
+                wcsph::scene::dam_break_particles(r)
             )
         })
         .collect();

@@ -84,8 +84,8 @@ impl SweepParams {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sph_solver::models::Preset;
     use sph_solver::sph::neighbors::NeighborMode;
-    use sph_solver::sph::params::Preset;
     use sph_strategies::StrategyName;
 
     fn example() -> SweepParams {

@@ -3,7 +3,7 @@
 //! A **group** is one (preset, neighbours, N, steps): the same initial state and the same
 //! final checksum for every strategy. For `wcsph`, N is the fluid-particle count 2R² of the
 //! resolution R nearest each `--n`
-//! ([`tank::resolution_for`](sph_solver::scene::tank::resolution_for)); `--n` values that
+//! ([`wcsph::scene::resolution_for`](sph_solver::models::wcsph::scene::resolution_for)); `--n` values that
 //! share a resolution make one group. Each group starts with its **reference cell**, `seq` at
 //! 1 core, measured whatever `--strategies` says: its mean is the denominator of speedup and
 //! its first run's checksum the one every other run of the group must reproduce. Then, for each
@@ -152,8 +152,8 @@ pub fn estimate_run_s(cell: &Cell, seq_run_s: f64, hardware_threads: usize) -> f
 #[cfg(test)]
 mod tests {
     use super::*;
+    use sph_solver::models::Preset;
     use sph_solver::sph::neighbors::NeighborMode;
-    use sph_solver::sph::params::Preset;
 
     fn params(strategies: &[StrategyName]) -> SweepParams {
         SweepParams {

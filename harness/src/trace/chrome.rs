@@ -226,9 +226,9 @@ mod tests {
     use super::*;
     use crate::trace::recorder::{KernelEvent, SerialEvent, SerialWork, ThreadInfo};
     use crate::trace::stats;
+    use sph_solver::models::Preset;
     use sph_solver::solver::Pass;
     use sph_solver::sph::neighbors::NeighborMode;
-    use sph_solver::sph::params::Preset;
 
     fn config() -> TraceConfig {
         TraceConfig {

@@ -6,9 +6,9 @@
 use serde::{Deserialize, Serialize};
 
 use crate::topology::Pin;
+use sph_solver::models::Preset;
 use sph_solver::simd::SimdPath;
 use sph_solver::sph::neighbors::NeighborMode;
-use sph_solver::sph::params::Preset;
 
 /// The `tool` field of a trace's `meta.json`.
 pub const TOOL: &str = "bench-sph trace";

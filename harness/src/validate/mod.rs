@@ -22,7 +22,7 @@ use crate::limits;
 use crate::run::{Steps, run_steps};
 use data::{Experiment, Point};
 use probe::{Probe, Sample, Scales};
-use sph_solver::scene::tank::{self, Fill};
+use sph_solver::models::wcsph::scene::{self, Fill};
 use sph_solver::solver::Simulation;
 use sph_solver::sph::neighbors::NeighborMode;
 use verdict::Outcome;
@@ -68,7 +68,7 @@ pub struct Validation {
 }
 
 /// Runs the dam break at resolution R (`resolution`, within
-/// [`RESOLUTIONS`](sph_solver::sph::wcsph::params::RESOLUTIONS)) with `strategy` on `config` until
+/// [`RESOLUTIONS`](sph_solver::models::wcsph::params::RESOLUTIONS)) with `strategy` on `config` until
 /// T ≥ [`T_END`], and compares it with the experiment.
 pub fn validate(
     resolution: usize,
@@ -76,12 +76,12 @@ pub fn validate(
     config: &Config,
 ) -> anyhow::Result<Validation> {
     let experiment = data::experiment().context("the shipped experiment data is broken")?;
-    let (prm, state) = tank::build(Fill::DamBreak, resolution)
+    let (prm, state) = scene::build(Fill::DamBreak, resolution)
         .with_context(|| format!("no memory for the dam break at resolution {resolution}"))?;
     let walls = state.len() - prm.fluid;
     let scales = Scales::of(&prm);
     let t_end_s = scales.time_of_front_time(T_END);
-    let mut sim = Simulation::new(prm, tank::domain(), state, NeighborMode::Grid);
+    let mut sim = Simulation::new(prm, scene::domain(), state, NeighborMode::Grid);
     let mut probe = Probe::new(&sim, prm.dx, t_end_s);
     let steps = Steps {
         total: limits::MAX_STEPS,

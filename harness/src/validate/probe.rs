@@ -16,8 +16,8 @@ use std::ops::ControlFlow;
 
 use crate::clock::Elapsed;
 use crate::run::Observer;
+use sph_solver::models::wcsph::params::{COLUMN_WIDTH, WcParams};
 use sph_solver::solver::Simulation;
-use sph_solver::sph::wcsph::params::{COLUMN_WIDTH, WcParams};
 
 /// Simulated time between samples, s.
 pub const SAMPLE_INTERVAL_S: f64 = 0.01;
@@ -157,12 +157,12 @@ impl Observer for Probe {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sph_solver::scene::tank::{self, Fill};
+    use sph_solver::models::wcsph::scene::{self, Fill};
     use sph_solver::sph::neighbors::NeighborMode;
 
     fn dam(resolution: usize) -> (WcParams, Simulation) {
-        let (prm, state) = tank::build(Fill::DamBreak, resolution).unwrap();
-        let sim = Simulation::new(prm, tank::domain(), state, NeighborMode::Grid);
+        let (prm, state) = scene::build(Fill::DamBreak, resolution).unwrap();
+        let sim = Simulation::new(prm, scene::domain(), state, NeighborMode::Grid);
         (prm, sim)
     }
 

@@ -420,8 +420,8 @@ where
 mod tests {
     use super::*;
     use sph_harness::trace::recorder::{KernelEvent, SerialEvent, ThreadInfo};
+    use sph_solver::models::Preset;
     use sph_solver::sph::neighbors::NeighborMode;
-    use sph_solver::sph::params::Preset;
 
     /// The phases of a step of Müller's model.
     const MUELLER_PHASES: [Phase; 4] = [

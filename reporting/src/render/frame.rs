@@ -39,9 +39,9 @@ use crate::render::colormap::Colormap;
 use crate::render::image::{Image, Rect};
 use crate::render::scale::Scale;
 use crate::render::text;
+use sph_solver::models::Physics;
+use sph_solver::models::Preset;
 use sph_solver::solver::Simulation;
-use sph_solver::solver::physics::Physics;
-use sph_solver::sph::params::Preset;
 use sph_solver::sph::state::{Domain, State};
 
 /// Narrowest frame, px: the caption and the legend need this much.
@@ -590,7 +590,7 @@ mod tests {
 
     #[test]
     fn every_pixel_of_a_frame_is_near_a_palette_colour() {
-        let state = sph_solver::scene::dam_break::initial_state(Preset::Seed, 200, 1);
+        let state = sph_solver::models::mueller::scene::initial_state(Preset::Seed, 200, 1);
         let p = painter(ColorBy::Density, &state);
         let img = p.draw(&state, &caption(200));
         let palette = p.palette();
@@ -631,7 +631,8 @@ mod tests {
     /// The `wcsph` dam break at resolution 8 (128 fluid particles) and its painter.
     fn wcsph(by: ColorBy) -> (sph_solver::scene::Scene, Painter) {
         let scene =
-            sph_solver::scene::Scene::tank(sph_solver::scene::tank::Fill::DamBreak, 8).unwrap();
+            sph_solver::scene::Scene::tank(sph_solver::models::wcsph::scene::Fill::DamBreak, 8)
+                .unwrap();
         let view = View::of(&scene.physics, scene.domain);
         let scale = Scale::new(by, &scene.physics, &scene.state);
         let painter = Painter::new(view, scale, 600);

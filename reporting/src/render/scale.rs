@@ -18,10 +18,10 @@
 
 use serde::Serialize;
 
-use sph_solver::solver::physics::Physics;
-use sph_solver::sph::params::Params;
+use sph_solver::models::Physics;
+use sph_solver::models::mueller::params::Params;
+use sph_solver::models::wcsph::params::{COLUMN_WIDTH, WcParams};
 use sph_solver::sph::state::State;
-use sph_solver::sph::wcsph::params::{COLUMN_WIDTH, WcParams};
 
 /// The quantity a particle's colour shows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -147,13 +147,13 @@ impl Scale {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use sph_solver::scene::dam_break;
-    use sph_solver::sph::params::Preset;
+    use sph_solver::models::Preset;
+    use sph_solver::models::mueller::scene;
 
     #[test]
     fn the_speed_range_is_the_free_fall_speed_from_the_top_of_the_dam() {
         let params = Preset::Seed.params();
-        let state = dam_break::initial_state(Preset::Seed, 1000, 1);
+        let state = scene::initial_state(Preset::Seed, 1000, 1);
         let scale = Scale::new(ColorBy::Speed, &params.into(), &state);
         assert_eq!(scale.lo, 0.0);
         // 1000 particles fill 27 rows of 38, so the top row is y = 300 + 16·26; EPS = 16.

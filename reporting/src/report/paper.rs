@@ -5,8 +5,8 @@
 //! on another machine. The report shows them only beside `seed`/`all-pairs` groups.
 
 use sph_harness::results::key::Group;
+use sph_solver::models::Preset;
 use sph_solver::sph::neighbors::NeighborMode;
-use sph_solver::sph::params::Preset;
 
 /// The paper's machine, in words.
 pub const MACHINE: &str = "Intel i5-8600K, 6 cores at 5 GHz";

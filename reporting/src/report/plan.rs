@@ -24,7 +24,7 @@ use super::view::GroupView;
 use sph_harness::results::key::{Group, LabelStyle};
 use sph_harness::results::rows::SummaryRow;
 use sph_harness::topology::{Pin, Topology};
-use sph_solver::sph::params::Preset;
+use sph_solver::models::Preset;
 
 /// A chart that does not apply, and why.
 #[derive(Debug, Clone, PartialEq)]

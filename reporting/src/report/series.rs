@@ -13,8 +13,8 @@ use super::view::GroupView;
 pub use sph_harness::results::key::Group;
 use sph_harness::results::rows::{Contended, SummaryRow, fastest};
 use sph_harness::topology::{Pin, Topology};
+use sph_solver::models::Preset;
 use sph_solver::sph::neighbors::NeighborMode;
-use sph_solver::sph::params::Preset;
 
 /// A point with its uncertainty: `y` the value, `lo..hi` its 95 % confidence interval
 /// (equal to `y` when unknown).

@@ -413,7 +413,7 @@ mod tests {
                 chunks: Some(45),
                 n: 1000,
                 steps: 3,
-                preset: sph_solver::sph::params::Preset::Seed,
+                preset: sph_solver::models::Preset::Seed,
                 neighbors: sph_solver::sph::neighbors::NeighborMode::AllPairs,
                 seed: Some(2019),
                 init: None,

@@ -31,7 +31,7 @@ use super::verdict::Entry;
 use super::view::GroupView;
 use sph_harness::results::key::LabelStyle;
 use sph_harness::results::stats::Interval;
-use sph_solver::sph::params::Preset;
+use sph_solver::models::Preset;
 
 /// The section: one comparison per wcsph group.
 #[derive(Debug, Clone, PartialEq)]

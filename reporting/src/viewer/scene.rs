@@ -10,10 +10,10 @@ use crate::render::image::Image;
 use crate::render::scale::{ColorBy, Scale};
 use crate::render::text;
 use crate::viewer::stepper::Stepper;
+use sph_solver::models::Physics;
+use sph_solver::models::Preset;
 use sph_solver::scene::Scene as DamBreak;
-use sph_solver::solver::physics::Physics;
 use sph_solver::sph::neighbors::NeighborMode;
-use sph_solver::sph::params::Preset;
 
 /// Fewest and most particles `+`/`-` reach.
 pub const N_RANGE: (usize, usize) = (10, 1_000_000);

@@ -6,7 +6,7 @@
 
 use std::io::Write;
 
-use crate::sph::params::Preset;
+use crate::models::Preset;
 use crate::sph::state::{FIELD_NAMES, State};
 
 /// How a dump's first line starts.

@@ -9,7 +9,7 @@
 //! - with `--neighbors grid`, the cell list: particle order and cell (`u32` each), sorted
 //!   positions (`f64` × 2), and one `u32` start per cell of the tank and of the empty ring
 //!   around it; the tank widens with N
-//!   (see [`crate::scene::dam_break`]); from 65 536 particles on, the scratch of the sort in
+//!   (see [`crate::models::mueller::scene`]); from 65 536 particles on, the scratch of the sort in
 //!   bands ([`Grid::sort_scratch_bytes`]: a `u32` per particle and 1 KiB per 16 384).
 //!
 //! A unit test holds the estimate equal to what a [`crate::solver::Simulation`] allocates.
@@ -19,13 +19,13 @@
 use std::mem::size_of;
 
 use crate::MAX_PARTICLES;
-use crate::scene::{dam_break, tank};
+use crate::models::Physics;
+use crate::models::Preset;
+use crate::models::wcsph::params::WcParams;
+use crate::models::{mueller, wcsph};
 use crate::solver::SPEED_BLOCK;
-use crate::solver::physics::Physics;
 use crate::sph::neighbors::{Grid, GridKeys, NeighborMode, SLOTS, WCSPH_SLOTS};
-use crate::sph::params::Preset;
 use crate::sph::state::FIELD_NAMES;
-use crate::sph::wcsph::params::WcParams;
 
 /// Why a run was refused.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -62,16 +62,16 @@ pub enum MemoryError {
 pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
     let (physics, domain, n, lists_of, fluid_scratch) = match preset {
         Preset::Wcsph => {
-            let r = tank::resolution_for(n);
-            let fluid = tank::dam_break_particles(r);
+            let r = wcsph::scene::resolution_for(n);
+            let fluid = wcsph::scene::dam_break_particles(r);
             let physics = Physics::from(WcParams::new(r, fluid));
-            let total = fluid + tank::wall_particles(r);
+            let total = fluid + wcsph::scene::wall_particles(r);
             let scratch = 8 * (fluid as u64 + fluid.div_ceil(SPEED_BLOCK) as u64);
-            (physics, tank::domain(), total, WCSPH_SLOTS, scratch)
+            (physics, wcsph::scene::domain(), total, WCSPH_SLOTS, scratch)
         }
         _ => {
             let physics = Physics::from(preset.params());
-            (physics, dam_break::domain(preset, n), n, SLOTS, 0)
+            (physics, mueller::scene::domain(preset, n), n, SLOTS, 0)
         }
     };
     let n64 = n as u64;

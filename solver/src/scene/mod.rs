@@ -1,18 +1,14 @@
-//! Initial states: the presets' dam-break layouts and the domain they live in, and the memory
-//! a run of them needs. [`Scene`] is the one way a command turns a preset and a size into a
-//! simulation.
+//! Initial states: [`Scene`] is the one way a command turns a preset and a size into a
+//! simulation (each model's layout is its folder's `scene`), and [`memory`] what its run needs.
 
-pub mod dam_break;
 pub mod memory;
 pub mod splitmix;
-pub mod tank;
 
 use std::collections::TryReserveError;
 
+use crate::models::{Physics, Preset, mueller, wcsph};
 use crate::solver::Simulation;
-use crate::solver::physics::Physics;
 use crate::sph::neighbors::NeighborMode;
-use crate::sph::params::Preset;
 use crate::sph::state::{Domain, State};
 
 /// A preset's initial state, ready to simulate.
@@ -29,14 +25,17 @@ pub struct Scene {
 impl Scene {
     /// The dam break of `preset` for `n` particles: Müller's presets place `n` jittered by
     /// `seed`; `wcsph` takes the resolution whose fluid count is nearest `n`
-    /// ([`tank::resolution_for`]) and has no jitter.
+    /// ([`wcsph::scene::resolution_for`]) and has no jitter.
     pub fn dam_break(preset: Preset, n: usize, seed: u64) -> Result<Scene, TryReserveError> {
         match preset {
-            Preset::Wcsph => Scene::tank(tank::Fill::DamBreak, tank::resolution_for(n)),
+            Preset::Wcsph => Scene::tank(
+                wcsph::scene::Fill::DamBreak,
+                wcsph::scene::resolution_for(n),
+            ),
             _ => Ok(Scene {
                 physics: preset.params().into(),
-                domain: dam_break::domain(preset, n),
-                state: dam_break::try_initial_state(preset, n, seed)?,
+                domain: mueller::scene::domain(preset, n),
+                state: mueller::scene::try_initial_state(preset, n, seed)?,
             }),
         }
     }
@@ -45,17 +44,17 @@ impl Scene {
     /// or for `wcsph` those of the resolution nearest `n`. A sweep's group is named by it.
     pub fn dam_break_fluid(preset: Preset, n: usize) -> usize {
         match preset {
-            Preset::Wcsph => tank::dam_break_particles(tank::resolution_for(n)),
+            Preset::Wcsph => wcsph::scene::dam_break_particles(wcsph::scene::resolution_for(n)),
             _ => n,
         }
     }
 
     /// The `wcsph` tank holding `fill` at resolution R.
-    pub fn tank(fill: tank::Fill, resolution: usize) -> Result<Scene, TryReserveError> {
-        let (prm, state) = tank::build(fill, resolution)?;
+    pub fn tank(fill: wcsph::scene::Fill, resolution: usize) -> Result<Scene, TryReserveError> {
+        let (prm, state) = wcsph::scene::build(fill, resolution)?;
         Ok(Scene {
             physics: prm.into(),
-            domain: tank::domain(),
+            domain: wcsph::scene::domain(),
             state,
         })
     }

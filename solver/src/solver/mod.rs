@@ -2,24 +2,23 @@
 //! plus the grid rebuild before them and the divergence check after them: three passes for
 //! Müller's model (density, forces, integrate), six for WCSPH (max speed, neighbours, walls,
 //! momentum, continuity, integrate). What the solver asks of a model is [`model::Model`];
-//! the registry of models is [`physics::Physics`]; how each model cuts its passes into kernel
-//! calls lives in `models`, one file per model;
+//! the registry of models is [`crate::models::Physics`], and how each model cuts its passes
+//! into kernel calls lives in its folder of `crate::models`; here is
 //! the one step loop ([`Simulation::advance_with`]) and the [`StepHooks`] through which a
 //! caller wraps each phase's executor (tracing, fault injection) or the check, in `step`.
 
 pub mod model;
-mod models;
 pub mod pass;
-pub mod physics;
-mod search;
+pub(crate) mod search;
 mod step;
 
-pub use models::wcsph::SPEED_BLOCK;
+pub use crate::models::wcsph::model::SPEED_BLOCK;
 pub use pass::Pass;
 pub use step::{Phase, PhaseJob, StepHooks};
 
 use sph_strategies::{Executor, KernelPanic};
 
+use crate::models::{Physics, with_model};
 use crate::simd::{self, AnyLanes, SimdPath};
 use crate::solver::model::{AnyScratch, Model, Particles};
 use crate::solver::search::with_search;
@@ -27,7 +26,6 @@ use crate::sph::neighbors::{
     self, AnyNeighbors, CellOrderNeedsGrid, GridKeys, NeighborMode, Neighbors, SumOrder,
 };
 use crate::sph::state::{Domain, Positions, State};
-use physics::{Physics, with_model};
 
 /// Why a step failed.
 #[derive(Debug, thiserror::Error)]

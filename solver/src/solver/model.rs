@@ -1,8 +1,8 @@
 //! What the solver asks of a model of the fluid. A model is its constants (a type that
 //! implements [`Model`]: Müller's `Params`, WCSPH's `WcParams`), its per-particle passes
-//! (`sph::passes`, `sph::wcsph::passes`) and its schedule (`models/`, one file per model: which
+//! (`passes.rs` in its folder of `crate::models`) and its schedule (`model.rs` there: which
 //! arrays each pass writes, and the pass handed to the strategy's executor). The solver runs a
-//! step through this trait and never names a model; `Physics` lists the models.
+//! step through this trait and never names a model; `crate::models::Physics` lists the models.
 
 use std::any::Any;
 use std::fmt::Debug;
@@ -10,9 +10,9 @@ use std::fmt::Debug;
 use sph_strategies::{Executor, KernelPanic};
 
 use super::pass::Pass;
+use crate::models::Preset;
 use crate::simd::AnyLanes;
 use crate::sph::neighbors::AnyNeighbors;
-use crate::sph::params::Preset;
 use crate::sph::state::{Domain, State};
 
 /// A model of the fluid, as its constants.

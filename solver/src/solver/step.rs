@@ -11,8 +11,8 @@
 use sph_strategies::{Executor, KernelPanic};
 
 use super::model::Model;
-use super::physics::with_model;
 use super::{Pass, Simulation, StepError};
+use crate::models::with_model;
 use crate::simd::Lanes;
 use crate::with_lanes;
 

@@ -31,8 +31,8 @@ use crate::report::view::GroupView;
 use sph_harness::results::files::COMPARE_CHART_PREFIX;
 use sph_harness::results::intervals::Ratio;
 use sph_harness::results::key::LabelStyle;
+use sph_solver::models::Preset;
 use sph_solver::sph::neighbors::NeighborMode;
-use sph_solver::sph::params::Preset;
 
 /// What makes two groups of different sides the same workload: steps may differ.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1079,9 +1079,9 @@ mod tests {
 
     #[test]
     fn mueller_density_in_lanes_has_the_same_bits_one_candidate_or_eight_at_a_time() {
+        use crate::models::Preset;
+        use crate::models::mueller::passes::density_pressure;
         use crate::sph::neighbors::NeighborLists;
-        use crate::sph::params::Preset;
-        use crate::sph::passes::density_pressure;
 
         // Sparse to crowded, with a pile past the scratch's limit: the eights' path (packing
         // lanes, on any machine) and the one-at-a-time path (portable) give the same density

@@ -15,8 +15,8 @@
 
 use std::collections::TryReserveError;
 
+use crate::models::Preset;
 use crate::scene::splitmix::SplitMix64;
-use crate::sph::params::Preset;
 use crate::sph::state::{Domain, State, try_zeros};
 
 /// Width and height of both presets' tank before growth, px (1.5 × an 800 × 600 window).
@@ -45,7 +45,7 @@ impl Layout {
     /// The preset's layout.
     ///
     /// # Panics
-    /// For [`Preset::Wcsph`], whose scene is [`crate::scene::tank`].
+    /// For [`Preset::Wcsph`], whose scene is [`crate::models::wcsph::scene`].
     pub fn of(preset: Preset) -> Layout {
         match preset {
             Preset::Seed => Layout {
@@ -60,7 +60,7 @@ impl Layout {
                 rows: 54,
                 base_columns: 19,
             },
-            Preset::Wcsph => panic!("the wcsph preset's scene is scene::tank"),
+            Preset::Wcsph => panic!("the wcsph preset's scene is models::wcsph::scene"),
         }
     }
 
@@ -92,7 +92,7 @@ pub fn domain(preset: Preset, n: usize) -> Domain {
 /// The initial dam break: `n` particles at rest, x jittered by the seeded generator.
 ///
 /// # Panics
-/// If memory runs out (commands call [`try_initial_state`], after [`super::memory::check`]).
+/// If memory runs out (commands call [`try_initial_state`], after [`crate::scene::memory::check`]).
 pub fn initial_state(preset: Preset, n: usize, seed: u64) -> State {
     try_initial_state(preset, n, seed)
         .unwrap_or_else(|e| panic!("no memory for {n} particles: {e}"))

@@ -4,13 +4,16 @@
 use glam::DVec2;
 use sph_strategies::{Executor, KernelPanic};
 
+use crate::models::mueller::passes;
+use crate::models::{
+    Preset,
+    mueller::params::{Integrator, Params},
+};
 use crate::simd::Lanes;
 use crate::solver::model::{Model, Particles, no_such_pass};
 use crate::solver::pass::Pass;
 use crate::solver::search::{with_search, with_search_lanes};
 use crate::sph::neighbors::{NeighborLists, Neighbors, SLOTS};
-use crate::sph::params::{Params, Preset};
-use crate::sph::passes;
 use crate::sph::state::{Domain, Fields, Positions, State};
 use crate::with_lanes;
 
@@ -27,7 +30,10 @@ impl Model for Params {
     }
 
     fn preset(&self) -> Preset {
-        Params::preset(self)
+        match self.integrator {
+            Integrator::Seed => Preset::Seed,
+            Integrator::Cpp => Preset::Cpp,
+        }
     }
 
     fn search_radius(&self) -> f64 {

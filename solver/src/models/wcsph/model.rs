@@ -1,4 +1,4 @@
-//! The weakly compressible model (the `wcsph` preset, see [`crate::sph::wcsph`]) as the solver
+//! The weakly compressible model (the `wcsph` preset, see [`crate::models::wcsph`]) as the solver
 //! runs it: its constants ([`WcParams`]) as a [`Model`], and its step's six passes. Fluid
 //! particles are `0..fluid`, walls the rest; each pass writes its own arrays over one of the
 //! two ranges.
@@ -6,15 +6,15 @@
 use glam::DVec2;
 use sph_strategies::{Executor, KernelPanic};
 
+use crate::models::Preset;
+use crate::models::wcsph::params::WcParams;
+use crate::models::wcsph::passes::{self, ContinuityInputs};
 use crate::simd::Lanes;
 use crate::solver::model::{self, Model, Particles, no_such_pass};
 use crate::solver::pass::Pass;
 use crate::solver::search::{with_search, with_search_lanes};
 use crate::sph::neighbors::{NeighborLists, Neighbors, WCSPH_SLOTS};
-use crate::sph::params::Preset;
 use crate::sph::state::{Domain, Fields, Positions, State};
-use crate::sph::wcsph::params::WcParams;
-use crate::sph::wcsph::passes::{self, ContinuityInputs};
 
 /// Fluid particles per block of the largest-speed reduction.
 pub const SPEED_BLOCK: usize = 256;

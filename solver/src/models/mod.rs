@@ -1,14 +1,23 @@
-//! Which model a simulation steps: the registry of models (a variant of [`Physics`], its
-//! `From` and its arm of `with_model!` each). Everything a model
-//! is — its preset, search, passes and schedule — it says through [`Model`]; this file only
-//! names them.
+//! The models, one folder each, and their registry. A model's folder holds its constants
+//! (`params`), its per-particle passes (`passes`, pure), the solver's view of it (`model`: a
+//! [`Model`]) and its initial state (`scene`): [`mueller`] (the `seed` and `cpp` presets) and
+//! [`wcsph`]. This file is the registry: a variant of [`Physics`], its `From` and its arm of
+//! `with_model!` per model, and the user's names for them ([`Preset`]). Everything a model is
+//! (its preset, search, passes and schedule) it says through [`Model`]; this file only names
+//! them.
 
-use super::model::Model;
-use super::pass::Pass;
+pub mod mueller;
+mod preset;
+pub mod wcsph;
+
+pub use preset::Preset;
+
+use crate::solver::model::Model;
+use crate::solver::pass::Pass;
 use crate::sph::neighbors::Bounds;
-use crate::sph::params::{Params, Preset};
 use crate::sph::state::Domain;
-use crate::sph::wcsph::params::WcParams;
+use mueller::params::Params;
+use wcsph::params::WcParams;
 
 /// The constants of a run, and with them the model and its passes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,8 +34,8 @@ pub enum Physics {
 macro_rules! with_model {
     ($physics:expr, $m:ident => $body:expr) => {
         match $physics {
-            $crate::solver::physics::Physics::Mueller($m) => $body,
-            $crate::solver::physics::Physics::Wcsph($m) => $body,
+            $crate::models::Physics::Mueller($m) => $body,
+            $crate::models::Physics::Wcsph($m) => $body,
         }
     };
 }

@@ -15,8 +15,8 @@
 
 use std::collections::TryReserveError;
 
+use crate::models::wcsph::params::{COLUMN_WIDTH, WcParams};
 use crate::sph::state::{Domain, State, try_zeros};
-use crate::sph::wcsph::params::{COLUMN_WIDTH, WcParams};
 
 /// The tank's length, in column widths (the experiment's data runs to Z = 4.11).
 pub const TANK_LENGTH: f64 = 5.0;
@@ -57,9 +57,9 @@ pub fn dam_break_particles(resolution: usize) -> usize {
 }
 
 /// The resolution whose dam break has the fluid-particle count nearest `n` (2R² ≈ n; ties
-/// go to the smaller R), within [`crate::sph::wcsph::params::RESOLUTIONS`].
+/// go to the smaller R), within [`crate::models::wcsph::params::RESOLUTIONS`].
 pub fn resolution_for(n: usize) -> usize {
-    let range = crate::sph::wcsph::params::RESOLUTIONS;
+    let range = crate::models::wcsph::params::RESOLUTIONS;
     let below = ((n as f64 / 2.0).sqrt().floor() as usize).clamp(*range.start(), *range.end());
     let above = (below + 1).min(*range.end());
     let gap = |r: usize| dam_break_particles(r).abs_diff(n);

@@ -6,10 +6,10 @@
 
 use glam::DVec2;
 
-use super::neighbors::{ListWriter, Neighbors, distance_squared};
 use super::params::{Integrator, Params};
-use super::state::{Domain, Fields, Positions};
 use crate::simd::{F64x4, Lanes};
+use crate::sph::neighbors::{ListWriter, Neighbors, distance_squared};
+use crate::sph::state::{Domain, Fields, Positions};
 
 /// Density (Müller 2003 eq. 3 with the poly6 kernel, eq. 20; self term included) and
 /// pressure `GAS_CONST · (rho − REST_DENS)` (eq. 12) of particle `i`, plus the number of its
