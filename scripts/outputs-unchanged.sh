@@ -69,6 +69,9 @@ outputs() {
     "$bin" simulate --init dump-seq.csv --steps 5 --json | sed -E "$timed" > sim-init.json
     "$bin" render --n 300 --steps 40 --every 10 --out anim.gif > render.stdout 2>&1
     "$bin" render --n 300 --steps 20 --every 10 --frames frames > frames.stdout 2>&1
+    "$bin" render --preset wcsph --resolution 8 --steps 40 --every 10 --out wcsph.gif > wcsph.stdout 2>&1
+    "$bin" render --preset cpp --n 300 --steps 20 --every 10 --color density --out density.gif \
+        > density.stdout 2>&1
     "$bin" list > list.txt
     # A trace: its meta.json but the measured times, and stats.csv's counts per pass and in all
     # (not its times, nor which and how many threads ran the calls: that is the scheduler's).

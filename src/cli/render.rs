@@ -85,7 +85,7 @@ pub fn run(args: &RenderArgs) -> anyhow::Result<()> {
         console::warn(&note);
     }
     let scale = Scale::new(args.color, &scene.physics, &scene.state);
-    let painter = Painter::new(View::of(&scene.physics, scene.domain), scale, args.width);
+    let painter = Painter::new(View::of(&scene), scale, args.width);
     let (width, height) = (painter.layout().width, painter.layout().height);
 
     // Open the output before simulating, so a bad path costs nothing.

@@ -41,6 +41,7 @@ use crate::render::scale::Scale;
 use crate::render::text;
 use sph_solver::models::Physics;
 use sph_solver::models::Preset;
+use sph_solver::scene::Scene;
 use sph_solver::solver::Simulation;
 use sph_solver::sph::state::{Domain, State};
 
@@ -131,21 +132,21 @@ pub struct View {
 }
 
 impl View {
-    /// The view of `domain` simulated with `physics`.
-    pub fn of(physics: &Physics, domain: Domain) -> View {
-        match physics {
-            Physics::Mueller(p) => View {
-                domain,
-                radius: 0.5 * p.h,
-                walls: Walls::Bars,
-            },
-            Physics::Wcsph(p) => View {
-                domain,
-                radius: 0.5 * p.dx,
-                walls: Walls::Particles {
-                    fluid: p.fluid,
-                    thickness: p.wall_layers() as f64 * p.dx,
-                },
+    /// The view of `scene`: walls outside the domain are drawn as the particles they are,
+    /// walls at its edges as bars.
+    pub fn of(scene: &Scene) -> View {
+        let physics = &scene.physics;
+        let depth = physics.wall_depth();
+        View {
+            domain: scene.domain,
+            radius: physics.drawn_radius(),
+            walls: if depth > 0.0 {
+                Walls::Particles {
+                    fluid: scene.fluid(),
+                    thickness: depth,
+                }
+            } else {
+                Walls::Bars
             },
         }
     }
@@ -511,8 +512,12 @@ mod tests {
 
     fn painter(by: ColorBy, state: &State) -> Painter {
         let physics = Physics::from(Preset::Seed.params());
-        let view = View::of(&physics, TANK);
-        Painter::new(view, Scale::new(by, &physics, state), 600)
+        let scene = Scene {
+            physics,
+            domain: TANK,
+            state: state.clone(),
+        };
+        Painter::new(View::of(&scene), Scale::new(by, &physics, state), 600)
     }
 
     /// Müller's view of `TANK` with kernel radius 16 px.
@@ -629,11 +634,9 @@ mod tests {
     }
 
     /// The `wcsph` dam break at resolution 8 (128 fluid particles) and its painter.
-    fn wcsph(by: ColorBy) -> (sph_solver::scene::Scene, Painter) {
-        let scene =
-            sph_solver::scene::Scene::tank(sph_solver::models::wcsph::scene::Fill::DamBreak, 8)
-                .unwrap();
-        let view = View::of(&scene.physics, scene.domain);
+    fn wcsph(by: ColorBy) -> (Scene, Painter) {
+        let scene = Scene::tank(sph_solver::models::wcsph::scene::Fill::DamBreak, 8).unwrap();
+        let view = View::of(&scene);
         let scale = Scale::new(by, &scene.physics, &scene.state);
         let painter = Painter::new(view, scale, 600);
         (scene, painter)
@@ -665,8 +668,7 @@ mod tests {
     fn the_wcsph_frame_holds_the_walls_and_its_axes_are_in_metres() {
         let (scene, p) = wcsph(ColorBy::Speed);
         let l = p.layout();
-        let Walls::Particles { thickness, .. } = View::of(&scene.physics, scene.domain).walls
-        else {
+        let Walls::Particles { thickness, .. } = View::of(&scene).walls else {
             panic!("wcsph walls are particles");
         };
         assert_eq!(thickness, 3.0 * 0.125);

@@ -19,8 +19,7 @@
 use serde::Serialize;
 
 use sph_solver::models::Physics;
-use sph_solver::models::mueller::params::Params;
-use sph_solver::models::wcsph::params::{COLUMN_WIDTH, WcParams};
+use sph_solver::solver::model::Units;
 use sph_solver::sph::state::State;
 
 /// The quantity a particle's colour shows.
@@ -51,37 +50,13 @@ pub struct Scale {
     pub units: Units,
 }
 
-/// The units a model computes in, which the legend names.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Units {
-    /// Müller's presets: lengths in px, densities in the solver's own units.
-    Pixels,
-    /// `wcsph`: m, s, kg.
-    Si,
-}
-
 impl Scale {
     /// The range for `by` in an animation of `physics` that starts from `initial` (see the
     /// module docs; `wcsph`'s range does not depend on `initial`).
     pub fn new(by: ColorBy, physics: &Physics, initial: &State) -> Scale {
-        match physics {
-            Physics::Mueller(params) => Scale::mueller(by, params, initial),
-            Physics::Wcsph(params) => Scale::wcsph(by, params),
-        }
-    }
-
-    /// Müller's range: from the constants and the top of the initial dam, px units.
-    fn mueller(by: ColorBy, params: &Params, initial: &State) -> Scale {
         let (lo, hi) = match by {
-            ColorBy::Speed => {
-                let top = initial.y.iter().copied().fold(params.eps, f64::max);
-                let fall = top - params.eps;
-                (0.0, (2.0 * params.gravity.length() * fall).sqrt())
-            }
-            ColorBy::Density => {
-                let own = params.mass_poly6 * ((params.hsq * params.hsq) * params.hsq);
-                (own, 4.0 * own)
-            }
+            ColorBy::Speed => physics.speed_range(initial),
+            ColorBy::Density => physics.density_range(),
         };
         // A dam lying on the floor has no fall height: keep the range non-empty.
         let hi = if hi > lo { hi } else { lo + 1.0 };
@@ -89,24 +64,7 @@ impl Scale {
             by,
             lo,
             hi,
-            units: Units::Pixels,
-        }
-    }
-
-    /// `wcsph`'s fixed physical range, SI units.
-    fn wcsph(by: ColorBy, params: &WcParams) -> Scale {
-        let (lo, hi) = match by {
-            ColorBy::Speed => {
-                let column = 2.0 * COLUMN_WIDTH;
-                (0.0, (2.0 * params.gravity.length() * column).sqrt())
-            }
-            ColorBy::Density => (params.rho0, 1.01 * params.rho0),
-        };
-        Scale {
-            by,
-            lo,
-            hi,
-            units: Units::Si,
+            units: physics.units(),
         }
     }
 
@@ -149,6 +107,7 @@ mod tests {
     use super::*;
     use sph_solver::models::Preset;
     use sph_solver::models::mueller::scene;
+    use sph_solver::models::wcsph::params::WcParams;
 
     #[test]
     fn the_speed_range_is_the_free_fall_speed_from_the_top_of_the_dam() {

@@ -216,7 +216,7 @@ fn build(s: &Settings) -> Result<(Stepper, Looks), TryReserveError> {
     let scene = DamBreak::dam_break(s.preset, s.n, s.seed)?;
     let looks = Looks {
         physics: scene.physics,
-        view: View::of(&scene.physics, scene.domain),
+        view: View::of(&scene),
         speed: Scale::new(ColorBy::Speed, &scene.physics, &scene.state),
         density: Scale::new(ColorBy::Density, &scene.physics, &scene.state),
     };

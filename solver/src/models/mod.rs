@@ -12,10 +12,10 @@ pub mod wcsph;
 
 pub use preset::Preset;
 
-use crate::solver::model::Model;
+use crate::solver::model::{Model, Units};
 use crate::solver::pass::Pass;
 use crate::sph::neighbors::Bounds;
-use crate::sph::state::Domain;
+use crate::sph::state::{Domain, State};
 use mueller::params::Params;
 use wcsph::params::WcParams;
 
@@ -79,6 +79,32 @@ impl Physics {
         with_model!(self, m => m.first_dt())
     }
 
+    /// How far outside the domain the walls' particles lie (0: the walls are the domain's
+    /// edges, as in Müller's model).
+    pub fn wall_depth(&self) -> f64 {
+        with_model!(self, m => m.wall_depth())
+    }
+
+    /// The units the model computes in.
+    pub fn units(&self) -> Units {
+        with_model!(self, m => m.units())
+    }
+
+    /// The radius a picture draws a particle with (see [`Model::drawn_radius`]).
+    pub fn drawn_radius(&self) -> f64 {
+        with_model!(self, m => m.drawn_radius())
+    }
+
+    /// The speeds a picture of a run from `initial` colours against.
+    pub fn speed_range(&self, initial: &State) -> (f64, f64) {
+        with_model!(self, m => m.speed_range(initial))
+    }
+
+    /// The densities a picture colours against.
+    pub fn density_range(&self) -> (f64, f64) {
+        with_model!(self, m => m.density_range())
+    }
+
     /// The model's passes, in step order.
     pub fn passes(&self) -> &'static [Pass] {
         with_model!(self, m => m.passes())
@@ -87,7 +113,7 @@ impl Physics {
     /// The rectangle the grid covers: the domain, and for WCSPH the walls' particle layers
     /// outside it (left, right and below).
     pub fn search_bounds(&self, domain: Domain) -> Bounds {
-        let walls = with_model!(self, m => m.wall_depth());
+        let walls = self.wall_depth();
         let inner = Bounds::of(domain);
         Bounds {
             min_x: inner.min_x - walls,

@@ -15,6 +15,15 @@ use crate::simd::AnyLanes;
 use crate::sph::neighbors::AnyNeighbors;
 use crate::sph::state::{Domain, State};
 
+/// The units a model computes in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Units {
+    /// Müller's presets: lengths in px, densities in the solver's own units.
+    Pixels,
+    /// `wcsph`: m, s, kg.
+    Si,
+}
+
 /// A model of the fluid, as its constants.
 pub trait Model: Copy + Debug {
     /// What a running simulation of the model keeps between passes besides the particles.
@@ -41,6 +50,20 @@ pub trait Model: Copy + Debug {
 
     /// The neighbour lists of `n` particles: how many particles have one, and its slots.
     fn lists(&self, n: usize) -> (usize, usize);
+
+    /// The units the model computes in.
+    fn units(&self) -> Units;
+
+    /// The radius a picture draws a particle with, model units: half the spacing of the
+    /// initial layout, so that neighbours touch.
+    fn drawn_radius(&self) -> f64;
+
+    /// The speeds a picture colours against, from 0 to that of a fall from the top of the
+    /// fluid to the floor (the fluid of `initial`, or of the model's own fixed scene).
+    fn speed_range(&self, initial: &State) -> (f64, f64);
+
+    /// The densities a picture colours against.
+    fn density_range(&self) -> (f64, f64);
 
     /// The scratch of a run of `n` particles.
     fn scratch(&self, n: usize) -> Self::Scratch;

@@ -10,7 +10,7 @@ use crate::models::{
     mueller::params::{Integrator, Params},
 };
 use crate::simd::Lanes;
-use crate::solver::model::{Model, Particles, no_such_pass};
+use crate::solver::model::{Model, Particles, Units, no_such_pass};
 use crate::solver::pass::Pass;
 use crate::solver::search::{with_search, with_search_lanes};
 use crate::sph::neighbors::{NeighborLists, Neighbors, SLOTS};
@@ -50,6 +50,27 @@ impl Model for Params {
 
     fn lists(&self, n: usize) -> (usize, usize) {
         (n, SLOTS)
+    }
+
+    fn units(&self) -> Units {
+        Units::Pixels
+    }
+
+    fn drawn_radius(&self) -> f64 {
+        0.5 * self.h
+    }
+
+    // A particle falling freely from the top of the initial dam to the floor.
+    fn speed_range(&self, initial: &State) -> (f64, f64) {
+        let top = initial.y.iter().copied().fold(self.eps, f64::max);
+        let fall = top - self.eps;
+        (0.0, (2.0 * self.gravity.length() * fall).sqrt())
+    }
+
+    // A particle with no neighbours (its own contribution) to four times that.
+    fn density_range(&self) -> (f64, f64) {
+        let own = self.mass_poly6 * ((self.hsq * self.hsq) * self.hsq);
+        (own, 4.0 * own)
     }
 
     fn scratch(&self, _: usize) {}

@@ -7,10 +7,10 @@ use glam::DVec2;
 use sph_strategies::{Executor, KernelPanic};
 
 use crate::models::Preset;
-use crate::models::wcsph::params::WcParams;
+use crate::models::wcsph::params::{COLUMN_WIDTH, WcParams};
 use crate::models::wcsph::passes::{self, ContinuityInputs};
 use crate::simd::Lanes;
-use crate::solver::model::{self, Model, Particles, no_such_pass};
+use crate::solver::model::{self, Model, Particles, Units, no_such_pass};
 use crate::solver::pass::Pass;
 use crate::solver::search::{with_search, with_search_lanes};
 use crate::sph::neighbors::{NeighborLists, Neighbors, WCSPH_SLOTS};
@@ -77,6 +77,26 @@ impl Model for WcParams {
     // Walls need lists too (of their fluid neighbours).
     fn lists(&self, n: usize) -> (usize, usize) {
         (n, WCSPH_SLOTS)
+    }
+
+    fn units(&self) -> Units {
+        Units::Si
+    }
+
+    fn drawn_radius(&self) -> f64 {
+        0.5 * self.dx
+    }
+
+    // The same for every resolution, so that renders compare: a fall from the top of the
+    // 2a-high column to the floor (also c0 / 10).
+    fn speed_range(&self, _initial: &State) -> (f64, f64) {
+        let column = 2.0 * COLUMN_WIDTH;
+        (0.0, (2.0 * self.gravity.length() * column).sqrt())
+    }
+
+    // Tait's stiffness keeps the density within about 1 %.
+    fn density_range(&self) -> (f64, f64) {
+        (self.rho0, 1.01 * self.rho0)
     }
 
     fn scratch(&self, n: usize) -> Scratch {
