@@ -13,7 +13,7 @@
 
 use std::fmt::Write as _;
 
-use super::plan::{CompareChart, ComparePlan, Compared, MachineBest, Ranking};
+use super::plan::{CompareChart, ComparePlan, Compared, MachineBest};
 use super::sides::{Side, SideRule, same_hardware_sets};
 use crate::report::cell::Best;
 use crate::report::load::Sweep;
@@ -23,7 +23,7 @@ use crate::report::markdown::{
 use crate::report::numbers::faster;
 use crate::report::series::Group;
 use crate::report::table::{Column, Table};
-use crate::report::verdict::{Entry, and_list, describe};
+use crate::report::verdict::{Entry, Verdict, and_list, describe};
 use sph_harness::results::key::LabelStyle;
 use sph_harness::results::rows::{Status, SummaryRow};
 
@@ -220,7 +220,7 @@ fn compared(md: &mut String, sides: &[Side<'_>], c: &Compared) {
 /// A row of the best-strategy table.
 fn best_row(tag: &str, b: &MachineBest) -> Vec<String> {
     let mut row = vec![tag.to_owned(), b.group.steps.to_string()];
-    match &b.best {
+    match b.best() {
         Some((s, best)) => {
             row.push(s.to_string());
             row.extend(cells(best));
@@ -256,30 +256,28 @@ fn flags(b: &Best) -> String {
 
 /// The ranking column.
 fn ranking(b: &MachineBest) -> String {
-    let text = match &b.ranking {
-        Ranking::NoCell => "no usable parallel cell".to_owned(),
-        Ranking::AllContended => {
-            "**not resolved**: every strategy's best cell was contended".to_owned()
-        }
-        Ranking::Only => "only one strategy measured".to_owned(),
-        Ranking::Unknown { next, why } => format!(
+    let text = match &b.verdict {
+        None if b.entries.is_empty() => "no usable parallel cell".to_owned(),
+        None => "**not resolved**: every strategy's best cell was contended".to_owned(),
+        Some(Verdict::Only(_)) => "only one strategy measured".to_owned(),
+        Some(Verdict::Unknown(_, why)) => format!(
             "**not resolved**: against the next lowest mean, {}, {}",
-            describe(next),
+            b.trusted.get(1).map(describe).unwrap_or_default(),
             why.phrase()
         ),
-        Ranking::Resolved { next, by } => format!(
+        Some(Verdict::Fastest { runner_up, by, .. }) => format!(
             "resolved: {} by the paired rounds",
-            faster(by, &format!("the next fastest, {}", describe(next)))
+            faster(by, &format!("the next fastest, {}", describe(runner_up)))
         ),
-        Ranking::NotResolved { overlapping } => {
-            let names: Vec<String> = overlapping.iter().map(describe).collect();
+        Some(Verdict::Tied { tied, .. }) => {
+            let names: Vec<String> = tied.iter().skip(1).map(describe).collect();
             format!(
                 "**not resolved**: not distinguishable from {}",
                 and_list(&names)
             )
         }
     };
-    match b.contended_left_out {
+    match b.contended_left_out() {
         0 => text,
         k => format!(
             "{text}; {} left out",
@@ -293,7 +291,7 @@ fn ranking(b: &MachineBest) -> String {
 pub fn verdict_across(sides: &[Side<'_>], best: &[MachineBest]) -> String {
     let unresolved: Vec<String> = best
         .iter()
-        .filter(|b| !matches!(b.ranking, Ranking::Resolved { .. }))
+        .filter(|b| !b.resolved())
         .map(|b| sides[b.side].tag.clone())
         .collect();
     if !unresolved.is_empty() {
@@ -305,11 +303,11 @@ pub fn verdict_across(sides: &[Side<'_>], best: &[MachineBest]) -> String {
     }
     let winners: Vec<String> = best
         .iter()
-        .filter_map(|b| Some((sides[b.side].tag.as_str(), b.best.as_ref()?.0)))
+        .filter_map(|b| Some((sides[b.side].tag.as_str(), b.best()?.0)))
         .map(|(tag, s)| format!("{tag} **{s}**"))
         .collect();
-    let first = best.first().and_then(|b| b.best.as_ref()).map(|e| e.0);
-    if best.iter().all(|b| b.best.as_ref().map(|e| e.0) == first) {
+    let first = best.first().and_then(|b| b.best()).map(|e| e.0);
+    if best.iter().all(|b| b.best().map(|e| e.0) == first) {
         format!(
             "Every machine's fastest strategy is **{}**, each resolved by its paired rounds.",
             first.map_or("—", |s| s.as_str())

@@ -26,10 +26,9 @@ use crate::report::select;
 use crate::report::select::SeriesKey;
 use crate::report::series::{self, Group, Line, Point};
 use crate::report::verdict;
-use crate::report::verdict::{Entry, Unknown, Verdict};
+use crate::report::verdict::{Entry, Verdict};
 use crate::report::view::GroupView;
 use sph_harness::results::files::COMPARE_CHART_PREFIX;
-use sph_harness::results::intervals::Ratio;
 use sph_harness::results::key::LabelStyle;
 use sph_solver::models::Preset;
 use sph_solver::sph::neighbors::NeighborMode;
@@ -202,100 +201,55 @@ pub fn strategy_bests(v: &GroupView) -> Vec<Entry> {
         .collect()
 }
 
-/// Whether the fastest strategy of a machine is told apart from the next.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Ranking {
-    /// No parallel strategy has a usable cell.
-    NoCell,
-    /// Every strategy's best cell was contended: the fastest is shown, not trusted.
-    AllContended,
-    /// Only one strategy was measured (without contention).
-    Only,
-    /// Some best cell cannot be ordered against the fastest: the lowest mean, no verdict.
-    Unknown {
-        /// The next fastest strategy's best cell.
-        next: Entry,
-        /// Why.
-        why: Unknown,
-    },
-    /// The fastest is faster than every other strategy by their paired rounds.
-    Resolved {
-        /// The next fastest strategy's best cell.
-        next: Entry,
-        /// How many times faster than it.
-        by: Ratio,
-    },
-    /// The fastest is not distinguishable from these strategies (fastest first).
-    NotResolved {
-        /// The best cells not distinguishable from the fastest.
-        overlapping: Vec<Entry>,
-    },
-}
-
-/// One machine's fastest strategy in one group, and whether that is resolved.
+/// One machine's fastest strategy in one group: the verdict of the group's findings
+/// ([`verdict::verdict`]) on each strategy's best cell, contended ones left out.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MachineBest {
     /// The side.
     pub side: usize,
     /// Its group.
     pub group: Group,
-    /// The fastest strategy's best cell (`None` with [`Ranking::NoCell`]).
-    pub best: Option<Entry>,
-    /// What the intervals support.
-    pub ranking: Ranking,
-    /// Strategies whose best cell was contended and so left out of the ranking.
-    pub contended_left_out: usize,
+    /// Every parallel strategy's best cell, in registry order.
+    pub entries: Vec<Entry>,
+    /// Those measured without contention, lowest mean first ([`verdict::trusted`]).
+    pub trusted: Vec<Entry>,
+    /// The verdict on `trusted` (`None`: every best cell was contended, or there is none).
+    pub verdict: Option<Verdict>,
 }
 
-/// The fastest strategy of the group of `v` on side `side`: the verdict of the group's
-/// findings ([`verdict::verdict`]) on each strategy's best cell, contended ones left out.
-pub fn machine_best(side: usize, v: &GroupView) -> MachineBest {
-    let entries = strategy_bests(v);
-    let trusted = verdict::trusted(&entries);
-    let contended_left_out = entries.len() - trusted.len();
-    let (best, ranking) = match verdict::verdict(&trusted) {
-        Some(Verdict::Only(e)) => (Some(e), Ranking::Only),
-        Some(Verdict::Unknown(e, why)) => (
-            Some(e),
-            Ranking::Unknown {
-                next: trusted[1].clone(),
-                why,
-            },
-        ),
-        Some(Verdict::Fastest {
-            winner,
-            runner_up,
-            by,
-        }) => (
-            Some(winner),
-            Ranking::Resolved {
-                next: runner_up,
-                by,
-            },
-        ),
-        Some(Verdict::Tied { mut tied, .. }) => {
-            let first = tied.remove(0);
-            (Some(first), Ranking::NotResolved { overlapping: tied })
+impl MachineBest {
+    /// The fastest strategy of the group of `v` on side `side`.
+    pub fn of(side: usize, v: &GroupView) -> MachineBest {
+        let entries = strategy_bests(v);
+        let trusted = verdict::trusted(&entries);
+        MachineBest {
+            side,
+            group: v.group,
+            verdict: verdict::verdict(&trusted),
+            entries,
+            trusted,
         }
-        None => {
-            let fastest = entries
+    }
+
+    /// The fastest strategy's best cell: the lowest mean measured without contention, or
+    /// where every one was contended the lowest mean (shown, not trusted); `None` without a
+    /// usable cell.
+    pub fn best(&self) -> Option<&Entry> {
+        self.trusted.first().or_else(|| {
+            self.entries
                 .iter()
                 .min_by(|a, b| a.1.mean_s.total_cmp(&b.1.mean_s))
-                .cloned();
-            let ranking = if fastest.is_some() {
-                Ranking::AllContended
-            } else {
-                Ranking::NoCell
-            };
-            (fastest, ranking)
-        }
-    };
-    MachineBest {
-        side,
-        group: v.group,
-        best,
-        ranking,
-        contended_left_out,
+        })
+    }
+
+    /// Strategies whose best cell was contended and so left out of the ranking.
+    pub fn contended_left_out(&self) -> usize {
+        self.entries.len() - self.trusted.len()
+    }
+
+    /// Whether the fastest is faster than every other strategy by their paired rounds.
+    pub fn resolved(&self) -> bool {
+        matches!(self.verdict, Some(Verdict::Fastest { .. }))
     }
 }
 
@@ -383,7 +337,7 @@ fn compare(sides: &[Side<'_>], names: &[String], matched: Matched) -> Compared {
     let best = matched
         .groups
         .iter()
-        .map(|(i, g)| machine_best(*i, view(*i, g)))
+        .map(|(i, g)| MachineBest::of(*i, view(*i, g)))
         .collect();
     let mut notes = Vec::new();
     // Per side: its speedup lines in this workload (none without a usable seq).
@@ -491,6 +445,7 @@ pub fn efficiency_of(speedup: &Line) -> Line {
 mod tests {
     use super::*;
     use crate::report::compare::sides::{SideRule, sides};
+    use crate::report::verdict::Unknown;
     use crate::report::view::tests::{measured, of_rows, with_trials};
     use sph_harness::results::fixtures::row;
     use sph_harness::results::fixtures::sweep_on;
@@ -578,37 +533,31 @@ mod tests {
     #[test]
     fn a_machine_best_is_resolved_only_where_the_paired_rounds_resolve_it() {
         let (rows, trials) = paired(&[2.0, 2.2, 1.8], &[2.4, 2.64, 2.16]);
-        let b = machine_best(0, &with_trials(rows, trials));
-        assert_eq!(b.best.as_ref().unwrap().0, StrategyName::RayonChunks);
+        let b = MachineBest::of(0, &with_trials(rows, trials));
+        assert_eq!(b.best().unwrap().0, StrategyName::RayonChunks);
+        assert!(b.resolved());
         assert!(
-            matches!(&b.ranking, Ranking::Resolved { next, by } if next.0 == StrategyName::RayonIter && (by.value - 1.2).abs() < 1e-12)
+            matches!(&b.verdict, Some(Verdict::Fastest { runner_up, by, .. }) if runner_up.0 == StrategyName::RayonIter && (by.value - 1.2).abs() < 1e-12)
         );
         // Rounds that disagree: not distinguishable.
         let (rows, trials) = paired(&[2.0, 2.4, 1.6], &[2.1, 2.2, 1.8]);
-        let b = machine_best(0, &with_trials(rows, trials));
-        assert!(
-            matches!(&b.ranking, Ranking::NotResolved { overlapping } if overlapping.len() == 1)
-        );
+        let b = MachineBest::of(0, &with_trials(rows, trials));
+        assert!(!b.resolved());
+        assert!(matches!(&b.verdict, Some(Verdict::Tied { tied, .. }) if tied.len() == 2));
         // Two rounds: no interval.
         let (rows, trials) = paired(&[2.0, 2.2], &[2.4, 2.64]);
-        let b = machine_best(0, &with_trials(rows, trials));
+        let b = MachineBest::of(0, &with_trials(rows, trials));
         assert!(matches!(
-            &b.ranking,
-            Ranking::Unknown {
-                why: Unknown::Rounds(2),
-                ..
-            }
+            &b.verdict,
+            Some(Verdict::Unknown(_, Unknown::Rounds(2)))
         ));
         let (mut rows, trials) = paired(&[2.0, 2.2, 1.8], &[2.4, 2.64, 2.16]);
         for r in &mut rows {
             r.contended = Some(true);
         }
-        let b = machine_best(0, &with_trials(rows, trials));
-        assert_eq!(
-            (b.ranking.clone(), b.contended_left_out),
-            (Ranking::AllContended, 2)
-        );
-        assert_eq!(b.best.unwrap().1.mean_s, 2.0);
+        let b = MachineBest::of(0, &with_trials(rows, trials));
+        assert_eq!((b.verdict.clone(), b.contended_left_out()), (None, 2));
+        assert_eq!(b.best().unwrap().1.mean_s, 2.0);
     }
 
     #[test]
@@ -639,7 +588,7 @@ mod tests {
         let at_two = chart.lines[1].speedup.points[1];
         assert_eq!((at_two.x, at_two.y), (2.0, 4.0 / 1.1));
         assert_eq!(chart.lines[1].efficiency.points[1].y, 4.0 / 1.1 / 2.0);
-        let bests: Vec<StrategyName> = c.best.iter().map(|b| b.best.as_ref().unwrap().0).collect();
+        let bests: Vec<StrategyName> = c.best.iter().map(|b| b.best().unwrap().0).collect();
         assert_eq!(bests, [StrategyName::RayonChunks, StrategyName::RayonIter]);
         assert!(c.notes.is_empty(), "{:?}", c.notes);
         assert_eq!(p.per_side[1][0].1.len(), 2);
