@@ -619,14 +619,8 @@ fn paper_context(md: &mut String, g: &Group) {
 }
 
 /// A chart embedded as an image, its caption below it in italics.
-fn chart(md: &mut String, c: &ChartPlan) {
-    let _ = writeln!(
-        md,
-        "![{}]({})\n\n*{}*\n",
-        alt(&c.caption),
-        c.file,
-        c.caption
-    );
+pub(super) fn chart(md: &mut String, c: &ChartPlan) {
+    let _ = writeln!(md, "![{}]({})\n\n*{}*\n", c.alt(), c.file, c.caption);
 }
 
 /// The group's charts with their captions, then the notes on those not drawn.
@@ -749,11 +743,6 @@ fn flagged_cores(b: &Best, columns: Columns<'_>) -> String {
         .iter()
         .filter(|(on, _)| *on)
         .fold(b.cores.to_string(), |cores, (_, f)| format!("{cores} {f}"))
-}
-
-/// An image's alt text: its caption up to the first `;` or `,`.
-fn alt(caption: &str) -> &str {
-    caption.split([';', ',']).next().unwrap_or(caption)
 }
 
 fn across_groups(md: &mut String, input: &Input<'_>) {

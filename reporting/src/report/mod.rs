@@ -160,8 +160,7 @@ pub fn generate_with(
     let text = match &drawing {
         Drawing::Compared(planned) => {
             for chart in planned.compared.iter().flat_map(|c| &c.charts) {
-                let path = out_dir.join(&chart.file);
-                charts::compare::draw(&path, &chart.title, &chart.subtitle, &chart.lines)?;
+                draw(&out_dir.join(&chart.file), chart)?;
             }
             compare::markdown::render(&compare::markdown::Input {
                 sweeps: &sweeps,
@@ -326,5 +325,6 @@ fn draw(path: &Path, chart: &plan::ChartPlan) -> anyhow::Result<()> {
             smt,
         } => charts::efficiency::draw(path, title, subtitle, (efficiency, serial), smt.as_ref()),
         ChartKind::Neighbors(lines) => charts::neighbors::draw(path, title, subtitle, lines),
+        ChartKind::Machines { lines, .. } => charts::compare::draw(path, title, subtitle, lines),
     }
 }

@@ -16,6 +16,7 @@ use sph_strategies::StrategyName;
 
 use super::cell;
 use super::charts::best::BestChart;
+use super::charts::compare::MachineLines;
 use super::paper;
 use super::select;
 use super::select::SeriesKey;
@@ -67,6 +68,14 @@ pub enum ChartKind {
     },
     /// Chart 6: all-pairs against grid, seconds per step against N.
     Neighbors(Vec<Line>),
+    /// A comparison of machines: one strategy's best speedup and efficiency against cores,
+    /// one line per machine.
+    Machines {
+        /// The strategy.
+        strategy: StrategyName,
+        /// One entry per machine with a speedup line, by side.
+        lines: Vec<MachineLines>,
+    },
 }
 
 /// One chart to draw.
@@ -84,6 +93,26 @@ pub struct ChartPlan {
     pub subtitle: String,
     /// The series.
     pub kind: ChartKind,
+}
+
+impl ChartPlan {
+    /// The image's alt text: the caption up to its first `;` or `,`, or for a comparison the
+    /// strategy and what the chart shows.
+    pub fn alt(&self) -> String {
+        match &self.kind {
+            ChartKind::Machines { strategy, .. } => {
+                format!("{strategy}: speedup and efficiency against cores, per machine")
+            }
+            _ => {
+                let caption = self.caption.as_str();
+                caption
+                    .split([';', ','])
+                    .next()
+                    .unwrap_or(caption)
+                    .to_owned()
+            }
+        }
+    }
 }
 
 /// Every chart of a report, in the order drawn, and the notes on those not drawn.

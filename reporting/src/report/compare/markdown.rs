@@ -13,12 +13,12 @@
 
 use std::fmt::Write as _;
 
-use super::plan::{CompareChart, ComparePlan, Compared, MachineBest};
+use super::plan::{ComparePlan, Compared, MachineBest};
 use super::sides::{Side, SideRule, same_hardware_sets};
 use crate::report::cell::Best;
 use crate::report::load::Sweep;
 use crate::report::markdown::{
-    CONTENDED, OVERSUBSCRIBED, banners, best_cells, best_columns, method, test_data_banner,
+    CONTENDED, OVERSUBSCRIBED, banners, best_cells, best_columns, chart, method, test_data_banner,
 };
 use crate::report::numbers::faster;
 use crate::report::series::Group;
@@ -206,8 +206,8 @@ fn compared(md: &mut String, sides: &[Side<'_>], c: &Compared) {
     }
     let _ = writeln!(md, "{t}");
     let _ = writeln!(md, "{}\n", verdict_across(sides, &c.best));
-    for chart in &c.charts {
-        embed(md, chart);
+    for planned in &c.charts {
+        chart(md, planned);
     }
     for note in &c.notes {
         let _ = writeln!(md, "- {note}");
@@ -319,15 +319,6 @@ pub fn verdict_across(sides: &[Side<'_>], best: &[MachineBest]) -> String {
             winners.join(", ")
         )
     }
-}
-
-/// A chart embedded as an image, its caption below it in italics.
-fn embed(md: &mut String, c: &CompareChart) {
-    let _ = writeln!(
-        md,
-        "![{}: speedup and efficiency against cores, per machine]({})\n\n*{}*\n",
-        c.strategy, c.file, c.caption
-    );
 }
 
 /// The workloads measured on one side only.

@@ -22,6 +22,7 @@ use sph_strategies::StrategyName;
 use super::sides::{Side, names};
 use crate::report::cell::Best;
 use crate::report::charts::compare::MachineLines;
+use crate::report::plan::{ChartKind, ChartPlan};
 use crate::report::select;
 use crate::report::select::SeriesKey;
 use crate::report::series::{self, Group, Line, Point};
@@ -253,39 +254,22 @@ impl MachineBest {
     }
 }
 
-/// One comparison chart: one strategy in one matched workload, one line per machine.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CompareChart {
-    /// File name, relative to the report (`compare-…`, never a name of the normal report).
-    pub file: String,
-    /// The strategy.
-    pub strategy: StrategyName,
-    /// The title drawn on the chart.
-    pub title: String,
-    /// The subtitle drawn under it.
-    pub subtitle: String,
-    /// The report's caption.
-    pub caption: String,
-    /// One entry per machine with a speedup line, by side.
-    pub lines: Vec<MachineLines>,
-}
-
 /// One matched workload: each machine's fastest strategy, the charts and the notes on what
 /// could not be compared.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct Compared {
     /// The workload and each side's group.
     pub matched: Matched,
     /// Each side's fastest strategy, by side.
     pub best: Vec<MachineBest>,
     /// One chart per strategy with speedups on two machines or more.
-    pub charts: Vec<CompareChart>,
+    pub charts: Vec<ChartPlan>,
     /// What is not charted, and why.
     pub notes: Vec<String>,
 }
 
 /// The whole comparison.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone)]
 pub struct ComparePlan {
     /// How each side is named beside its tag ([`names`]).
     pub names: Vec<String>,
@@ -383,9 +367,9 @@ fn compare(sides: &[Side<'_>], names: &[String], matched: Matched) -> Compared {
                 "{s}: speedups on {} only: nothing to compare, no chart.",
                 sides[one.side].tag
             )),
-            _ => charts.push(CompareChart {
+            _ => charts.push(ChartPlan {
                 file: format!("{COMPARE_CHART_PREFIX}{}-{s}.png", matched.slug()),
-                strategy: s,
+                group: None,
                 title: format!("Speedup and efficiency on each machine: {s}"),
                 caption: format!(
                     "{s}: best speedup over each machine's own seq (above; bars: 95 % \
@@ -393,7 +377,7 @@ fn compare(sides: &[Side<'_>], names: &[String], matched: Matched) -> Compared {
                      same interval over p) against cores, one line per machine; {subtitle}."
                 ),
                 subtitle: subtitle.clone(),
-                lines,
+                kind: ChartKind::Machines { strategy: s, lines },
             }),
         }
     }
@@ -582,12 +566,14 @@ mod tests {
                 "compare-seed-all-pairs-n60-s3-s5-rayon-iter.png"
             ]
         );
-        let chart = &c.charts[0];
-        assert_eq!(chart.lines.len(), 2);
-        assert_eq!(chart.lines[1].legend, "B: EPYC, 16 hardware\nthreads");
-        let at_two = chart.lines[1].speedup.points[1];
+        let ChartKind::Machines { lines, .. } = &c.charts[0].kind else {
+            panic!("a comparison's chart has a line per machine");
+        };
+        assert_eq!(lines.len(), 2);
+        assert_eq!(lines[1].legend, "B: EPYC, 16 hardware\nthreads");
+        let at_two = lines[1].speedup.points[1];
         assert_eq!((at_two.x, at_two.y), (2.0, 4.0 / 1.1));
-        assert_eq!(chart.lines[1].efficiency.points[1].y, 4.0 / 1.1 / 2.0);
+        assert_eq!(lines[1].efficiency.points[1].y, 4.0 / 1.1 / 2.0);
         let bests: Vec<StrategyName> = c.best.iter().map(|b| b.best().unwrap().0).collect();
         assert_eq!(bests, [StrategyName::RayonChunks, StrategyName::RayonIter]);
         assert!(c.notes.is_empty(), "{:?}", c.notes);
