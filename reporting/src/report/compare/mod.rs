@@ -9,6 +9,13 @@
 //! the first the second reproduced. [`crate::report::generate`] draws the charts
 //! ([`crate::report::charts::compare`]) and writes the text.
 //!
+//! A comparison is the ordinary report's machinery with the machine as one more key: each
+//! side's groups are ordinary [`GroupView`](crate::report::view::GroupView)s, a machine's
+//! fastest strategy is the findings' own [`Verdict`](crate::report::verdict::Verdict), and its
+//! charts are ordinary [`ChartPlan`](crate::report::plan::ChartPlan)s drawn and embedded as
+//! every other chart. What is the comparison's own: forming sides, matching workloads across
+//! them, the machines' table, the wording across machines and the reproducibility section.
+//!
 //! A cell counts once within a side (the same cell in two directories of one machine is
 //! refused, as in a single study); the same cell on two sides is what a comparison compares.
 //! Chart files are named `compare-…`, so that they never take the name of a chart of the
