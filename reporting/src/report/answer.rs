@@ -15,7 +15,6 @@ use std::fmt::Write as _;
 use super::cell::Best;
 use super::findings::{AtCores, Finding, Withheld};
 use super::numbers::{faster, plus_minus};
-use super::select;
 use super::table::{Column, Table};
 use super::verdict::{Entry, Verdict, and_list};
 use super::view::{Design, GroupView};
@@ -82,7 +81,7 @@ fn said(v: &GroupView, found: &[Finding]) -> Vec<Said> {
     }
     let seq_trusted = !found.contains(&Finding::ContendedReference);
     let mut out = Vec::new();
-    for c in select::cores(&v.rows, &v.group) {
+    for c in v.cores() {
         let at = found.iter().find_map(|f| match f {
             Finding::AtCores(at) if at.cores == c => Some(at.clone()),
             _ => None,

@@ -89,7 +89,22 @@ pub struct Best {
     pub grid_runs: Option<Runs>,
 }
 
+/// How tables flag a cell with more threads than the machine has.
+pub const OVERSUBSCRIBED: &str = "⚠ oversubscribed";
+/// How tables flag a cell that other work disturbed.
+pub const CONTENDED: &str = "⚠ contended";
+
 impl Best {
+    /// Its flags: [`OVERSUBSCRIBED`] and [`CONTENDED`] where they apply.
+    pub fn flags(&self) -> impl Iterator<Item = &'static str> {
+        [
+            (self.oversubscribed, OVERSUBSCRIBED),
+            (self.contended, CONTENDED),
+        ]
+        .into_iter()
+        .filter_map(|(on, flag)| on.then_some(flag))
+    }
+
     /// A usable cell's numbers with its `runs` (`None` without a mean).
     pub fn of(r: &SummaryRow, runs: Runs) -> Option<Best> {
         let mean_s = r.mean_s?;

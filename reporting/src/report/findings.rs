@@ -39,7 +39,6 @@ use super::verdict::{
 use super::view::{Design, GroupView};
 use sph_harness::results::intervals::{MIN_ROUNDS, Ratio};
 use sph_harness::results::stats::Interval;
-use sph_strategies::StrategyName;
 
 /// What the data of a group supports, decided before it is worded.
 #[derive(Debug, Clone, PartialEq)]
@@ -147,7 +146,7 @@ pub fn findings(view: &GroupView) -> Vec<Finding> {
     if !seq_trusted {
         out.push(Finding::ContendedReference);
     }
-    for c in select::cores(&view.rows, &view.group) {
+    for c in view.cores() {
         let at: Vec<Entry> = bests
             .iter()
             .filter_map(|(k, b)| {
@@ -161,10 +160,7 @@ pub fn findings(view: &GroupView) -> Vec<Finding> {
             out.push(Finding::OneCore(one));
         }
     }
-    let strategies: Vec<StrategyName> = select::strategies(&view.rows, &view.group)
-        .into_iter()
-        .filter(|&s| s != StrategyName::Seq)
-        .collect();
+    let strategies = view.parallel_strategies();
     out.extend(super::placements::compare(view, &strategies, seq_trusted).map(Finding::Placements));
     out.extend(best_chunks(view, &bests));
     out.extend(chunking(view, &bests));
@@ -245,7 +241,8 @@ fn against_paper(view: &GroupView, bests: &[(SeriesKey, Vec<Best>)]) -> Option<F
     if !paper::comparable(&view.group) {
         return None;
     }
-    let points: Vec<PaperPoint> = select::cores(&view.rows, &view.group)
+    let points: Vec<PaperPoint> = view
+        .cores()
         .into_iter()
         .filter_map(|c| {
             let p = paper::at(c)?;
@@ -489,9 +486,9 @@ impl AtCores {
 pub(crate) mod tests {
     use super::*;
     use crate::report::view::tests::{Spec, measured, view, with_trials};
-    use StrategyName::{RayonChunks, RayonIter, Seq};
     use sph_harness::results::rows::Phase;
     use sph_harness::topology::Pin;
+    use sph_strategies::StrategyName::{RayonChunks, RayonIter, Seq};
 
     const NONE: Pin = Pin::None;
     /// seq's times per round: the machine drifts from round to round.

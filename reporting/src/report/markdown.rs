@@ -5,7 +5,7 @@
 use std::fmt::Write as _;
 
 use super::cell;
-use super::cell::Best;
+use super::cell::{Best, CONTENDED};
 use super::findings::{Finding, findings};
 use super::load::Sweep;
 use super::numbers::{interval, plus_minus, sig};
@@ -38,10 +38,6 @@ pub struct Input<'a> {
 
 pub use super::numbers::{mean_sd, secs, times};
 
-/// How tables flag a cell with more threads than the machine has.
-pub(super) const OVERSUBSCRIBED: &str = "⚠ oversubscribed";
-/// How tables flag a cell that other work disturbed.
-pub(super) const CONTENDED: &str = "⚠ contended";
 /// How tables flag a best cell of a confirmed group that its confirmation did not measure.
 const UNCONFIRMED: &str = "⚠ not confirmed";
 
@@ -491,18 +487,14 @@ fn group(md: &mut String, v: &GroupView, found: &[Finding], input: &Input<'_>) {
     }
     let _ = writeln!(md, "### Best cell per core count (Table 1 analogue)\n");
     let _ = writeln!(md, "{}\n", chosen(v));
-    let smt =
-        topology_of(input.sweeps, g).and_then(|t| series::smt_band(t, &select::cores(&v.rows, g)));
+    let smt = topology_of(input.sweeps, g).and_then(|t| series::smt_band(t, &v.cores()));
     let columns = Columns {
         pin: select::is_pinned(&v.rows, g),
         smt: smt.as_ref(),
         confirmed: v.is_confirmed(),
     };
     let bests = v.series_bests();
-    for s in select::strategies(&v.rows, g)
-        .into_iter()
-        .filter(|&s| s != StrategyName::Seq)
-    {
+    for s in v.parallel_strategies() {
         let mut best: Vec<Best> = bests
             .iter()
             .filter(|(k, _)| k.strategy == s)
@@ -734,15 +726,10 @@ fn table(
 
 /// A best cell's cores with its flags: `3 ⚠ oversubscribed ⚠ not confirmed`.
 fn flagged_cores(b: &Best, columns: Columns<'_>) -> String {
-    let flags = [
-        (b.oversubscribed, OVERSUBSCRIBED),
-        (b.contended, CONTENDED),
-        (columns.confirmed && !b.confirmed, UNCONFIRMED),
-    ];
-    flags
-        .iter()
-        .filter(|(on, _)| *on)
-        .fold(b.cores.to_string(), |cores, (_, f)| format!("{cores} {f}"))
+    let unconfirmed = (columns.confirmed && !b.confirmed).then_some(UNCONFIRMED);
+    b.flags()
+        .chain(unconfirmed)
+        .fold(b.cores.to_string(), |cores, f| format!("{cores} {f}"))
 }
 
 fn across_groups(md: &mut String, input: &Input<'_>) {

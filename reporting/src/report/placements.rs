@@ -97,7 +97,7 @@ fn placement_pair(
     };
     let mut at = Vec::new();
     let mut contended = 0;
-    for c in select::cores(&view.rows, &view.group) {
+    for c in view.cores() {
         let both: Vec<PinPair> = ok
             .iter()
             .filter(|r| r.strategy == s && r.pin == a && r.cores == c)
@@ -253,11 +253,7 @@ mod tests {
 
     /// The placement sentences of `v`, as the findings word them (its `seq` trusted).
     fn sentences_of(v: &GroupView) -> Vec<String> {
-        let strategies: Vec<StrategyName> = select::strategies(&v.rows, &v.group)
-            .into_iter()
-            .filter(|&s| s != Seq)
-            .collect();
-        compare(v, &strategies, true)
+        compare(v, &v.parallel_strategies(), true)
             .map(|p| p.sentence())
             .collect()
     }

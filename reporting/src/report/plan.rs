@@ -133,7 +133,7 @@ pub fn plan<'t>(
     let mut out = ReportPlan::default();
     for v in views {
         chunk_charts(v, &mut out);
-        let cores = select::cores(&v.rows, &v.group);
+        let cores = v.cores();
         let smt = topology(&v.group).and_then(|t| series::smt_band(t, &cores));
         cores_charts(v, smt, &mut out);
     }
@@ -241,7 +241,7 @@ fn chunk_charts(v: &GroupView, out: &mut ReportPlan) {
 /// Charts 3–5 of `v`, or why they are not drawn.
 fn cores_charts(v: &GroupView, smt: Option<SmtBand>, out: &mut ReportPlan) {
     let g = &v.group;
-    let cores = select::cores(&v.rows, g);
+    let cores = v.cores();
     match v.reference().and_then(|r| r.mean_s) {
         Some(seq_s) if cores.len() > 1 => {
             let bests = v.series_bests();
@@ -281,10 +281,7 @@ fn best_charts(
     let subtitle = g.label(LabelStyle::Report);
     let comparable = paper::comparable(g);
     let speedups = series::speedup_lines(bests);
-    for s in select::strategies(&v.rows, g)
-        .into_iter()
-        .filter(|&s| s != StrategyName::Seq)
-    {
+    for s in v.parallel_strategies() {
         let mut runtime = Vec::new();
         let mut speedup = Vec::new();
         for (key, best) in bests.iter().filter(|(k, _)| k.strategy == s) {

@@ -22,6 +22,7 @@ use sph_harness::results::meta::Meta;
 use sph_harness::results::params::Schedule;
 use sph_harness::results::rows::{Contended, Phase, SummaryRow, TrialRow, fastest};
 use sph_harness::results::summarize::by_round;
+use sph_strategies::StrategyName;
 
 /// How a sweep ordered its runs and computed its intervals: whether its rounds pair.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -213,6 +214,19 @@ impl GroupView {
                     .unwrap_or(chosen);
                 self.best(row)
             })
+            .collect()
+    }
+
+    /// The core counts of the group's usable cells (any strategy but `seq`), ascending.
+    pub fn cores(&self) -> Vec<usize> {
+        select::cores(&self.rows, &self.group)
+    }
+
+    /// Every strategy of the group but `seq`, in the order they first appear.
+    pub fn parallel_strategies(&self) -> Vec<StrategyName> {
+        select::strategies(&self.rows, &self.group)
+            .into_iter()
+            .filter(|&s| s != StrategyName::Seq)
             .collect()
     }
 

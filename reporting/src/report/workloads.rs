@@ -138,9 +138,9 @@ fn workload(v: &GroupView) -> Workload {
 
 /// Each strategy's best cell at `cores` in `v` (every strategy but `seq`), fastest first.
 fn entries(v: &GroupView, cores: usize) -> Vec<Entry> {
-    let mut out: Vec<Entry> = select::strategies(&v.rows, &v.group)
+    let mut out: Vec<Entry> = v
+        .parallel_strategies()
         .into_iter()
-        .filter(|&s| s != StrategyName::Seq)
         .filter_map(|s| {
             let best = v.best_per_cores(select::SeriesKey::unpinned(s));
             Some((s, Box::new(best.into_iter().find(|b| b.cores == cores)?)))
@@ -151,8 +151,8 @@ fn entries(v: &GroupView, cores: usize) -> Vec<Entry> {
 }
 
 fn rankings(toy: &GroupView, real: &GroupView) -> Vec<RankingAt> {
-    let real_cores = select::cores(&real.rows, &real.group);
-    select::cores(&toy.rows, &toy.group)
+    let real_cores = real.cores();
+    toy.cores()
         .into_iter()
         .filter(|c| real_cores.contains(c))
         .map(|c| {
@@ -295,17 +295,11 @@ fn place(ranked: Option<&(usize, Best)>) -> String {
         || format!("{} s", sig(b.mean_s)),
         |s| plus_minus(s, b.speedup_ci),
     );
-    format!(
-        "{rank} · {speed}{}{}{}",
-        b.chunks
-            .map_or_else(String::new, |k| format!(", {k} chunks")),
-        if b.oversubscribed {
-            " ⚠ oversubscribed"
-        } else {
-            ""
-        },
-        if b.contended { " ⚠ contended" } else { "" }
-    )
+    let chunks = b
+        .chunks
+        .map_or_else(String::new, |k| format!(", {k} chunks"));
+    let flags: String = b.flags().map(|f| format!(" {f}")).collect();
+    format!("{rank} · {speed}{chunks}{flags}")
 }
 
 #[cfg(test)]

@@ -17,9 +17,7 @@ use super::plan::{ComparePlan, Compared, MachineBest};
 use super::sides::{Side, SideRule, same_hardware_sets};
 use crate::report::cell::Best;
 use crate::report::load::Sweep;
-use crate::report::markdown::{
-    CONTENDED, OVERSUBSCRIBED, banners, best_cells, best_columns, chart, method, test_data_banner,
-};
+use crate::report::markdown::{banners, best_cells, best_columns, chart, method, test_data_banner};
 use crate::report::numbers::faster;
 use crate::report::series::Group;
 use crate::report::table::{Column, Table};
@@ -240,13 +238,7 @@ fn cells(b: &Best) -> impl Iterator<Item = String> {
 
 /// `⚠ oversubscribed`, `⚠ contended`, both, or `—`.
 fn flags(b: &Best) -> String {
-    let mut f: Vec<&str> = Vec::new();
-    if b.oversubscribed {
-        f.push(OVERSUBSCRIBED);
-    }
-    if b.contended {
-        f.push(CONTENDED);
-    }
+    let f: Vec<&str> = b.flags().collect();
     if f.is_empty() {
         "—".to_owned()
     } else {
@@ -379,11 +371,8 @@ fn side_summary(md: &mut String, side: &Side<'_>, name: &str, groups: &[(Group, 
         }
     }
     let _ = writeln!(md, "{t}");
-    let failed = side
-        .rows
-        .iter()
-        .filter(|r| r.status == Status::Failed)
-        .count();
+    let rows = side.sweeps.iter().flat_map(|s| &s.rows);
+    let failed = rows.filter(|r| r.status == Status::Failed).count();
     if failed > 0 {
         let _ = writeln!(
             md,

@@ -23,7 +23,6 @@ use super::sides::{Side, names};
 use crate::report::cell::Best;
 use crate::report::charts::compare::MachineLines;
 use crate::report::plan::{ChartKind, ChartPlan};
-use crate::report::select;
 use crate::report::select::SeriesKey;
 use crate::report::series::{self, Group, Line, Point};
 use crate::report::verdict;
@@ -195,9 +194,8 @@ pub fn strategy_best(v: &GroupView, s: StrategyName) -> Option<Best> {
 
 /// Every parallel strategy's best cell in `v` over every cores value, in registry order.
 pub fn strategy_bests(v: &GroupView) -> Vec<Entry> {
-    select::strategies(&v.rows, &v.group)
+    v.parallel_strategies()
         .into_iter()
-        .filter(|&s| s != StrategyName::Seq)
         .filter_map(|s| Some((s, Box::new(strategy_best(v, s)?))))
         .collect()
 }
@@ -338,8 +336,8 @@ fn compare(sides: &[Side<'_>], names: &[String], matched: Matched) -> Compared {
         } else {
             speedups.push((*i, series::speedup_lines(&v.series_bests())));
         }
-        for s in select::strategies(&v.rows, g) {
-            if s != StrategyName::Seq && !strategies.contains(&s) {
+        for s in v.parallel_strategies() {
+            if !strategies.contains(&s) {
                 strategies.push(s);
             }
         }

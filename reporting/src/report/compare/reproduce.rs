@@ -16,7 +16,6 @@ use std::fmt::Write as _;
 use super::sides::{Side, same_hardware_sets};
 use crate::report::cell;
 use crate::report::numbers::{faster, percent, plus_minus};
-use crate::report::select;
 use crate::report::select::SeriesKey;
 use crate::report::series::Group;
 use crate::report::table::{Column, Table};
@@ -139,7 +138,7 @@ fn rankings(first: &Side<'_>, second: &Side<'_>) -> (usize, Vec<Changed>) {
                 .and_then(|(_, b)| b.iter().find(|b| b.cores == c && !b.contended))
                 .cloned()
         };
-        for c in select::cores(&v.rows, &v.group) {
+        for c in v.cores() {
             for (n, (a, _)) in ours.iter().enumerate() {
                 for (b, _) in &ours[n + 1..] {
                     let (Some(a1), Some(b1), Some(a2), Some(b2)) = (

@@ -11,7 +11,6 @@ use std::path::Path;
 use crate::report::load::Sweep;
 use crate::report::view::GroupView;
 use sph_harness::results::meta::Machine;
-use sph_harness::results::rows::SummaryRow;
 
 /// How directories are grouped into sides.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -29,8 +28,6 @@ pub struct Side<'a> {
     pub tag: String,
     /// Its sweeps, in the order given.
     pub sweeps: Vec<&'a Sweep>,
-    /// The usable and failed cells of all its sweeps, directory by directory.
-    pub rows: Vec<SummaryRow>,
     /// Its groups ([`GroupView::of`] its sweeps).
     pub views: Vec<GroupView>,
 }
@@ -45,6 +42,11 @@ impl Side<'_> {
     /// Its directories, in the order given.
     pub fn dirs(&self) -> Vec<&Path> {
         self.sweeps.iter().map(|s| s.dir.as_path()).collect()
+    }
+
+    /// The view of group `g`, if the side measured it.
+    pub fn view(&self, g: &crate::report::series::Group) -> Option<&GroupView> {
+        self.views.iter().find(|v| v.group == *g)
     }
 }
 
@@ -67,14 +69,10 @@ pub fn sides(sweeps: &[Sweep], rule: SideRule) -> Vec<Side<'_>> {
             SideRule::EachDirectory => None,
         };
         match joins {
-            Some(i) => {
-                out[i].sweeps.push(s);
-                out[i].rows.extend(s.rows.iter().cloned());
-            }
+            Some(i) => out[i].sweeps.push(s),
             None => out.push(Side {
                 tag: tag(out.len()),
                 sweeps: vec![s],
-                rows: s.rows.clone(),
                 views: Vec::new(),
             }),
         }
@@ -83,13 +81,6 @@ pub fn sides(sweeps: &[Sweep], rule: SideRule) -> Vec<Side<'_>> {
         side.views = GroupView::of(side.sweeps.iter().copied());
     }
     out
-}
-
-impl Side<'_> {
-    /// The view of group `g`, if the side measured it.
-    pub fn view(&self, g: &crate::report::series::Group) -> Option<&GroupView> {
-        self.views.iter().find(|v| v.group == *g)
-    }
 }
 
 /// Whether `sides` make a comparison rather than one pooled study: more than one machine, or
@@ -148,6 +139,7 @@ pub(crate) mod tests {
     use super::*;
     use sph_harness::results::fixtures::row;
     use sph_harness::results::fixtures::sweep_on;
+    use sph_harness::results::rows::SummaryRow;
     use sph_strategies::StrategyName;
 
     fn seq() -> Vec<SummaryRow> {
@@ -173,7 +165,8 @@ pub(crate) mod tests {
                 ("B".to_owned(), vec![Path::new("b")]),
             ]
         );
-        assert_eq!(by_machine[0].rows.len(), 2);
+        let rows: usize = by_machine[0].sweeps.iter().map(|s| s.rows.len()).sum();
+        assert_eq!(rows, 2);
         assert!(is_comparison(&by_machine, SideRule::ByMachine));
         assert!(same_hardware_sets(&by_machine).is_empty());
         assert_eq!(
