@@ -6,7 +6,8 @@
 //! ([`cli`]) over the crates below, whose modules it re-exports so that one path names each:
 //!
 //! - `sph-strategies`: the parallel strategies, knowing nothing of SPH;
-//! - `sph-solver`: the physics ([`sph`], [`simd`], [`solver`], [`scene`], [`checksum`]);
+//! - `sph-solver`: the physics ([`models`], [`sph`], [`simd`], [`solver`], [`scene`],
+//!   [`checksum`]);
 //! - `sph-harness`: what measures and keeps ([`run`], [`clock`], [`contention`],
 //!   [`topology`], [`placement`], [`limits`], [`io`], [`output`], [`signals`], [`sweep`],
 //!   [`results`], [`merge`], [`trace`], [`validate`]);

@@ -1,7 +1,8 @@
 //! What a particle's colour shows, and the fixed range it is drawn against.
 //!
-//! The range is decided once per animation, from the constants and the initial state, so the
-//! same colour means the same value in every frame. Müller's presets (pixel units):
+//! The range is decided once per animation, so the same colour means the same value in every
+//! frame; the model gives it (`Model::speed_range` and `density_range`, in each model's
+//! `model.rs`), from its constants and the initial state. Müller's presets (pixel units):
 //! - **speed** `|v|`, px/s, from 0 to `√(2·|g|·(y_top − EPS))`, the speed of a particle falling
 //!   freely from the top of the initial dam to the floor;
 //! - **density** ρ, from `ρ_self = MASS·POLY6·HSQ³` (a particle with no neighbours: its own
@@ -51,14 +52,15 @@ pub struct Scale {
 }
 
 impl Scale {
-    /// The range for `by` in an animation of `physics` that starts from `initial` (see the
-    /// module docs; `wcsph`'s range does not depend on `initial`).
+    /// The range for `by` in an animation of `physics` that starts from `initial`: the
+    /// model's (see the module docs).
     pub fn new(by: ColorBy, physics: &Physics, initial: &State) -> Scale {
         let (lo, hi) = match by {
             ColorBy::Speed => physics.speed_range(initial),
             ColorBy::Density => physics.density_range(),
         };
-        // A dam lying on the floor has no fall height: keep the range non-empty.
+        // A range can be empty (a Müller dam lying on the floor has no fall height): keep it
+        // non-empty.
         let hi = if hi > lo { hi } else { lo + 1.0 };
         Scale {
             by,

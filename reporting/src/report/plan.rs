@@ -83,7 +83,8 @@ pub enum ChartKind {
 pub struct ChartPlan {
     /// File name, relative to the report.
     pub file: String,
-    /// The group it belongs to (`None` for charts across groups).
+    /// The group it belongs to (`None` for charts across groups, and for a comparison's
+    /// charts, whose workload is one group on each machine).
     pub group: Option<Group>,
     /// The report's one-sentence caption.
     pub caption: String,

@@ -36,7 +36,7 @@ impl Preset {
 
     /// Whether this is one of Müller's pixel-unit presets ([`Preset::MUELLER`]).
     pub fn is_mueller(self) -> bool {
-        self != Preset::Wcsph
+        matches!(self, Preset::Seed | Preset::Cpp)
     }
 
     /// The constants of a Müller preset.

@@ -69,7 +69,7 @@ pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
             let scratch = 8 * (fluid as u64 + fluid.div_ceil(SPEED_BLOCK) as u64);
             (physics, wcsph::scene::domain(), total, WCSPH_SLOTS, scratch)
         }
-        _ => {
+        Preset::Seed | Preset::Cpp => {
             let physics = Physics::from(preset.params());
             (physics, mueller::scene::domain(preset, n), n, SLOTS, 0)
         }

@@ -32,7 +32,7 @@ impl Scene {
                 wcsph::scene::Fill::DamBreak,
                 wcsph::scene::resolution_for(n),
             ),
-            _ => Ok(Scene {
+            Preset::Seed | Preset::Cpp => Ok(Scene {
                 physics: preset.params().into(),
                 domain: mueller::scene::domain(preset, n),
                 state: mueller::scene::try_initial_state(preset, n, seed)?,
@@ -45,7 +45,7 @@ impl Scene {
     pub fn dam_break_fluid(preset: Preset, n: usize) -> usize {
         match preset {
             Preset::Wcsph => wcsph::scene::dam_break_particles(wcsph::scene::resolution_for(n)),
-            _ => n,
+            Preset::Seed | Preset::Cpp => n,
         }
     }
 

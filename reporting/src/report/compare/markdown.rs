@@ -21,7 +21,7 @@ use crate::report::markdown::{banners, best_cells, best_columns, chart, method, 
 use crate::report::numbers::faster;
 use crate::report::series::Group;
 use crate::report::table::{Column, Table};
-use crate::report::verdict::{Entry, Verdict, and_list, describe};
+use crate::report::verdict::{self, Entry, Order, Verdict, and_list, describe};
 use sph_harness::results::key::LabelStyle;
 use sph_harness::results::rows::{Status, SummaryRow};
 
@@ -252,11 +252,20 @@ fn ranking(b: &MachineBest) -> String {
         None if b.entries.is_empty() => "no usable parallel cell".to_owned(),
         None => "**not resolved**: every strategy's best cell was contended".to_owned(),
         Some(Verdict::Only(_)) => "only one strategy measured".to_owned(),
-        Some(Verdict::Unknown(_, why)) => format!(
-            "**not resolved**: against the next lowest mean, {}, {}",
-            b.trusted.get(1).map(describe).unwrap_or_default(),
-            why.phrase()
-        ),
+        Some(Verdict::Unknown(first, why)) => {
+            // The first cell the lowest mean could not be ordered against: where the verdict
+            // stopped, not necessarily the next lowest mean.
+            let unordered =
+                b.trusted.iter().enumerate().skip(1).find(|(_, other)| {
+                    matches!(verdict::order(&first.1, &other.1), Order::Unknown(_))
+                });
+            let against = match unordered {
+                Some((1, other)) => format!("the next lowest mean, {}", describe(other)),
+                Some((_, other)) => describe(other),
+                None => "the next lowest mean".to_owned(),
+            };
+            format!("**not resolved**: against {against}, {}", why.phrase())
+        }
         Some(Verdict::Fastest { runner_up, by, .. }) => format!(
             "resolved: {} by the paired rounds",
             faster(by, &format!("the next fastest, {}", describe(runner_up)))
@@ -393,6 +402,60 @@ mod tests {
     use sph_harness::results::rows::Phase;
     use sph_harness::topology::Pin;
     use sph_strategies::StrategyName;
+
+    #[test]
+    fn the_ranking_column_says_what_the_paired_rounds_resolve_and_which_cell_they_could_not_order()
+    {
+        use crate::report::view::tests::with_trials;
+        use StrategyName::{CrossbeamPool, RayonChunks, RayonIter, Seq};
+        let seq: &[f64] = &[4.0, 4.4, 3.6];
+        let ranking_of = |cells: &[(StrategyName, &[f64])], contended: bool| {
+            let mut specs = vec![(Seq, 1, None, Pin::None, seq)];
+            specs.extend(cells.iter().map(|&(s, t)| (s, 2, None, Pin::None, t)));
+            let (mut rows, trials) = measured(&specs, Phase::Grid);
+            for r in rows.iter_mut().filter(|r| r.strategy != Seq) {
+                r.contended = Some(contended);
+            }
+            ranking(&MachineBest::of(0, &with_trials(rows, trials)))
+        };
+        let (chunks, iter): (&[f64], &[f64]) = (&[2.0, 2.2, 1.8], &[2.4, 2.64, 2.16]);
+        let resolved = ranking_of(&[(RayonChunks, chunks), (RayonIter, iter)], false);
+        assert!(
+            resolved.starts_with("resolved: ") && resolved.contains("the next fastest, rayon-iter"),
+            "{resolved}"
+        );
+        // Two rounds of rayon-iter: no interval against the next lowest mean.
+        let two: &[f64] = &[2.4, 2.64];
+        let next = ranking_of(&[(RayonChunks, chunks), (RayonIter, two)], false);
+        assert!(
+            next.starts_with("**not resolved**: against the next lowest mean, rayon-iter"),
+            "{next}"
+        );
+        // rayon-iter is ordered, crossbeam-pool (third lowest mean) is not: the text names it.
+        let pool: &[f64] = &[2.5, 2.75];
+        let third = ranking_of(
+            &[
+                (RayonChunks, chunks),
+                (RayonIter, iter),
+                (CrossbeamPool, pool),
+            ],
+            false,
+        );
+        assert!(
+            third.starts_with("**not resolved**: against crossbeam-pool")
+                && !third.contains("rayon-iter"),
+            "{third}"
+        );
+        let contended = ranking_of(&[(RayonChunks, chunks), (RayonIter, iter)], true);
+        assert_eq!(
+            contended,
+            "**not resolved**: every strategy's best cell was contended; 2 contended strategies \
+             left out"
+        );
+        assert_eq!(ranking_of(&[], false), "no usable parallel cell");
+        let only = ranking_of(&[(RayonChunks, chunks)], false);
+        assert_eq!(only, "only one strategy measured");
+    }
 
     /// A sweep in `dir` on `cpu` of seq (4 s, drifting by round), rayon-chunks and rayon-iter
     /// at 1 core (4.1 and 4.2 s) and at 2 cores `chunks_2` and `iter_2` seconds, drifting

@@ -1,5 +1,6 @@
-//! The constants of Müller's step, per preset (see the book's "Physics" page,
-//! book/src/physics.md). Units: pixels (px), seconds (s), mass units (mu).
+//! The constants of Müller's step, derived from the few that differ per preset (gravity, time
+//! step, damping: [`Preset::params`](crate::models::Preset::params)); see the book's "Physics"
+//! page, book/src/physics.md. Units: pixels (px), seconds (s), mass units (mu).
 
 use glam::DVec2;
 use std::f64::consts::PI;
