@@ -3,18 +3,24 @@
 // What it is: the `seed` preset's dam break (shared/SOLVER.md, Müller, Charypar & Gross 2003
 // as the seed paper's Haskell program evaluates it), written the way the C++ original
 // (cerrno/mueller-sph, src/main.cpp) is written: one std::vector of particle structs and three
-// plain O(N^2) loops per step. No SIMD intrinsics, no threads, no grid. Speed figures of
+// plain O(N^2) loops per step. No SIMD intrinsics, no grid, and no threads unless it is built
+// with -fopenmp: then each pass's loop over particles is `omp parallel for schedule(static)`,
+// the OpenMP team the strategies are measured against (a particle's sums do not depend on
+// how the particles are split, so the bits and the checksum are the same). Speed figures of
 // bench-sph are reported as ratios to this program's time, measured in the same run
 // (scripts/speed-bench.sh).
 //
 // It computes bit for bit what `bench-sph simulate --strategy seq` (all-pairs, seed preset)
-// computes: the same initial state (SplitMix64 jitter, src/scene/dam_break.rs), the same
-// constants and operation order (src/sph/params.rs, src/sph/passes.rs) and the same checksum
-// (FNV-1a 64 over the little-endian bits of x, y, vx, vy per particle, src/checksum.rs).
+// computes: the same initial state (SplitMix64 jitter, solver/src/models/mueller/scene.rs), the
+// same constants and operation order (solver/src/models/preset.rs, models/mueller/params.rs,
+// models/mueller/passes.rs) and the same checksum (FNV-1a 64 over the little-endian bits of x,
+// y, vx, vy per particle, solver/src/checksum.rs).
 // It must be compiled without contracting a*b+c into fused multiply-adds:
 //
 //   g++ -O2 -ffp-contract=off -std=c++17 -o mueller benches/plain-loop/mueller.cpp
 //   ./mueller [N [STEPS [SEED]]]          # defaults: 1000 1000 2019
+//   g++ -O2 -ffp-contract=off -std=c++17 -fopenmp -o mueller-omp benches/plain-loop/mueller.cpp
+//   OMP_NUM_THREADS=2 ./mueller-omp        # the OpenMP team on 2 threads
 //
 // Output, one line of JSON: {"n":..,"steps":..,"wall_s":..,"checksum":"<16 hex>"}, where
 // wall_s times the step loop only (std::chrono::steady_clock), not setup or the checksum.
@@ -108,6 +114,7 @@ std::vector<Particle> init_dam(std::size_t n, std::uint64_t seed) {
 
 void compute_density_pressure(std::vector<Particle>& ps) {
     const std::size_t n = ps.size();
+#pragma omp parallel for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
         Particle& pi = ps[i];
         double rho = 0.0;
@@ -128,6 +135,7 @@ void compute_density_pressure(std::vector<Particle>& ps) {
 
 void compute_forces(std::vector<Particle>& ps) {
     const std::size_t n = ps.size();
+#pragma omp parallel for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
         Particle& pi = ps[i];
         double fpress_x = 0.0, fpress_y = 0.0;
@@ -158,7 +166,10 @@ void compute_forces(std::vector<Particle>& ps) {
 }
 
 void integrate(std::vector<Particle>& ps, double width, double height) {
-    for (Particle& a : ps) {
+    const std::size_t n = ps.size();
+#pragma omp parallel for schedule(static)
+    for (std::size_t i = 0; i < n; ++i) {
+        Particle& a = ps[i];
         // Symplectic Euler, the seed preset's grouping: v + DT * (f / rho).
         a.vx = a.vx + DT * (a.fx / a.rho);
         a.vy = a.vy + DT * (a.fy / a.rho);
