@@ -39,6 +39,7 @@ mod docs_links;
 mod imports;
 mod layers;
 mod physics_step;
+mod plain_loop;
 mod run_hooks;
 mod solver_runs;
 mod strategies_match_seq;
