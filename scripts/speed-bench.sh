@@ -25,7 +25,13 @@
 # N = 10^6, the peak resident memory per particle; for the paired runs the efficiency of each
 # run (min, median, max) and of its median step. It checks that the plain loop ends in the
 # same state as `bench-sph simulate --strategy seq` (all-pairs): same checksum.
-# Without a C++ compiler the plain loop and the ratio columns are skipped.
+# The paper's workload across cores: the plain loop's OpenMP build (-fopenmp; each pass's loop
+# `omp parallel for schedule(static)`) on 1 .. hardware threads, its speedup (1-thread median
+# over T-thread median), beside bench-sph's paired speedups (`bench-sph speedup`,
+# REF_PAIRED_STRATEGIES) at each T >= 2, all-pairs, N = 1000; the OpenMP runs must end in the
+# plain loop's state.
+# Without a C++ compiler the plain loop and the ratio columns are skipped; without OpenMP, the
+# OpenMP anchor.
 # Run it on an otherwise quiet machine: it warns when the 1-minute load exceeds half the
 # hardware threads. Needs bash, cargo, awk, sort; no jq.
 set -euo pipefail
@@ -48,6 +54,10 @@ LARGE_STRATEGIES=("seq - -" "rayon-chunks 2 10" "crossbeam-pool 2 10" "crossbeam
 PAIRED_STRATEGIES=("crossbeam-pool 2 10" "crossbeam-pool 2 50" "rayon-chunks 2 10" "rayon-chunks 2 50")
 PAIRED_N=1000000
 PAIRED_STEPS=10
+# The paper's workload across cores (all-pairs, REF_N, REF_STEPS): bench-sph's strategies paired
+# with seq at each core count from 2 to the hardware threads, "STRATEGY CHUNKS", beside the
+# plain loop's OpenMP build.
+REF_PAIRED_STRATEGIES=("crossbeam-pool 4" "rayon-chunks 10")
 # The N whose peak RSS per particle is reported.
 RSS_N=1000000
 # --quick replaces the step counts.
@@ -204,11 +214,18 @@ cargo build --release >&2
 [[ -x "$BIN" ]] || die "no bench-sph binary at $BIN after the build"
 
 PLAIN=""
+OMP=""
 if command -v -- "$CXX" >/dev/null 2>&1; then
     echo "compiling benches/plain-loop/mueller.cpp with $CXX -O2 -ffp-contract=off ..." >&2
     "$CXX" -O2 -ffp-contract=off -std=c++17 -o "$WORK/mueller" benches/plain-loop/mueller.cpp
     PLAIN="$WORK/mueller"
     PLAIN_CXX="$("$CXX" --version 2>/dev/null | head -n 1)"
+    if "$CXX" -O2 -ffp-contract=off -std=c++17 -fopenmp -o "$WORK/mueller-omp" \
+        benches/plain-loop/mueller.cpp 2>/dev/null; then
+        OMP="$WORK/mueller-omp"
+    else
+        echo "'$CXX' cannot build with -fopenmp: skipping the OpenMP anchor" >&2
+    fi
 else
     echo "no C++ compiler ('$CXX' not found): skipping the plain loop and the ratio columns" >&2
 fi
@@ -311,7 +328,8 @@ simd_flag() {
     if [[ -n "$1" ]]; then printf '%s\n' --simd "$1"; fi
 }
 
-echo "runs: $RUNS, interleaved; rows per run: plain loop, reference, large N" >&2
+echo "runs: $RUNS, interleaved; rows per run: plain loop, reference, large N, paired, the" \
+    "paper's workload across cores" >&2
 for ((run = 1; run <= RUNS; run++)); do
     if [[ -n "$PLAIN" ]]; then
         run_one plain "$PLAIN" "$REF_N" "$REF_STEPS"
@@ -345,6 +363,19 @@ for ((run = 1; run <= RUNS; run++)); do
         run_paired "paired:$PAIRED_N:$PAIRED_STEPS:$strategy:$cores:$chunks" "$BIN" speedup \
             --json --strategy "$strategy" --cores "$cores" --chunks "$chunks" --neighbors grid \
             --n "$PAIRED_N" --steps "$PAIRED_STEPS"
+    done
+    for ((t = 1; t <= THREADS; t++)); do
+        if [[ -n "$OMP" ]]; then
+            run_one "omp:$t" env OMP_NUM_THREADS="$t" "$OMP" "$REF_N" "$REF_STEPS"
+        fi
+        if ((t >= 2)); then
+            for strat in "${REF_PAIRED_STRATEGIES[@]}"; do
+                read -r strategy chunks <<<"$strat"
+                run_paired "refpaired:$strategy:$t:$chunks" "$BIN" speedup --json \
+                    --strategy "$strategy" --cores "$t" --chunks "$chunks" \
+                    --neighbors all-pairs --n "$REF_N" --steps "$REF_STEPS"
+            done
+        fi
     done
 done
 
@@ -498,6 +529,41 @@ for simd in "${SIMDS[@]}"; do
     fi
 done
 
+say ""
+say "The paper's workload across cores: all-pairs, N = $REF_N, $REF_STEPS steps; speedup min/med/max"
+say "(OpenMP: 1-thread median over each T-thread run; bench-sph: \`speedup\`, paired with seq)"
+header=("OpenMP plain loop")
+for strat in "${REF_PAIRED_STRATEGIES[@]}"; do
+    read -r strategy chunks <<<"$strat"
+    header+=("$strategy chunks=$chunks")
+done
+line="$(printf '%-6s' cores)"
+for h in "${header[@]}"; do line+="$(printf ' %26s' "$h")"; done
+say "$line"
+omp1=""
+if [[ -n "$OMP" ]]; then read -r _ omp1 _ <<<"$(stats omp:1)"; fi
+for ((t = 1; t <= THREADS; t++)); do
+    line="$(printf '%-6s' "$t")"
+    cell="-"
+    if [[ -n "$OMP" ]]; then
+        read -r lo med hi <<<"$(stats "omp:$t")"
+        cell="$(awk -v b="$omp1" -v lo="$lo" -v m="$med" -v hi="$hi" \
+            'BEGIN { printf "%.2f/%.2f/%.2f", b / hi, b / m, b / lo }')"
+    fi
+    line+="$(printf ' %26s' "$cell")"
+    for strat in "${REF_PAIRED_STRATEGIES[@]}"; do
+        read -r strategy chunks <<<"$strat"
+        cell="-"
+        if ((t >= 2)); then
+            read -r lo med hi <<<"$(stats "refpaired:$strategy:$t:$chunks")"
+            cell="$(awk -v t="$t" -v lo="$lo" -v m="$med" -v hi="$hi" \
+                'BEGIN { printf "%.2f/%.2f/%.2f", t * lo, t * m, t * hi }')"
+        fi
+        line+="$(printf ' %26s' "$cell")"
+    done
+    say "$line"
+done
+
 # ---- Checks -------------------------------------------------------------------------------
 say ""
 SAME_ALL=yes
@@ -512,6 +578,16 @@ if [[ -n "$PLAIN" ]]; then
     done
 else
     say "plain loop computes the same state: not checked (no C++ compiler)"
+fi
+if [[ -n "$OMP" ]]; then
+    omp_same=yes
+    for ((t = 1; t <= THREADS; t++)); do
+        if [[ "$(checksums "omp:$t")" != "$(checksums plain)" ]]; then
+            omp_same=no
+            SAME_ALL=no
+        fi
+    done
+    say "the OpenMP build computes the plain loop's state on 1 .. $THREADS threads: $omp_same"
 fi
 # Strategies must agree with seq bit for bit at every size.
 AGREE=yes
