@@ -219,7 +219,9 @@ fn cells(s: &Said) -> [String; 4] {
             )
         }
         Verdict::Only(w) => (w, cell(&w.1), "the only strategy measured".to_owned()),
-        Verdict::Unknown(w, why) => (w, cell(&w.1), format!("no order: {}", why.phrase())),
+        Verdict::Unknown { lowest: w, why, .. } => {
+            (w, cell(&w.1), format!("no order: {}", why.phrase()))
+        }
     };
     let flag = if at.oversubscribed {
         " ⚠ oversubscribed"

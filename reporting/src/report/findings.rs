@@ -445,7 +445,7 @@ impl AtCores {
                 };
                 format!("{where_}, only {} {only}{left_out}.", describe(w))
             }
-            Verdict::Unknown(w, why) => format!(
+            Verdict::Unknown { lowest: w, why, .. } => format!(
                 "{where_}, the lowest mean is {}, but {}, so no strategy can be called \
                  fastest{left_out}.",
                 describe(w),

@@ -70,8 +70,15 @@ pub fn calm(b: &Best) -> bool {
 pub enum Verdict {
     /// Only one cell.
     Only(Entry),
-    /// Some cell cannot be ordered against the lowest mean: that one, and why.
-    Unknown(Entry, Unknown),
+    /// Some cell cannot be ordered against the lowest mean.
+    Unknown {
+        /// The lowest mean.
+        lowest: Entry,
+        /// The first cell (by mean) it cannot be ordered against.
+        against: Entry,
+        /// Why.
+        why: Unknown,
+    },
     /// The lowest mean is faster than every other cell, each by its paired rounds.
     Fastest {
         /// The fastest.
@@ -100,7 +107,13 @@ pub fn verdict(trusted: &[Entry]) -> Option<Verdict> {
     let mut by = None;
     for other in &trusted[1..] {
         match order(&first.1, &other.1) {
-            Order::Unknown(why) => return Some(Verdict::Unknown(first, why)),
+            Order::Unknown(why) => {
+                return Some(Verdict::Unknown {
+                    lowest: first,
+                    against: other.clone(),
+                    why,
+                });
+            }
             Order::AFaster(r) => {
                 by.get_or_insert(r);
             }
@@ -145,7 +158,11 @@ pub fn verdict_phrase(v: Option<&Verdict>) -> String {
     match v {
         None => "no cell was measured without contention".to_owned(),
         Some(Verdict::Only((s, _))) => format!("only {s} was measured"),
-        Some(Verdict::Unknown((s, _), why)) => format!(
+        Some(Verdict::Unknown {
+            lowest: (s, _),
+            why,
+            ..
+        }) => format!(
             "the lowest mean is {s}'s, but {}, so no strategy can be called fastest",
             why.phrase()
         ),

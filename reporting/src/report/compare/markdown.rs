@@ -21,7 +21,7 @@ use crate::report::markdown::{banners, best_cells, best_columns, chart, method, 
 use crate::report::numbers::faster;
 use crate::report::series::Group;
 use crate::report::table::{Column, Table};
-use crate::report::verdict::{self, Entry, Order, Verdict, and_list, describe};
+use crate::report::verdict::{Entry, Verdict, and_list, describe};
 use sph_harness::results::key::LabelStyle;
 use sph_harness::results::rows::{Status, SummaryRow};
 
@@ -252,19 +252,15 @@ fn ranking(b: &MachineBest) -> String {
         None if b.entries.is_empty() => "no usable parallel cell".to_owned(),
         None => "**not resolved**: every strategy's best cell was contended".to_owned(),
         Some(Verdict::Only(_)) => "only one strategy measured".to_owned(),
-        Some(Verdict::Unknown(first, why)) => {
-            // The first cell the lowest mean could not be ordered against: where the verdict
-            // stopped, not necessarily the next lowest mean.
-            let unordered =
-                b.trusted.iter().enumerate().skip(1).find(|(_, other)| {
-                    matches!(verdict::order(&first.1, &other.1), Order::Unknown(_))
-                });
-            let against = match unordered {
-                Some((1, other)) => format!("the next lowest mean, {}", describe(other)),
-                Some((_, other)) => describe(other),
-                None => "the next lowest mean".to_owned(),
-            };
-            format!("**not resolved**: against {against}, {}", why.phrase())
+        // The cell the verdict stopped at, not necessarily the next lowest mean.
+        Some(Verdict::Unknown { against, why, .. }) => {
+            let next = b.trusted.get(1).is_some_and(|n| n.0 == against.0);
+            let which = if next { "the next lowest mean, " } else { "" };
+            format!(
+                "**not resolved**: against {which}{}, {}",
+                describe(against),
+                why.phrase()
+            )
         }
         Some(Verdict::Fastest { runner_up, by, .. }) => format!(
             "resolved: {} by the paired rounds",

@@ -531,7 +531,10 @@ mod tests {
         let b = MachineBest::of(0, &with_trials(rows, trials));
         assert!(matches!(
             &b.verdict,
-            Some(Verdict::Unknown(_, Unknown::Rounds(2)))
+            Some(Verdict::Unknown {
+                why: Unknown::Rounds(2),
+                ..
+            })
         ));
         let (mut rows, trials) = paired(&[2.0, 2.2, 1.8], &[2.4, 2.64, 2.16]);
         for r in &mut rows {
