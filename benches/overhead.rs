@@ -1,31 +1,23 @@
 //! Criterion bench: what each strategy costs per pass, apart from the work. Every strategy in
-//! the registry, at each core count from 1 to the machine's hardware threads, runs passes over
-//! a tiny output (16 `u64`s a core) cut into one chunk per core (`--chunks` = cores, the
-//! least a chunked strategy can be given), in two kinds:
-//! - `empty-pass`: the kernel only writes each element's index. This is the cheapest a pass
-//!   can be, but not what a pass costs in a run: with nothing to do, the thread that forks
-//!   may finish every chunk before another thread takes one (rayon's work-first stealing
-//!   does exactly that), so no work crosses threads.
-//! - `busy-5us`: each element also keeps its thread busy for 5 µs / 16 (a clock loop), so a
-//!   pass is 5 µs of work per core however a strategy cuts it, and every thread must take its
-//!   share for the pass to end in 5 µs. A pass's time over 5 µs is the strategy's cost of
-//!   forking, handing out and joining real work at that core count (with its kernel calls:
-//!   `rayon-spawn` makes one per element, each reading the clock), and a strategy that leaves
-//!   a core idle shows it as up to 5 µs more.
+//! the registry, at each core count from 1 to the machine's hardware threads, runs the passes
+//! of `bench_sph::run::pass_cost` (one chunk a thread, each thread's chunk busy for the pass's
+//! work a thread) in two kinds:
+//! - `empty-pass`: no work. The cheapest a pass can be, but not what a pass costs in a run:
+//!   with nothing to do, the thread that forks may finish every chunk before another thread
+//!   takes one (rayon's work-first stealing does exactly that), so no work crosses threads.
+//! - `busy-5us`: 5 µs of work a thread, so every thread must take its share for the pass to
+//!   end in 5 µs: what it takes beyond is the strategy's cost of forking, handing out and
+//!   joining real work at that core count.
 //!
 //! The strategy's threads start before the timing, as in a run. Run with `cargo bench --bench
-//! overhead`; criterion prints each time per pass with its interval. A pass of the paper's
-//! workload (all-pairs, N = 1000) is tens of µs of work on one core: set the two side by side
-//! to see where a strategy's speedup must bend.
+//! overhead`; `bench-sph overhead` measures the same passes with intervals over rounds that
+//! take turns across strategies.
 
-use std::hint::black_box;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
+use bench_sph::run::pass_cost::{busy_passes, pass_of};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use sph_strategies::{Config, Executor, Session, StrategyName};
-
-/// Elements of the output per core: two cache lines each.
-const PER_CORE: usize = 16;
+use sph_strategies::{Executor, Session, StrategyName};
 
 /// `iters` passes over `out`, each element busy for `busy`, timed inside the strategy's
 /// session.
@@ -39,30 +31,15 @@ impl Session for Passes<'_> {
     type Output = Duration;
 
     fn run<E: Executor>(self, exec: &E) -> Duration {
-        let Passes { out, iters, busy } = self;
-        let begin = Instant::now();
-        for _ in 0..iters {
-            exec.for_each_chunk(&mut *out, |first, chunk: &mut [u64]| {
-                let start = Instant::now();
-                let until = busy * chunk.len() as u32;
-                while start.elapsed() < until {}
-                for (k, x) in chunk.iter_mut().enumerate() {
-                    *x = (first + k) as u64;
-                }
-            })
-            .expect("a pass of the benchmark runs");
-        }
-        let elapsed = begin.elapsed();
-        black_box(out);
-        elapsed
+        busy_passes(exec, self.out, self.iters, self.busy).expect("a pass of the benchmark runs")
     }
 }
 
 fn passes(c: &mut Criterion) {
     let all = std::thread::available_parallelism().map_or(1, |n| n.get());
-    for (kind, busy) in [
+    for (kind, work) in [
         ("empty-pass", Duration::ZERO),
-        ("busy-5us", Duration::from_micros(5) / PER_CORE as u32),
+        ("busy-5us", Duration::from_micros(5)),
     ] {
         let mut group = c.benchmark_group(format!("overhead/{kind}"));
         group
@@ -75,8 +52,8 @@ fn passes(c: &mut Criterion) {
                 if strategy.info().effective_cores(cores) < cores {
                     continue;
                 }
-                let config = Config::new(cores, cores);
-                let mut out = vec![0u64; PER_CORE * cores];
+                let config = sph_strategies::Config::new(cores, cores);
+                let (mut out, busy) = pass_of(cores, work);
                 let id = BenchmarkId::new(strategy.as_str(), format!("{cores}-cores"));
                 group.bench_function(id, |b| {
                     b.iter_custom(|iters| {

@@ -4,6 +4,7 @@
 
 mod list;
 mod merge;
+mod overhead;
 mod parallel;
 mod render;
 mod report;
@@ -23,6 +24,7 @@ use clap::{Parser, Subcommand};
 use crate::limits;
 
 pub use merge::MergeArgs;
+pub use overhead::OverheadArgs;
 pub use render::RenderArgs;
 pub use report::ReportArgs;
 pub use simulate::SimulateArgs;
@@ -61,12 +63,28 @@ pub enum Command {
         after_help = "The two copies run the same steps from the same state, taking turns step by step \
         (which goes first alternating), so that a machine whose speed drifts slows both alike; both \
         must end with the same checksum. Each step is timed as simulate times its steps; the \
-        strategy's threads are woken first, and sleep while seq steps.\n\n\
+        strategy's threads are woken first and, since they fall asleep while seq steps, roused \
+        (untimed) before each of its steps, as they would be awake in a run of their own.\n\n\
         Examples:\n  \
         bench-sph speedup --strategy crossbeam-pool --cores 2 --neighbors grid --n 1000000 --steps 10\n  \
         bench-sph speedup --strategy rayon-chunks --cores 2 --chunks 45 --steps 1000 --json"
     )]
     Speedup(SpeedupArgs),
+    /// What a pass costs each strategy apart from its work, at each core count, with its
+    /// interval.
+    #[command(
+        after_help = "Each pass has --work-us of work a thread (a clock loop), cut into one chunk a \
+        thread; a pass ends in that time only if every thread takes its share at once, and what it \
+        takes beyond is the strategy's own cost of forking, handing out and joining the pass. A \
+        pass of the paper's workload (all-pairs, N = 1000) is about 30-100 µs of work on one core: \
+        set the two side by side to see where a strategy's speedup bends. Each cell starts its \
+        threads and wakes them before each round, as a run does; the cells take turns round by \
+        round.\n\n\
+        Examples:\n  \
+        bench-sph overhead                                # every strategy, 1..the hardware threads\n  \
+        bench-sph overhead --strategies team,rayon-chunks --cores 2 --work-us 0 --json"
+    )]
+    Overhead(OverheadArgs),
     /// List the parallel strategies, one per line: name, then what it does.
     List,
     /// Animate the dam break: an animated GIF (or PNG frames), one frame every K steps.
@@ -175,6 +193,7 @@ pub fn run() -> anyhow::Result<()> {
     match command {
         Command::Simulate(args) => simulate::run(&args),
         Command::Speedup(args) => speedup::run(&args),
+        Command::Overhead(args) => overhead::run(&args),
         Command::List => list::run(&mut std::io::stdout().lock()),
         Command::Render(args) => render::run(&args),
         Command::Sweep(args) => sweep::run(&args),

@@ -15,18 +15,23 @@
 //!
 //! Strategies are chosen by name through the [registry](StrategyName); adding one is one new
 //! file plus one registry line. They are [`seq`], [`rayon_iter`], [`rayon_spawn`],
-//! [`rayon_chunks`], [`crossbeam_pool`] and [`std_static`]; each module's documentation says
-//! how it schedules a pass and what that costs. The rayon strategies own a pool of exactly
-//! `cores` threads built in [`Strategy::build`]; `crossbeam-pool` starts its `cores` threads
-//! once per run; `std-static` starts threads on every pass.
+//! [`rayon_chunks`], [`crossbeam_pool`], [`std_static`], [`team`], [`chili_join`] and
+//! [`paralight_pool`]; each module's documentation says how it schedules a pass and what that
+//! costs. The rayon strategies and `paralight` own a pool of exactly `cores` threads built in
+//! [`Strategy::build`], `chili` one of `cores − 1` threads that the calling thread joins;
+//! `crossbeam-pool` and `team` start their `cores` threads once per run; `std-static` starts
+//! threads on every pass.
 //!
 //! All of this is safe Rust except one small private module, `erased_job`, which lets
-//! `crossbeam-pool`'s long-lived threads call a kernel borrowed for one pass (its safe API
-//! returns only once every worker is done with the kernel; see the `// SAFETY:` notes there).
+//! `crossbeam-pool`'s and `team`'s long-lived threads call a kernel borrowed for one pass (its
+//! safe API returns only once every worker is done with the kernel; see the `// SAFETY:` notes
+//! there).
 
+pub mod chili_join;
 pub mod crossbeam_pool;
 mod erased_job;
 mod panic;
+pub mod paralight_pool;
 pub mod placement;
 pub mod rayon_chunks;
 pub mod rayon_iter;
@@ -37,6 +42,7 @@ pub mod seq;
 mod spin_wait;
 mod split;
 pub mod std_static;
+pub mod team;
 #[cfg(test)]
 mod testing;
 mod thread_start;
@@ -46,7 +52,7 @@ pub use panic::KernelPanic;
 pub use placement::Placement;
 pub use registry::{StrategyName, UnknownStrategy, run};
 pub use split::{Split, balanced_chunks};
-pub use wake::{Woken, wake};
+pub use wake::{Woken, rouse, wake};
 
 /// How many threads and chunks a strategy should use.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -6,7 +6,12 @@
 //! it starts, with the worker's 0-based index, before the worker does anything else. Worker i
 //! of a run is:
 //! - for the rayon strategies, pool thread i (called once, when the pool starts it);
-//! - for `crossbeam-pool`, thread i of the run (0 runs the session);
+//! - for `crossbeam-pool` and `team`, thread i of the run (0 runs the session);
+//! - for `chili`, worker 0 is the thread that runs the session (it computes too), and the
+//!   pool's threads are workers 1, 2, ... in the order they first take a chunk in the run,
+//!   each placed just before that chunk (chili has no thread-start hook);
+//! - for `paralight`, the pool thread that took item i of a placement pass run when the
+//!   pool is built (each item waits until all have started, so each thread takes one);
 //! - for `std-static`, the thread of block i of a pass (called on every pass, since each pass
 //!   starts its threads: the hook's cost is then part of the strategy's cost per pass);
 //! - `seq` starts no thread: it runs on the caller, which the caller places itself.

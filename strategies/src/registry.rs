@@ -58,6 +58,9 @@ registry! {
     RayonChunks => rayon_chunks::RayonChunks,
     CrossbeamPool => crossbeam_pool::CrossbeamPool,
     StdStatic => std_static::StdStatic,
+    Team => team::Team,
+    Chili => chili_join::ChiliJoin,
+    Paralight => paralight_pool::ParalightPool,
 }
 
 impl StrategyName {

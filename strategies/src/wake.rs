@@ -14,10 +14,10 @@
 //! stays slow: the run then goes on and says so as it would without the wake). On a quiet
 //! machine it costs about [`SETTLED`]. It computes nothing the run reads.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
-use crate::{Executor, KernelPanic};
+use crate::{Config, Executor, Info, KernelPanic};
 
 /// How long each kernel call of a waking pass spins.
 pub const SPIN: Duration = Duration::from_micros(500);
@@ -28,6 +28,41 @@ pub const SLACK: Duration = Duration::from_micros(200);
 pub const SETTLED: Duration = Duration::from_millis(10);
 /// The longest a wake lasts.
 pub const LONGEST: Duration = Duration::from_millis(150);
+
+/// The longest a kernel call of [`rouse`]'s pass waits for the others.
+pub const ROUSE_LONGEST: Duration = Duration::from_millis(1);
+
+/// Brings a strategy's sleeping threads back before a pass that is about to be timed: one
+/// pass over one element per thread of `exec`, whose kernel calls each wait, spinning, until
+/// all the pass's calls have begun, or for at most [`ROUSE_LONGEST`]. The calls are as many
+/// as `info` promises for `config` ([`Info::kernel_calls`]; one per element for a strategy
+/// that promises no number), so every thread that takes a call stays in the pass until the
+/// last one has come, and they leave it together, awake.
+///
+/// Returns whether every call came in time. A thread that slept through [`ROUSE_LONGEST`]
+/// is still waking when the timed pass starts, as without the rouse. Computes nothing the
+/// run reads; nothing to do for an executor of one thread.
+pub fn rouse<E: Executor>(exec: &E, info: &Info, config: &Config) -> Result<bool, KernelPanic> {
+    let len = exec.threads();
+    let calls = info.kernel_calls(len, config).unwrap_or(len);
+    if len < 2 || calls < 2 {
+        return Ok(true);
+    }
+    let (arrived, late) = (AtomicUsize::new(0), AtomicBool::new(false));
+    let mut cells = vec![0u8; len];
+    exec.for_each_chunk(&mut cells[..], |_, _| {
+        arrived.fetch_add(1, Ordering::AcqRel);
+        let start = Instant::now();
+        while arrived.load(Ordering::Acquire) < calls {
+            if start.elapsed() > ROUSE_LONGEST {
+                late.store(true, Ordering::Relaxed);
+                break;
+            }
+            std::hint::spin_loop();
+        }
+    })?;
+    Ok(!late.into_inner())
+}
 
 /// What a wake found.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -168,6 +203,47 @@ mod tests {
         // std-static: a call per thread, 0.5 ms; one core takes 1 ms.
         assert!(on_all_cores(MS * 9 / 10, 2, 2, times));
         assert!(!on_all_cores(MS, 2, 2, times));
+    }
+
+    #[test]
+    fn a_rouse_keeps_each_call_until_all_have_come_and_gives_up_on_a_thread_that_never_does() {
+        let config = crate::Config::new(2, 8);
+        let info = <crate::crossbeam_pool::CrossbeamPool as crate::Strategy>::INFO;
+        assert!(rouse(&SeqExecutor, &info, &config).unwrap(), "one thread");
+        // Both calls on the caller, one after the other: the first waits out its limit.
+        let start = Instant::now();
+        assert!(!rouse(&Serial, &info, &config).unwrap());
+        assert!(start.elapsed() >= ROUSE_LONGEST);
+        // A real pool: both threads come (a loaded machine may need more than one try).
+        struct Rousing(crate::Config);
+        impl crate::Session for Rousing {
+            type Output = bool;
+            fn run<E: Executor>(self, exec: &E) -> bool {
+                let info = <crate::crossbeam_pool::CrossbeamPool as crate::Strategy>::INFO;
+                (0..100).any(|_| rouse(exec, &info, &self.0).unwrap())
+            }
+        }
+        let pool = <crate::crossbeam_pool::CrossbeamPool as crate::Strategy>::build(&config);
+        assert!(crate::Strategy::run(&pool.unwrap(), Rousing(config)).unwrap());
+    }
+
+    /// Claims two threads and runs every call on the caller, one after the other.
+    struct Serial;
+
+    impl Executor for Serial {
+        fn for_each_chunk<O, F>(&self, out: O, kernel: F) -> Result<(), KernelPanic>
+        where
+            O: crate::Split,
+            F: Fn(usize, O) + Sync,
+        {
+            for (first, chunk) in crate::balanced_chunks(out, 8) {
+                kernel(first, chunk);
+            }
+            Ok(())
+        }
+        fn threads(&self) -> usize {
+            2
+        }
     }
 
     #[test]

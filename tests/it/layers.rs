@@ -62,7 +62,7 @@ fn the_strategies_crate_depends_on_threads_only() {
     let extra = beyond(
         &deps,
         "sph-strategies",
-        &["rayon", "crossbeam", "thiserror"],
+        &["rayon", "crossbeam", "chili", "paralight", "thiserror"],
     );
     assert!(extra.is_empty(), "sph-strategies depends on {extra:?}");
 }

@@ -10,6 +10,7 @@
 #[cfg(feature = "testing")]
 pub mod fault;
 pub mod paired;
+pub mod pass_cost;
 
 use std::ops::ControlFlow;
 

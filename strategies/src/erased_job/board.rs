@@ -1,63 +1,14 @@
-//! The one place in the workspace with `unsafe`: handing a job borrowed for one pass to
-//! long-lived worker threads.
-//!
-//! Safe Rust cannot give a thread that outlives a borrow a reference to the borrowed data,
-//! even when we know the thread stops using it before the borrow ends. A [`JobBoard`] does
-//! exactly that and nothing else: [`JobBoard::run`] publishes a `&(dyn Fn() + Sync)` with its
-//! lifetime erased, every serving thread that joins the pass while it is open calls it once,
-//! the pass is closed to newcomers when the dispatcher's own call returns, and `run` returns
-//! only after every thread that joined has said it is done with the job.
-//!
-//! The soundness argument lives entirely in this file, behind a safe API: no caller can make
-//! the board call a job after `run` has returned, whatever the job does (a job that panics is
-//! caught on the worker, which still signals completion and keeps serving) and whatever the
-//! callers do (concurrent `run`s are serialised; a shut-down board refuses new jobs; any
-//! number of threads may serve, each one that joins is counted). The worst a misuse can cause
-//! is a hang — e.g. a job that waits for a worker that never comes — never a dangling
-//! reference.
-
-#![allow(unsafe_code)]
+//! [`JobBoard`]: a job borrowed for one pass, run by whichever serving threads join the pass
+//! while it is open (`crossbeam-pool`'s board).
 
 use std::mem;
-use std::ptr::NonNull;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
 
 use crossbeam::utils::CachePadded;
 
+use super::{AbortOnUnwind, ErasedJob};
 use crate::{KernelPanic, panic, spin_wait};
-
-/// A `&(dyn Fn() + Sync)` whose lifetime has been erased. Only [`JobBoard`] creates and calls
-/// one, and only while the borrow it came from is alive (see [`JobBoard::run`]).
-#[derive(Clone, Copy)]
-struct ErasedJob(NonNull<dyn Fn() + Sync + 'static>);
-
-// SAFETY: an `ErasedJob` is a shared reference to a `Sync` closure, and `&T` is `Send` when
-// `T: Sync`. The lifetime it lost is upheld by `JobBoard`'s protocol, not by the type.
-unsafe impl Send for ErasedJob {}
-
-impl ErasedJob {
-    /// Erases the lifetime of `job`.
-    fn new<'a>(job: &'a (dyn Fn() + Sync + 'a)) -> Self {
-        let ptr: NonNull<dyn Fn() + Sync + 'a> = NonNull::from(job);
-        // SAFETY: both types are the same fat pointer and differ only in the trait object's
-        // lifetime bound, so the layout is identical. Creating the pointer is harmless; it is
-        // dereferenced only in `call`, whose contract keeps it within `'a`.
-        let ptr: NonNull<dyn Fn() + Sync + 'static> = unsafe { mem::transmute(ptr) };
-        ErasedJob(ptr)
-    }
-
-    /// Calls the job.
-    ///
-    /// # Safety
-    /// The borrow that `self` was created from must still be alive.
-    unsafe fn call(self) {
-        // SAFETY: the pointer came from a valid shared reference (`new`) and, by this
-        // function's contract, that reference's borrow has not ended yet.
-        let job = unsafe { self.0.as_ref() };
-        job();
-    }
-}
 
 /// What the dispatcher and the workers share, behind one mutex.
 struct State {
@@ -160,7 +111,9 @@ impl JobBoard {
         // window (even one from a clock read while waiting) into an abort.
         let guard = AbortOnUnwind;
         state.in_flight = true;
-        state.job = Some(ErasedJob::new(job));
+        // The board's jobs take no index: every thread that joins runs the same call.
+        let indexed = |_: usize| job();
+        state.job = Some(ErasedJob::new(&indexed));
         state.epoch += 1;
         state.escaped = None;
         self.epoch_hint.store(state.epoch, Ordering::Release);
@@ -169,7 +122,8 @@ impl JobBoard {
         if wake_workers {
             self.to_workers.notify_all();
         }
-        // The dispatcher's own share: a plain call through the live borrow. Its panic is
+        // The dispatcher's own share: a plain call through the live borrow. (`indexed`, which
+        // the workers call, lives until `run` returns, after the wait below.) Its panic is
         // caught; an unwind that still escapes aborts (the guard above), so that the wait
         // below can never be skipped.
         let own = panic::catch(job);
@@ -244,7 +198,7 @@ impl JobBoard {
             // unwinding job from skipping the count-out below, and the guard aborts should an
             // unwind escape `catch` all the same.
             let guard = AbortOnUnwind;
-            let outcome = panic::catch(|| unsafe { job.call() });
+            let outcome = panic::catch(|| unsafe { job.call(0) });
 
             // From here on `job` is never called again; the next iteration overwrites it.
             let mut state = self.lock();
@@ -297,17 +251,6 @@ impl JobBoard {
 
     fn wait<'g>(&self, cv: &Condvar, guard: MutexGuard<'g, State>) -> MutexGuard<'g, State> {
         cv.wait(guard).unwrap_or_else(PoisonError::into_inner)
-    }
-}
-
-/// Aborts the process when dropped. Armed around the calls of a job and disarmed with
-/// `mem::forget` after them, so only an unwind that escaped `panic::catch` reaches it: going
-/// on would skip the bookkeeping that keeps an erased job from outliving its borrow.
-struct AbortOnUnwind;
-
-impl Drop for AbortOnUnwind {
-    fn drop(&mut self) {
-        std::process::abort();
     }
 }
 

@@ -1,0 +1,76 @@
+//! The one place in the workspace with `unsafe`: handing a job borrowed for one pass to
+//! long-lived worker threads.
+//!
+//! Safe Rust cannot give a thread that outlives a borrow a reference to the borrowed data,
+//! even when we know the thread stops using it before the borrow ends. Two boards do exactly
+//! that and nothing else. Each publishes a `&(dyn Fn(usize) + Sync)` with its lifetime erased
+//! ([`ErasedJob`]); every serving thread that joins the pass while it is open calls it once
+//! (with its own index); the pass is closed to newcomers when the dispatcher's own call
+//! returns; and the dispatcher's `run` returns only after every thread that joined has said it
+//! is done with the job:
+//! - [`JobBoard`] (`crossbeam-pool`) keeps its books under one mutex;
+//! - [`TeamBoard`] (`team`) keeps them in one atomic word, so that a pass costs the
+//!   dispatcher one store and one read-modify-write and each worker two, and takes a lock
+//!   only to sleep or to wake a sleeper.
+//!
+//! The soundness argument lives entirely in this module, behind a safe API: no caller can make
+//! a board call a job after `run` has returned, whatever the job does (a job that panics is
+//! caught on the worker, which still signals completion and keeps serving) and whatever the
+//! callers do (concurrent `run`s are serialised or refused; a shut-down board refuses new
+//! jobs; any number of threads may serve, each one that joins is counted). The worst a misuse
+//! can cause is a hang — e.g. a job that waits for a worker that never comes — never a
+//! dangling reference.
+
+#![allow(unsafe_code)]
+
+mod board;
+mod team;
+
+pub(crate) use board::JobBoard;
+pub(crate) use team::TeamBoard;
+
+use std::mem;
+use std::ptr::NonNull;
+
+/// A `&(dyn Fn(usize) + Sync)` whose lifetime has been erased. Only the boards create and
+/// call one, and only while the borrow it came from is alive (see their `run`).
+#[derive(Clone, Copy)]
+struct ErasedJob(NonNull<dyn Fn(usize) + Sync + 'static>);
+
+// SAFETY: an `ErasedJob` is a shared reference to a `Sync` closure, and `&T` is `Send` when
+// `T: Sync`. The lifetime it lost is upheld by the boards' protocols, not by the type.
+unsafe impl Send for ErasedJob {}
+
+impl ErasedJob {
+    /// Erases the lifetime of `job`.
+    fn new<'a>(job: &'a (dyn Fn(usize) + Sync + 'a)) -> Self {
+        let ptr: NonNull<dyn Fn(usize) + Sync + 'a> = NonNull::from(job);
+        // SAFETY: both types are the same fat pointer and differ only in the trait object's
+        // lifetime bound, so the layout is identical. Creating the pointer is harmless; it is
+        // dereferenced only in `call`, whose contract keeps it within `'a`.
+        let ptr: NonNull<dyn Fn(usize) + Sync + 'static> = unsafe { mem::transmute(ptr) };
+        ErasedJob(ptr)
+    }
+
+    /// Calls the job as thread `index`.
+    ///
+    /// # Safety
+    /// The borrow that `self` was created from must still be alive.
+    unsafe fn call(self, index: usize) {
+        // SAFETY: the pointer came from a valid shared reference (`new`) and, by this
+        // function's contract, that reference's borrow has not ended yet.
+        let job = unsafe { self.0.as_ref() };
+        job(index);
+    }
+}
+
+/// Aborts the process when dropped. Armed around the calls of a job and disarmed with
+/// `mem::forget` after them, so only an unwind that escaped `panic::catch` reaches it: going
+/// on would skip the bookkeeping that keeps an erased job from outliving its borrow.
+struct AbortOnUnwind;
+
+impl Drop for AbortOnUnwind {
+    fn drop(&mut self) {
+        std::process::abort();
+    }
+}
