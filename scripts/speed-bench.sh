@@ -57,7 +57,7 @@ PAIRED_STEPS=10
 # The paper's workload across cores (all-pairs, REF_N, REF_STEPS): bench-sph's strategies paired
 # with seq at each core count from 2 to the hardware threads, "STRATEGY CHUNKS", beside the
 # plain loop's OpenMP build.
-REF_PAIRED_STRATEGIES=("team 2" "crossbeam-pool 4" "rayon-chunks 10")
+REF_PAIRED_STRATEGIES=("team 8" "crossbeam-pool 4" "rayon-chunks 10")
 # The N whose peak RSS per particle is reported.
 RSS_N=1000000
 # --quick replaces the step counts.

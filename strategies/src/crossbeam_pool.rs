@@ -11,9 +11,8 @@
 //! chunks.
 //!
 //! **What crossbeam does here, and what it does not.** Crossbeam provides the threads
-//! (`crossbeam::scope`), the chunk queue, the first, busy part of every wait (`Backoff`, see
-//! `spin_wait`) and the cache-line padding of the two atomics that waiting threads watch
-//! (`CachePadded`, in `erased_job`). The job board itself — publish a job, let the workers
+//! (`crossbeam::scope`), the chunk queue and the cache-line padding of the two atomics that
+//! waiting threads watch (`CachePadded`, in `erased_job`). The job board itself — publish a job, let the workers
 //! that show up join it, close the pass when no chunk is left and wait only for the workers
 //! already inside it, sleep after a short watch — is a mutex and two condition variables in
 //! `erased_job`, not a channel: a channel delivers each message to one receiver, while every

@@ -5,39 +5,45 @@
 //! microseconds (more on a virtual machine), so a thread that waits for the next pass, or for
 //! the end of one, first watches an atomic hint. How it watches matters when cores are
 //! shared: a thread that only spins keeps its core from the very thread it waits for, or from
-//! another process, for the whole time. So it spins busily only a few short rounds
-//! (`crossbeam`'s `Backoff`, 127 pause instructions in all), then yields its core
-//! between checks (`yield_now`: immediate when the core is free, a real hand-over when
+//! another process, for the whole time. So it spins busily only briefly ([`SPINS`] pause
+//! instructions, checking after each), then yields its core between checks (`yield_now`: immediate when the core is free, a real hand-over when
 //! another thread wants it), and after [`LIMIT`] gives up, so the caller sleeps.
 
 use std::time::{Duration, Instant};
 
-use crossbeam::utils::Backoff;
-
 /// How long a thread watches a hint, spinning then yielding, before it sleeps.
 const LIMIT: Duration = Duration::from_micros(200);
 
+/// Pauses spun, checking between them, before the watch yields.
+const SPINS: u32 = 127;
+
 /// Returns `true` as soon as `done()` holds, or `false` once [`LIMIT`] has passed without it.
 ///
-/// Busy spinning lasts only a few exponential rounds; after that every check is separated by
-/// a `yield_now`, so a thread waiting here never holds a contended core for more than one
+/// Busy spinning lasts only [`SPINS`] pauses; after that every check is separated by a
+/// `yield_now`, so a thread waiting here never holds a contended core for more than one
 /// scheduling decision at a time.
 pub(crate) fn spin_then_yield(done: impl Fn() -> bool) -> bool {
-    let backoff = Backoff::new();
-    // `snooze` spins (2^step pauses) for its first steps and yields after them; the clock is
-    // read only once the spinning is over.
-    while !backoff.is_completed() {
+    spin_then_yield_for(LIMIT, done)
+}
+
+/// [`spin_then_yield`], giving up once `limit` has passed.
+pub(crate) fn spin_then_yield_for(limit: Duration, done: impl Fn() -> bool) -> bool {
+    // As many pauses as crossbeam's `Backoff` spins (1 + 2 + ... + 64, which this loop
+    // replaced), but the condition is checked after every one: `Backoff`'s last run of 64
+    // pauses between checks is several microseconds on a CPU with a slow `pause` (about 140
+    // cycles on Sapphire Rapids), and a pass's start waited that long to be seen.
+    for _ in 0..SPINS {
         if done() {
             return true;
         }
-        backoff.snooze();
+        std::hint::spin_loop();
     }
     let start = Instant::now();
     loop {
         if done() {
             return true;
         }
-        if start.elapsed() > LIMIT {
+        if start.elapsed() > limit {
             return false;
         }
         std::thread::yield_now();

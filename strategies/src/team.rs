@@ -1,25 +1,31 @@
-//! `team`: an OpenMP-style team — `cores` threads kept for the whole run, each pass cut into
-//! one contiguous block per thread, and a barrier between passes that spins, then sleeps.
+//! `team`: an OpenMP-style team — `cores` threads kept for the whole run, each pass dealt
+//! out in one contiguous share per thread, and a barrier between passes that spins, then
+//! sleeps.
 //!
 //! **Scheduling.** [`Strategy::run`] starts exactly `cores` threads once per run and keeps
 //! them; the session runs on the first (thread 0; the calling thread only waits for it).
-//! Each pass is cut into `min(cores, len)` balanced contiguous blocks, and thread `i` takes
-//! block `i`: with every thread present, that is a static partition, the same block on the
-//! same thread pass after pass, as `#pragma omp parallel for schedule(static)`. A thread that
-//! has finished its own block takes any block nobody has started (the next ones first), so a
-//! thread that is late — asleep, or descheduled because another process wants its core —
-//! costs the pass its help, not a wait: the pass ends once every block is done and every
-//! thread that took one has left.
+//! Each pass is cut into `min(chunks, len)` balanced chunks, and thread `i` owns the `i`-th
+//! contiguous share of them (`cores` shares as equal as whole chunks allow). A thread takes
+//! its own share's chunks from the front; once its share is done, it takes chunks from the
+//! back of the other shares (the next threads' first). With `--chunks` equal to `--cores`,
+//! and every thread present, that is a static partition — the same block on the same thread
+//! pass after pass, as `#pragma omp parallel for schedule(static)`. More chunks keep the
+//! shares as static but let a thread that finished early take the last chunks of a slower
+//! one (uneven work, a thread that is late), and a thread that is late — asleep, or
+//! descheduled because another process wants its core — holds up the pass by at most the one
+//! chunk it is in, not by its share: the pass ends once every chunk is done and every thread
+//! that took one has left.
 //!
 //! **Cost.** No thread start-up per pass. Per pass the session's thread opens the pass with
 //! one atomic store and closes it with one read-modify-write; a worker joins with one
 //! compare-and-swap and leaves with one subtraction (`TeamBoard`, in `erased_job`); each
-//! block is claimed with one swap on its own flag. No lock, no queue, nothing per element.
-//! Between passes a thread watches the pass word for up to 200 µs (spinning, then yielding
-//! its core between checks; see `spin_wait`) before it sleeps on a condition variable, so
-//! back-to-back passes need no wake-up; the watching shows up as CPU time.
+//! chunk is taken with one compare-and-swap on its share's word (a cache line of its own, the
+//! owner's unless others help). No queue, nothing per element. Between passes a thread
+//! watches the pass word for up to 200 µs (spinning, then yielding its core between checks;
+//! see `spin_wait`) before it sleeps on a condition variable, so back-to-back passes need no
+//! wake-up; the watching shows up as CPU time.
 //!
-//! **Panics.** A kernel panic is caught per block; the first one is returned as
+//! **Panics.** A kernel panic is caught per chunk; the first one is returned as
 //! [`KernelPanic`] once the pass has finished, and the threads keep serving later passes.
 //!
 //! **Thread limits and shut-down.** As `crossbeam-pool`: a refused thread fails the run with
@@ -28,8 +34,10 @@
 
 use std::cell::Cell;
 use std::marker::PhantomData;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Mutex, OnceLock, PoisonError};
+
+use crossbeam::utils::CachePadded;
 
 use crate::erased_job::TeamBoard;
 use crate::thread_start::ThreadStarts;
@@ -38,10 +46,11 @@ use crate::{
     balanced_chunks, panic,
 };
 
-/// `cores` threads kept for the run, one contiguous block of each pass per thread.
+/// `cores` threads kept for the run, one contiguous share of each pass's chunks per thread.
 #[derive(Debug, Clone, Copy)]
 pub struct Team {
     cores: usize,
+    chunks: usize,
     placement: Placement,
     starts: ThreadStarts,
 }
@@ -50,16 +59,18 @@ impl Strategy for Team {
     const INFO: Info = Info {
         name: "team",
         description: "an OpenMP-style team: --cores threads kept for the whole run (the \
-                      steps run on one of them), each pass cut into one contiguous block per \
-                      thread, a spinning barrier between passes; a late thread's block is \
-                      taken by whoever is free",
-        calls: crate::Calls::Blocks,
+                      steps run on one of them); each pass's min(--chunks, N) chunks dealt \
+                      out as one contiguous share per thread, taken from the front by its \
+                      owner and from the back by a thread done with its own; a spinning \
+                      barrier between passes",
+        calls: crate::Calls::Chunks,
     };
 
     fn build(config: &Config) -> Result<Self, BuildError> {
         config.validate()?;
         Ok(Team {
             cores: config.cores,
+            chunks: config.chunks,
             placement: config.placement,
             starts: ThreadStarts::default(),
         })
@@ -75,6 +86,8 @@ impl Strategy for Team {
         let executor = TeamExecutor {
             board: &board,
             threads: self.cores,
+            chunks: self.chunks,
+            shares: (0..self.cores).map(|_| Share::new(0, 0)).collect(),
             not_sync: PhantomData,
         };
         let (cores, placement, board) = (self.cores, self.placement, &board);
@@ -123,26 +136,61 @@ struct TeamExecutor<'a> {
     board: &'a TeamBoard,
     /// The team's threads, the session's included.
     threads: usize,
+    chunks: usize,
+    /// One per thread, kept from pass to pass.
+    shares: Vec<Share>,
     not_sync: PhantomData<Cell<()>>,
 }
 
-/// One block of a pass: claimed by exactly one thread, which moves the chunk out.
-struct Block<O> {
-    claimed: AtomicBool,
-    chunk: Mutex<Option<(usize, O)>>,
-}
+/// The chunks a thread owns in a pass: a range of chunk indices, `front` in the high half
+/// of the word and `back` (exclusive) in the low half. The owner takes chunks from the front,
+/// a thread whose own range is done takes them from the back; each take is one
+/// compare-and-swap that moves one end, so every chunk is taken exactly once.
+struct Share(CachePadded<AtomicU64>);
 
-impl<O> Block<O> {
-    /// The block's chunk, for the one thread that claims it first.
-    fn claim(&self) -> Option<(usize, O)> {
-        // A plain read first: a block already taken costs no write to its cache line.
-        if self.claimed.load(Ordering::Relaxed) || self.claimed.swap(true, Ordering::AcqRel) {
-            return None;
+impl Share {
+    fn new(front: usize, back: usize) -> Share {
+        Share(CachePadded::new(AtomicU64::new(Self::word(front, back))))
+    }
+
+    /// Makes the share `front..back` again: only between passes, when nobody takes.
+    fn reset(&self, front: usize, back: usize) {
+        self.0.store(Self::word(front, back), Ordering::Relaxed);
+    }
+
+    fn word(front: usize, back: usize) -> u64 {
+        ((front as u64) << 32) | back as u64
+    }
+
+    /// The next chunk from the front, for the owner.
+    fn take_front(&self) -> Option<usize> {
+        self.take(|front, back| (front + 1, back, front))
+    }
+
+    /// The last chunk not yet taken, for a helper.
+    fn take_back(&self) -> Option<usize> {
+        self.take(|front, back| (front, back - 1, back - 1))
+    }
+
+    /// Applies `step(front, back)` = (new front, new back, chunk taken) while any is left.
+    fn take(&self, step: impl Fn(u64, u64) -> (u64, u64, u64)) -> Option<usize> {
+        let mut word = self.0.load(Ordering::Acquire);
+        loop {
+            let (front, back) = (word >> 32, word & u64::from(u32::MAX));
+            if front >= back {
+                return None;
+            }
+            let (front, back, taken) = step(front, back);
+            match self.0.compare_exchange_weak(
+                word,
+                (front << 32) | back,
+                Ordering::AcqRel,
+                Ordering::Acquire,
+            ) {
+                Ok(_) => return usize::try_from(taken).ok(),
+                Err(now) => word = now,
+            }
         }
-        self.chunk
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .take()
     }
 }
 
@@ -155,24 +203,42 @@ impl Executor for TeamExecutor<'_> {
         if out.is_empty() {
             return Ok(());
         }
-        let blocks: Vec<Block<O>> = balanced_chunks(out, self.threads)
+        // Each chunk is moved out by the one thread whose compare-and-swap took its index.
+        // At most 2³² chunks: a share's ends are 32-bit halves of one word.
+        let most = self.chunks.min(u32::MAX as usize);
+        let chunks: Vec<Mutex<Option<(usize, O)>>> = balanced_chunks(out, most)
             .into_iter()
-            .map(|chunk| Block {
-                claimed: AtomicBool::new(false),
-                chunk: Mutex::new(Some(chunk)),
-            })
+            .map(|chunk| Mutex::new(Some(chunk)))
             .collect();
+        let (n, threads) = (chunks.len(), self.threads);
+        // Set before the pass opens (the board's opening store publishes them).
+        let shares = &self.shares;
+        for (t, share) in shares.iter().enumerate() {
+            share.reset(t * n / threads, (t + 1) * n / threads);
+        }
         let first_panic: OnceLock<KernelPanic> = OnceLock::new();
+        let run = |i: usize| {
+            let taken = chunks[i]
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .take();
+            if let Some((first, chunk)) = taken
+                && let Err(p) = panic::catch(|| kernel(first, chunk))
+            {
+                let _ = first_panic.set(p); // a later panic: the first one is kept
+            }
+        };
 
-        // Run by thread `me`: its own block first, then any block nobody has started, the
-        // next ones first. A panicking kernel is caught here; the first panic is kept.
+        // Run by thread `me`: its own share from the front, then the others' from the back,
+        // the next threads' first. A panicking kernel is caught in `run`; the first panic is
+        // kept.
         let job = |me: usize| {
-            let n = blocks.len();
-            for k in 0..n {
-                if let Some((first, chunk)) = blocks[(me + k) % n].claim()
-                    && let Err(p) = panic::catch(|| kernel(first, chunk))
-                {
-                    let _ = first_panic.set(p); // a later panic: the first one is kept
+            while let Some(i) = shares[me].take_front() {
+                run(i);
+            }
+            for other in (1..threads).map(|k| (me + k) % threads) {
+                while let Some(i) = shares[other].take_back() {
+                    run(i);
                 }
             }
         };
@@ -195,9 +261,28 @@ mod tests {
     use crate::testing::{distinct, run_counting, thread_ids_per_pass};
 
     #[test]
+    fn a_share_gives_every_chunk_once_to_its_owner_at_the_front_or_a_helper_at_the_back() {
+        let share = Share::new(10, 1010);
+        let (front, back) = std::thread::scope(|s| {
+            let owner = s.spawn(|| std::iter::from_fn(|| share.take_front()).collect::<Vec<_>>());
+            let helper = s.spawn(|| std::iter::from_fn(|| share.take_back()).collect::<Vec<_>>());
+            (owner.join().unwrap(), helper.join().unwrap())
+        });
+        assert!(front.windows(2).all(|w| w[0] < w[1]), "the owner goes up");
+        assert!(
+            back.windows(2).all(|w| w[0] > w[1]),
+            "the helper comes down"
+        );
+        let mut all = [front, back].concat();
+        all.sort_unstable();
+        assert_eq!(all, (10..1010).collect::<Vec<_>>());
+        assert_eq!((share.take_front(), share.take_back()), (None, None));
+    }
+
+    #[test]
     fn with_every_thread_present_each_pass_gives_each_thread_one_block() {
-        // Each call sleeps 1 ms, far longer than a thread takes to join the pass.
-        let passes = thread_ids_per_pass::<Team>(3, 1, 30, 5);
+        // One chunk a thread; each call sleeps 1 ms, far longer than a thread takes to join.
+        let passes = thread_ids_per_pass::<Team>(3, 3, 30, 5);
         assert!(passes.iter().all(|pass| pass.len() == 3), "{passes:?}");
         let all: Vec<_> = passes.concat();
         assert!((2..=3).contains(&distinct(&all)), "{passes:?}");
@@ -212,6 +297,7 @@ mod tests {
         ] {
             let strategy = Team {
                 cores: 4,
+                chunks: 8,
                 placement: Placement::OS,
                 starts: ThreadStarts {
                     refuse: Some(refuse),

@@ -21,6 +21,7 @@ mod cli_locks;
 mod cli_merge;
 mod cli_merge_checks;
 mod cli_messages;
+mod cli_overhead;
 mod cli_ownership;
 mod cli_pin;
 mod cli_render;

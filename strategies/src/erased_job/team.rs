@@ -11,6 +11,7 @@
 use std::mem;
 use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
+use std::time::Duration;
 
 use crossbeam::utils::CachePadded;
 
@@ -23,6 +24,12 @@ const OPEN: u64 = 1 << 31;
 const INSIDE: u64 = OPEN - 1;
 /// One epoch.
 const EPOCH: u64 = 1 << 32;
+
+/// How long the dispatcher watches for the last worker of a closed pass before it sleeps.
+/// Short: by then every chunk has been taken, so a worker still inside is either busy with
+/// its last chunk or descheduled in it, and a sleeping dispatcher leaves its core idle, which
+/// lets the operating system move a descheduled worker onto it.
+const LAST_OUT: Duration = Duration::from_micros(20);
 
 fn epoch(word: u64) -> u64 {
     word >> 32
@@ -220,7 +227,7 @@ impl TeamBoard {
     /// Waits until no worker is inside the closed pass: watching first, then asleep.
     fn wait_for_workers(&self) {
         let drained = |order| self.pass.load(order) & INSIDE == 0;
-        if spin_wait::spin_then_yield(|| drained(Ordering::Acquire)) {
+        if spin_wait::spin_then_yield_for(LAST_OUT, || drained(Ordering::Acquire)) {
             return;
         }
         let mut sleep = self.lock();
