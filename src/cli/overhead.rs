@@ -8,7 +8,7 @@ use clap::Args;
 use serde::Serialize;
 
 use crate::output::console;
-use crate::results::intervals::mean_interval;
+use crate::results::intervals::ratio;
 use crate::run::pass_cost;
 use crate::sweep::range::{self, Axis};
 use sph_strategies::StrategyName;
@@ -28,7 +28,8 @@ pub struct OverheadArgs {
     /// Passes per round (1..=100000).
     #[arg(long, default_value_t = 1000, value_parser = passes)]
     pub passes: u64,
-    /// Rounds per cell (2..=100); the cells take turns round by round.
+    /// Rounds per cell (3..=100, the fewest that give an interval); the cells take turns
+    /// round by round.
     #[arg(long, default_value_t = 10, value_parser = rounds)]
     pub rounds: usize,
     /// Print one JSON object instead of text.
@@ -45,7 +46,7 @@ fn passes(s: &str) -> Result<u64, String> {
 }
 
 fn rounds(s: &str) -> Result<usize, String> {
-    super::in_range(s, "rounds", 2, 100)
+    super::in_range(s, "rounds", crate::results::intervals::MIN_ROUNDS, 100)
 }
 
 /// One strategy at one core count.
@@ -53,7 +54,8 @@ fn rounds(s: &str) -> Result<usize, String> {
 struct Cell {
     strategy: &'static str,
     cores: usize,
-    /// Mean time a pass, µs, over the rounds, and its 95 % interval.
+    /// Typical time a pass, µs: the geometric mean of the rounds' mean times a pass, and its
+    /// 95 % interval (as a sweep's cell times).
     pass_us: f64,
     pass_low_us: f64,
     pass_high_us: f64,
@@ -129,16 +131,19 @@ pub fn run(args: &OverheadArgs) -> anyhow::Result<()> {
 
 fn cell(strategy: StrategyName, cores: usize, times: &[f64], work: Duration, hw: usize) -> Cell {
     let us = |s: f64| s * 1e6;
-    let mean = crate::results::stats::mean(times);
-    // At least two rounds (the flag's range), so the interval exists.
-    let interval = mean_interval(times).map_or((mean, mean), |i| (i.low, i.high));
+    // Every round's time is positive and finite (a pass takes time), and there are at least
+    // `MIN_ROUNDS` of them (the flag's range): the estimate and its interval exist.
+    let typical = ratio(times).expect("positive times");
+    let interval = typical
+        .interval
+        .map_or((f64::NAN, f64::NAN), |i| (i.low, i.high));
     Cell {
         strategy: strategy.info().name,
         cores,
-        pass_us: us(mean),
+        pass_us: us(typical.value),
         pass_low_us: us(interval.0),
         pass_high_us: us(interval.1),
-        beyond_work_us: us(mean) - us(work.as_secs_f64()),
+        beyond_work_us: us(typical.value) - us(work.as_secs_f64()),
         oversubscribed: cores > hw,
     }
 }
@@ -149,8 +154,9 @@ fn print_report(r: &Report, json: bool) -> anyhow::Result<()> {
         return say(&serde_json::to_string(r)?);
     }
     say(&format!(
-        "a pass with {} µs of work a thread, one chunk a thread: mean time a pass over {} rounds \
-         of {} passes, 95 % interval; beyond the work is the strategy's cost a pass",
+        "a pass with {} µs of work a thread, one chunk a thread: typical time a pass (geometric \
+         mean over {} rounds of {} passes) and its 95 % interval; beyond the work is the \
+         strategy's cost a pass",
         r.work_us, r.rounds, r.passes
     ))?;
     let width = r.cells.iter().map(|c| c.strategy.len()).max().unwrap_or(8);

@@ -1,5 +1,5 @@
-//! Waiting a short, bounded time for a condition without sleeping, for the job board's
-//! threads before they sleep on a condition variable.
+//! Waiting a short, bounded time for a condition without sleeping, for the boards' threads
+//! (`erased_job`) before they sleep on a condition variable.
 //!
 //! Passes follow each other within microseconds, and waking a sleeping thread costs tens of
 //! microseconds (more on a virtual machine), so a thread that waits for the next pass, or for

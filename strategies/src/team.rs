@@ -14,13 +14,14 @@
 //! one (uneven work, a thread that is late), and a thread that is late — asleep, or
 //! descheduled because another process wants its core — holds up the pass by at most the one
 //! chunk it is in, not by its share: the pass ends once every chunk is done and every thread
-//! that took one has left.
+//! that joined the pass has left.
 //!
 //! **Cost.** No thread start-up per pass. Per pass the session's thread opens the pass with
 //! one atomic store and closes it with one read-modify-write; a worker joins with one
 //! compare-and-swap and leaves with one subtraction (`TeamBoard`, in `erased_job`); each
 //! chunk is taken with one compare-and-swap on its share's word (a cache line of its own, the
-//! owner's unless others help). No queue, nothing per element. Between passes a thread
+//! owner's unless others help) and moved out of its slot under an uncontended lock. No queue,
+//! nothing per element. Between passes a thread
 //! watches the pass word for up to 200 µs (spinning, then yielding its core between checks;
 //! see `spin_wait`) before it sleeps on a condition variable, so back-to-back passes need no
 //! wake-up; the watching shows up as CPU time.

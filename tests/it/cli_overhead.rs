@@ -63,7 +63,7 @@ fn every_cell_asked_for_is_measured_and_no_pass_beats_its_work() {
 #[test]
 fn bad_numbers_are_errors_naming_their_range() {
     for (flag, value, says) in [
-        ("--rounds", "1", "between 2 and 100"),
+        ("--rounds", "2", "between 3 and 100"),
         ("--work-us", "1001", "between 0 and 1000"),
         ("--passes", "0", "between 1 and 100000"),
         ("--cores", "0", "--cores"),

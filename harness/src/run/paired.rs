@@ -36,7 +36,8 @@ pub struct PairedTimes {
 /// microseconds on a quiet machine (more on a virtual one), which a run of the strategy alone,
 /// its passes back to back, does not pay. So before each of its steps, untimed, the
 /// strategy's threads are roused ([`sph_strategies::rouse`]): its steps begin as they do in a
-/// run of their own. At the paper's workload on the project's 2-core VM, with the threads
+/// run of their own, where the serial work between steps is shorter than the threads' watch
+/// (at N = 10⁶ a run of its own may find them asleep, and the rouse spares it that cost). At the paper's workload on the project's 2-core VM, with the threads
 /// left asleep, `crossbeam-pool` measured 1.47× here where its runs alone were 1.78× faster
 /// than `seq`'s.
 pub fn run_paired(

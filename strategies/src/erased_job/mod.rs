@@ -10,8 +10,9 @@
 //! is done with the job:
 //! - [`JobBoard`] (`crossbeam-pool`) keeps its books under one mutex;
 //! - [`TeamBoard`] (`team`) keeps them in one atomic word, so that a pass costs the
-//!   dispatcher one store and one read-modify-write and each worker two, and takes a lock
-//!   only to sleep or to wake a sleeper.
+//!   dispatcher one store and one read-modify-write on it (and two on a flag that only it
+//!   touches) and each worker two, and takes a lock only to sleep, to wake a sleeper, or to
+//!   keep a panic.
 //!
 //! The soundness argument lives entirely in this module, behind a safe API: no caller can make
 //! a board call a job after `run` has returned, whatever the job does (a job that panics is

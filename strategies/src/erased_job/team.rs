@@ -49,8 +49,10 @@ pub(crate) struct TeamBoard {
     /// A `run` is between opening its pass and returning.
     in_flight: AtomicBool,
     shutdown: AtomicBool,
-    /// The first panic that escaped a worker's call of the pass's job.
+    /// The first panic that escaped a worker's call of the pass's job, and whether there is
+    /// one (so that a pass without a panic takes no lock).
     escaped: Mutex<Option<KernelPanic>>,
+    panicked: AtomicBool,
     /// Workers asleep on `to_workers`, and whether the dispatcher sleeps on `to_dispatcher`:
     /// a notification (a system call) is sent only when someone sleeps.
     workers_asleep: AtomicUsize,
@@ -71,6 +73,7 @@ impl TeamBoard {
             in_flight: AtomicBool::new(false),
             shutdown: AtomicBool::new(false),
             escaped: Mutex::new(None),
+            panicked: AtomicBool::new(false),
             workers_asleep: AtomicUsize::new(0),
             dispatcher_asleep: AtomicBool::new(false),
             sleep: Mutex::new(()),
@@ -90,12 +93,12 @@ impl TeamBoard {
     /// been shut down; in both cases before anything is published.
     pub(crate) fn run(&self, job: &(dyn Fn(usize) + Sync)) -> Result<(), KernelPanic> {
         assert!(
-            !self.in_flight.swap(true, Ordering::Acquire),
-            "a team board runs one pass at a time"
-        );
-        assert!(
             !self.shutdown.load(Ordering::Acquire),
             "team board used after shut-down"
+        );
+        assert!(
+            !self.in_flight.swap(true, Ordering::Acquire),
+            "a team board runs one pass at a time"
         );
         let erased = ErasedJob::new(job);
         // From opening the pass until no worker is inside it, an unwind out of `run` would
@@ -127,11 +130,15 @@ impl TeamBoard {
             self.wait_for_workers();
         }
         mem::forget(guard);
-        let escaped = self
-            .escaped
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .take();
+        // Set by a worker before it counted itself out, which the close or the wait above saw.
+        let escaped = if self.panicked.swap(false, Ordering::Relaxed) {
+            self.escaped
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .take()
+        } else {
+            None
+        };
         self.in_flight.store(false, Ordering::Release);
         match own {
             Err(p) => Err(p),
@@ -164,6 +171,7 @@ impl TeamBoard {
                     .lock()
                     .unwrap_or_else(PoisonError::into_inner)
                     .get_or_insert(p);
+                self.panicked.store(true, Ordering::Relaxed);
             }
             // Counted out: from here on `job` is never read again. SeqCst, with
             // `dispatcher_asleep` in `wait_for_workers`: either the dispatcher sees the count
