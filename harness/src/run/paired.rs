@@ -37,9 +37,9 @@ pub struct PairedTimes {
 /// its passes back to back, does not pay. So before each of its steps, untimed, the
 /// strategy's threads are roused ([`sph_strategies::rouse`]): its steps begin as they do in a
 /// run of their own, where the serial work between steps is shorter than the threads' watch
-/// (at N = 10⁶ a run of its own may find them asleep, and the rouse spares it that cost). At the paper's workload on the project's 2-core VM, with the threads
-/// left asleep, `crossbeam-pool` measured 1.47× here where its runs alone were 1.78× faster
-/// than `seq`'s.
+/// (at N = 10⁶ a run of its own may find them asleep, and the rouse spares it that cost). At
+/// the paper's workload on the project's 2-core VM, with the threads left asleep,
+/// `crossbeam-pool` measured 1.47× here where its runs alone were 1.78× faster than `seq`'s.
 pub fn run_paired(
     seq_sim: &mut Simulation,
     sim: &mut Simulation,
@@ -91,8 +91,11 @@ impl Session for Paired<'_> {
                     .seq_s
                     .push(timed(|| self.seq_sim.advance(&SeqExecutor, 1)).map_err(seq)?);
             }
-            // A kernel panic here would be the rouse's own, which cannot panic.
-            let _ = rouse(exec, &self.info, &self.config);
+            // Whether every thread came in time is not needed: a late one is still waking, as
+            // it would be without the rouse.
+            let next = self.sim.steps_done + 1;
+            rouse(exec, &self.info, &self.config)
+                .map_err(|source| strategy(StepError::Kernel { step: next, source }))?;
             times
                 .strategy_s
                 .push(timed(|| self.sim.advance(exec, 1)).map_err(strategy)?);
