@@ -44,12 +44,12 @@
 
 use std::cell::{Cell, RefCell};
 use std::num::NonZero;
-use std::sync::OnceLock;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Duration;
 
 use chili::Scope;
 
+use crate::panic::FirstPanic;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Placement, Session, Split, Strategy,
     balanced_chunks, panic,
@@ -164,13 +164,10 @@ impl Executor for ChiliExecutor<'_> {
         let pass = Pass {
             kernel: &kernel,
             placer: &self.placer,
-            first_panic: OnceLock::new(),
+            panics: FirstPanic::default(),
         };
         join_chunks(&mut self.scope.borrow_mut(), &mut slots, &pass);
-        match pass.first_panic.into_inner() {
-            Some(p) => Err(p),
-            None => Ok(()),
-        }
+        pass.panics.or(Ok(()))
     }
 
     fn threads(&self) -> usize {
@@ -183,7 +180,7 @@ struct Pass<'a, F> {
     kernel: &'a F,
     placer: &'a LazyPlacement,
     /// The first kernel panic of the pass; later ones are dropped.
-    first_panic: OnceLock<KernelPanic>,
+    panics: FirstPanic,
 }
 
 impl<F> Pass<'_, F> {
@@ -193,13 +190,10 @@ impl<F> Pass<'_, F> {
     where
         F: Fn(usize, O),
     {
-        let called = panic::catch(|| {
+        self.panics.catch(|| {
             self.placer.place_current_thread();
             (self.kernel)(first, chunk);
         });
-        if let Err(p) = called {
-            let _ = self.first_panic.set(p); // a later panic: the first one is kept
-        }
     }
 }
 

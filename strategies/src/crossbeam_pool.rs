@@ -48,16 +48,16 @@
 //! that `unsafe` is confined to the private module `erased_job`, whose safe API returns only
 //! after every worker that joined the pass is done with the job.
 
-use crate::erased_job::JobBoard;
+use crate::erased_job::{JobBoard, ShutDownOnDrop};
+use crate::panic::FirstPanic;
 use crate::thread_start::ThreadStarts;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Placement, Session, Split, Strategy,
-    balanced_chunks, panic,
+    balanced_chunks,
 };
 use crossbeam::queue::ArrayQueue;
 use std::cell::Cell;
 use std::marker::PhantomData;
-use std::sync::OnceLock;
 
 /// A pool of `cores` long-lived crossbeam scoped threads pulling chunks dynamically.
 #[derive(Debug, Clone, Copy)]
@@ -134,15 +134,6 @@ impl Strategy for CrossbeamPool {
     }
 }
 
-/// Tells the workers to exit when dropped, including during unwinding.
-struct ShutDownOnDrop<'a>(&'a JobBoard);
-
-impl Drop for ShutDownOnDrop<'_> {
-    fn drop(&mut self) {
-        self.0.shut_down();
-    }
-}
-
 /// Publishes each pass on the board.
 ///
 /// Deliberately not `Sync`: a kernel (which must be `Sync`) therefore cannot capture the
@@ -172,23 +163,17 @@ impl Executor for PoolExecutor<'_> {
                 unreachable!("the queue holds exactly the pass's chunks");
             }
         }
-        let first_panic: OnceLock<KernelPanic> = OnceLock::new();
+        let panics = FirstPanic::default();
 
         // Run by every worker: pop chunks (each one exactly once, in index order) until none
         // is left. A panicking kernel is caught here; the first panic is kept.
         let job = || {
             while let Some((first, chunk)) = queue.pop() {
-                if let Err(p) = panic::catch(|| kernel(first, chunk)) {
-                    let _ = first_panic.set(p); // a later panic: the first one is kept
-                }
+                panics.catch(|| kernel(first, chunk));
             }
         };
         let escaped = self.board.run(&job);
-
-        match first_panic.into_inner() {
-            Some(p) => Err(p),
-            None => escaped,
-        }
+        panics.or(escaped)
     }
 
     fn threads(&self) -> usize {

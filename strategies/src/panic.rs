@@ -2,6 +2,7 @@
 
 use std::any::Any;
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::OnceLock;
 
 /// A kernel panicked while a strategy was running a pass.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -34,4 +35,23 @@ impl KernelPanic {
 /// (see [`crate::Executor::for_each_chunk`]).
 pub fn catch<R>(f: impl FnOnce() -> R) -> Result<R, KernelPanic> {
     catch_unwind(AssertUnwindSafe(f)).map_err(KernelPanic::from_payload)
+}
+
+/// The first kernel panic of a pass whose kernel calls are caught one by one, on whichever
+/// threads run them; later ones are dropped.
+#[derive(Default)]
+pub(crate) struct FirstPanic(OnceLock<KernelPanic>);
+
+impl FirstPanic {
+    /// Runs `f`, keeping its panic if it is the pass's first.
+    pub(crate) fn catch(&self, f: impl FnOnce()) {
+        if let Err(p) = catch(f) {
+            let _ = self.0.set(p); // a later panic: the first one is kept
+        }
+    }
+
+    /// The pass's outcome: its first kept panic, else `rest` (what escaped around the calls).
+    pub(crate) fn or(self, rest: Result<(), KernelPanic>) -> Result<(), KernelPanic> {
+        self.0.into_inner().map_or(rest, Err)
+    }
 }

@@ -54,13 +54,14 @@
 use std::any::Any;
 use std::cell::RefCell;
 use std::panic::{AssertUnwindSafe, catch_unwind, resume_unwind};
-use std::sync::{Barrier, Mutex, MutexGuard, OnceLock};
+use std::sync::{Barrier, Mutex, MutexGuard};
 
 use paralight::prelude::{
     CpuPinningPolicy, ExactParallelSourceExt, IntoExactParallelSource, ParallelIteratorExt,
     RangeStrategy, ThreadCount, ThreadPool, ThreadPoolBuilder,
 };
 
+use crate::panic::FirstPanic;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Placement, Session, Split, Strategy,
     balanced_chunks, panic,
@@ -189,7 +190,7 @@ impl Executor for ParalightExecutor<'_> {
             return Ok(());
         }
         let chunks = balanced_chunks(out, self.chunks);
-        let first_panic: OnceLock<KernelPanic> = OnceLock::new();
+        let panics = FirstPanic::default();
         let mut pool = self.pool.borrow_mut();
         // Caught around the whole pass too: paralight itself may panic on the caller (e.g.
         // over 2^32 items), never on a worker.
@@ -197,16 +198,9 @@ impl Executor for ParalightExecutor<'_> {
             chunks
                 .into_par_iter()
                 .with_thread_pool(&mut **pool)
-                .for_each(|(first, chunk)| {
-                    if let Err(p) = panic::catch(|| kernel(first, chunk)) {
-                        let _ = first_panic.set(p); // a later panic: the first one is kept
-                    }
-                });
+                .for_each(|(first, chunk)| panics.catch(|| kernel(first, chunk)));
         });
-        match first_panic.into_inner() {
-            Some(p) => Err(p),
-            None => escaped,
-        }
+        panics.or(escaped)
     }
 
     fn threads(&self) -> usize {

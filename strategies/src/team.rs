@@ -36,15 +36,16 @@
 use std::cell::Cell;
 use std::marker::PhantomData;
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Mutex, OnceLock, PoisonError};
+use std::sync::{Mutex, PoisonError};
 
 use crossbeam::utils::CachePadded;
 
-use crate::erased_job::TeamBoard;
+use crate::erased_job::{ShutDownOnDrop, TeamBoard};
+use crate::panic::FirstPanic;
 use crate::thread_start::ThreadStarts;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Placement, Session, Split, Strategy,
-    balanced_chunks, panic,
+    balanced_chunks,
 };
 
 /// `cores` threads kept for the run, one contiguous share of each pass's chunks per thread.
@@ -117,15 +118,6 @@ impl Strategy for Team {
             let joined = session_thread.join();
             Ok(joined.unwrap_or_else(|payload| std::panic::resume_unwind(payload)))
         })
-    }
-}
-
-/// Tells the threads to exit when dropped, including during unwinding.
-struct ShutDownOnDrop<'a>(&'a TeamBoard);
-
-impl Drop for ShutDownOnDrop<'_> {
-    fn drop(&mut self) {
-        self.0.shut_down();
     }
 }
 
@@ -217,16 +209,14 @@ impl Executor for TeamExecutor<'_> {
         for (t, share) in shares.iter().enumerate() {
             share.reset(t * n / threads, (t + 1) * n / threads);
         }
-        let first_panic: OnceLock<KernelPanic> = OnceLock::new();
+        let panics = FirstPanic::default();
         let run = |i: usize| {
             let taken = chunks[i]
                 .lock()
                 .unwrap_or_else(PoisonError::into_inner)
                 .take();
-            if let Some((first, chunk)) = taken
-                && let Err(p) = panic::catch(|| kernel(first, chunk))
-            {
-                let _ = first_panic.set(p); // a later panic: the first one is kept
+            if let Some((first, chunk)) = taken {
+                panics.catch(|| kernel(first, chunk));
             }
         };
 
@@ -244,11 +234,7 @@ impl Executor for TeamExecutor<'_> {
             }
         };
         let escaped = self.board.run(&job);
-
-        match first_panic.into_inner() {
-            Some(p) => Err(p),
-            None => escaped,
-        }
+        panics.or(escaped)
     }
 
     fn threads(&self) -> usize {

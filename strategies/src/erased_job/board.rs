@@ -257,6 +257,7 @@ impl JobBoard {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::erased_job::{ShutDownOnDrop, wait_for};
     use std::collections::HashMap;
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::thread::{self, ThreadId};
@@ -269,25 +270,9 @@ mod tests {
             for _ in 0..workers {
                 s.spawn(|| board.serve());
             }
-            let _stop = ShutDown(&board);
+            let _stop = ShutDownOnDrop(&board);
             f(&board);
         });
-    }
-
-    /// Shuts the board down when dropped, so a failed assertion still lets the scope join.
-    struct ShutDown<'a>(&'a JobBoard);
-
-    impl Drop for ShutDown<'_> {
-        fn drop(&mut self) {
-            self.0.shut_down();
-        }
-    }
-
-    /// Yields until `done()`; the test's watchdog is the test harness's own.
-    fn wait_for(done: impl Fn() -> bool) {
-        while !done() {
-            thread::yield_now();
-        }
     }
 
     #[test]

@@ -65,6 +65,44 @@ impl ErasedJob {
     }
 }
 
+/// A board whose serving threads can be told to exit.
+pub(crate) trait ShutDown {
+    /// Makes every serving thread return once it has finished any job in flight.
+    fn shut_down(&self);
+}
+
+impl ShutDown for JobBoard {
+    fn shut_down(&self) {
+        JobBoard::shut_down(self);
+    }
+}
+
+impl ShutDown for TeamBoard {
+    fn shut_down(&self) {
+        TeamBoard::shut_down(self);
+    }
+}
+
+/// Tells a board's serving threads to exit when dropped, including during unwinding: a
+/// strategy creates it before its first worker, so that every way out of its thread scope —
+/// a return, a refused thread, a panicking session — releases the workers and the scope can
+/// join them.
+pub(crate) struct ShutDownOnDrop<'a, B: ShutDown>(pub(crate) &'a B);
+
+impl<B: ShutDown> Drop for ShutDownOnDrop<'_, B> {
+    fn drop(&mut self) {
+        self.0.shut_down();
+    }
+}
+
+/// Yields until `done()`, for the boards' tests; the test's watchdog is the test harness's own.
+#[cfg(test)]
+fn wait_for(done: impl Fn() -> bool) {
+    while !done() {
+        std::thread::yield_now();
+    }
+}
+
 /// Aborts the process when dropped. Armed around the calls of a job and disarmed with
 /// `mem::forget` after them, so only an unwind that escaped `panic::catch` reaches it: going
 /// on would skip the bookkeeping that keeps an erased job from outliving its borrow.

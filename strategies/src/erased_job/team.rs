@@ -259,6 +259,7 @@ impl TeamBoard {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::erased_job::{ShutDownOnDrop, wait_for};
     use std::collections::HashMap;
     use std::sync::atomic::AtomicUsize;
     use std::thread::{self, ThreadId};
@@ -273,24 +274,9 @@ mod tests {
                 let board = &board;
                 s.spawn(move || board.serve(i));
             }
-            let _stop = ShutDown(&board);
+            let _stop = ShutDownOnDrop(&board);
             f(&board);
         });
-    }
-
-    /// Shuts the board down when dropped, so a failed assertion still lets the scope join.
-    struct ShutDown<'a>(&'a TeamBoard);
-
-    impl Drop for ShutDown<'_> {
-        fn drop(&mut self) {
-            self.0.shut_down();
-        }
-    }
-
-    fn wait_for(done: impl Fn() -> bool) {
-        while !done() {
-            thread::yield_now();
-        }
     }
 
     #[test]
