@@ -216,15 +216,13 @@ cargo build --release >&2
 PLAIN=""
 OMP=""
 if command -v -- "$CXX" >/dev/null 2>&1; then
-    echo "compiling benches/plain-loop/mueller.cpp with $CXX -O2 -ffp-contract=off ..." >&2
-    "$CXX" -O2 -ffp-contract=off -std=c++17 -o "$WORK/mueller" benches/plain-loop/mueller.cpp
+    CXX="$CXX" scripts/build-plain-loop.sh "$WORK" >/dev/null
     PLAIN="$WORK/mueller"
     PLAIN_CXX="$("$CXX" --version 2>/dev/null | head -n 1)"
-    if "$CXX" -O2 -ffp-contract=off -std=c++17 -fopenmp -o "$WORK/mueller-omp" \
-        benches/plain-loop/mueller.cpp 2>/dev/null; then
+    if [[ -x "$WORK/mueller-omp" ]]; then
         OMP="$WORK/mueller-omp"
     else
-        echo "'$CXX' cannot build with -fopenmp: skipping the OpenMP anchor" >&2
+        echo "skipping the OpenMP anchor" >&2
     fi
 else
     echo "no C++ compiler ('$CXX' not found): skipping the plain loop and the ratio columns" >&2

@@ -8,8 +8,7 @@ use clap::Args;
 use serde::Serialize;
 
 use crate::output::console;
-use crate::results::intervals::ratio;
-use crate::run::pass_cost;
+use crate::run::pass_cost::{self, CostRow};
 use crate::sweep::range::{self, Axis};
 use sph_strategies::StrategyName;
 
@@ -49,22 +48,6 @@ fn rounds(s: &str) -> Result<usize, String> {
     super::in_range(s, "rounds", crate::results::intervals::MIN_ROUNDS, 100)
 }
 
-/// One strategy at one core count.
-#[derive(Debug, Serialize)]
-struct Cell {
-    strategy: &'static str,
-    cores: usize,
-    /// Typical time a pass, µs: the geometric mean of the rounds' mean times a pass, and its
-    /// 95 % interval (as a sweep's cell times).
-    pass_us: f64,
-    pass_low_us: f64,
-    pass_high_us: f64,
-    /// `pass_us` less the work a thread: the strategy's cost a pass.
-    beyond_work_us: f64,
-    /// More threads than the machine's hardware threads.
-    oversubscribed: bool,
-}
-
 /// What `overhead --json` prints.
 #[derive(Debug, Serialize)]
 struct Report {
@@ -72,7 +55,7 @@ struct Report {
     passes: u64,
     rounds: usize,
     hardware_threads: usize,
-    cells: Vec<Cell>,
+    cells: Vec<CostRow>,
 }
 
 /// Runs `overhead`.
@@ -89,36 +72,16 @@ pub fn run(args: &OverheadArgs) -> anyhow::Result<()> {
     } else {
         args.strategies.clone()
     };
-    // A strategy that runs every pass on the calling thread is measured at one core only.
-    let cells: Vec<(StrategyName, usize)> = strategies
-        .iter()
-        .flat_map(|&s| {
-            let mut at: Vec<usize> = cores.iter().map(|&c| s.info().effective_cores(c)).collect();
-            at.dedup();
-            at.into_iter().map(move |c| (s, c))
-        })
-        .collect();
     if cores.iter().any(|&c| c > hardware) {
         console::warn(&format!(
             "warning: more threads than the {hardware} hardware threads (oversubscribed): \
              those cells measure threads taking turns on a core"
         ));
     }
+    let cells = pass_cost::cells(&strategies, &cores);
     let work = Duration::from_micros(args.work_us);
-    // The cells take turns round by round, so that a slow spell of the machine hits all.
-    let mut times = vec![Vec::with_capacity(args.rounds); cells.len()];
-    for _ in 0..args.rounds {
-        for (&(strategy, cores), times) in cells.iter().zip(&mut times) {
-            let round = pass_cost::measure(strategy, cores, work, args.passes, 1)
-                .with_context(|| format!("{strategy} at {cores} cores"))?;
-            times.extend(round);
-        }
-    }
-    let cells = cells
-        .iter()
-        .zip(&times)
-        .map(|(&(strategy, cores), times)| cell(strategy, cores, times, work, hardware))
-        .collect();
+    let cells = pass_cost::table(&cells, work, args.passes, args.rounds, hardware, || false)?
+        .expect("never asked to stop");
     let report = Report {
         work_us: args.work_us,
         passes: args.passes,
@@ -127,25 +90,6 @@ pub fn run(args: &OverheadArgs) -> anyhow::Result<()> {
         cells,
     };
     print_report(&report, args.json)
-}
-
-fn cell(strategy: StrategyName, cores: usize, times: &[f64], work: Duration, hw: usize) -> Cell {
-    let us = |s: f64| s * 1e6;
-    // Every round's time is positive and finite (a pass takes time), and there are at least
-    // `MIN_ROUNDS` of them (the flag's range): the estimate and its interval exist.
-    let typical = ratio(times).expect("positive times");
-    let interval = typical
-        .interval
-        .map_or((f64::NAN, f64::NAN), |i| (i.low, i.high));
-    Cell {
-        strategy: strategy.info().name,
-        cores,
-        pass_us: us(typical.value),
-        pass_low_us: us(interval.0),
-        pass_high_us: us(interval.1),
-        beyond_work_us: us(typical.value) - us(work.as_secs_f64()),
-        oversubscribed: cores > hw,
-    }
 }
 
 fn print_report(r: &Report, json: bool) -> anyhow::Result<()> {

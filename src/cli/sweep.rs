@@ -136,6 +136,17 @@ pub struct SweepArgs {
     /// it touches. Merge the K directories with `bench-sph merge`; the report comes after.
     #[arg(long, value_name = "I/K", value_parser = clap::value_parser!(Shard))]
     pub shard: Option<Shard>,
+    /// After the cells, measure what a pass costs each strategy at each core count (as
+    /// `bench-sph overhead` does, 5 µs of work a thread) into pass-cost.csv; the report sets it
+    /// beside the workload's own pass. Adds about a second per strategy and core count.
+    #[arg(long)]
+    pub pass_cost: bool,
+    /// After the cells, run PATH, the plain C++ loop's OpenMP build
+    /// (`scripts/build-plain-loop.sh`), at each core count in rounds as the cells ran, for
+    /// each group of the seed preset with all-pairs, into anchor.csv; the report sets its
+    /// speedups beside the strategies'.
+    #[arg(long, value_name = "PATH")]
+    pub anchor: Option<PathBuf>,
     /// Do not draw charts at the end.
     #[arg(long)]
     pub no_plots: bool,
@@ -217,6 +228,8 @@ impl SweepArgs {
                 pins
             },
             shard: self.shard,
+            pass_cost: self.pass_cost,
+            anchor: self.anchor.as_deref().map(anchor_path).transpose()?,
         })
     }
 
@@ -309,4 +322,16 @@ fn charts(dir: &Path, no_plots: bool) -> anyhow::Result<String> {
         text.push_str(&format!("\n  {}", p.display()));
     }
     Ok(text)
+}
+
+/// `--anchor`'s program as an absolute path (so that `--resume` from another directory runs
+/// it), refused here when there is no such file.
+fn anchor_path(path: &Path) -> anyhow::Result<PathBuf> {
+    let found = path
+        .canonicalize()
+        .with_context(|| format!("--anchor '{}': no such program", path.display()))?;
+    if !found.is_file() {
+        anyhow::bail!("--anchor '{}': not a program file", path.display());
+    }
+    Ok(found)
 }

@@ -33,6 +33,7 @@ mod cli_report_safety;
 mod cli_simulate;
 mod cli_speedup;
 mod cli_sweep;
+mod cli_sweep_beside;
 mod cli_sweep_safety;
 mod cli_trace;
 mod cli_validate;

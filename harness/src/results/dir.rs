@@ -22,7 +22,7 @@ use crate::output::claim::{self, Claimed, Owner};
 use crate::output::lock::{self, DirLock, LOCK_FILE};
 use crate::output::record::{self, Command, Record};
 use crate::results::meta::Meta;
-use crate::results::{REFERENCES_FILE, REPORT_FILE};
+use crate::results::{ANCHOR_FILE, PASS_COST_FILE, REFERENCES_FILE, REPORT_FILE};
 
 /// The default results directory: `results/<UTC timestamp>`, or with `-2`, `-3`, … when a
 /// sweep started in the same second took that name. Created here, exclusively.
@@ -64,8 +64,10 @@ pub fn open_new(dir: &Path, force: bool, command: Command) -> anyhow::Result<Cla
         .with_context(|| format!("cannot create results directory '{}'", dir.display()))?;
     // Every file of the results, and the report, must be writable before anything is.
     let mut writes = vec![TRIALS_FILE, SUMMARY_FILE, META_FILE, REPORT_FILE];
-    if command == Command::Merge {
-        writes.push(REFERENCES_FILE);
+    match command {
+        Command::Merge => writes.push(REFERENCES_FILE),
+        Command::Sweep => writes.extend([PASS_COST_FILE, ANCHOR_FILE]),
+        _ => {}
     }
     let owner = Owner {
         command,

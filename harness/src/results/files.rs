@@ -11,6 +11,11 @@ pub const SUMMARY_FILE: &str = "summary.csv";
 pub const META_FILE: &str = "meta.json";
 /// Every shard's `seq` rows, in a merge of shards (`bench-sph merge`; `summary.csv`'s columns).
 pub const REFERENCES_FILE: &str = "references.csv";
+/// What a pass costs each strategy at each core count (`sweep --pass-cost`;
+/// [`crate::run::pass_cost::CostRow`]).
+pub const PASS_COST_FILE: &str = "pass-cost.csv";
+/// The OpenMP anchor's runs (`sweep --anchor`; [`super::anchor::AnchorRun`]).
+pub const ANCHOR_FILE: &str = "anchor.csv";
 /// The report's file name.
 pub const REPORT_FILE: &str = "REPORT.md";
 

@@ -21,7 +21,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 
-use super::files::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
+use super::anchor::{ANCHOR_COLUMNS, AnchorRun};
+use super::files::{ANCHOR_FILE, META_FILE, PASS_COST_FILE, SUMMARY_FILE, TRIALS_FILE};
 use super::key::Cell;
 use super::meta::Meta;
 use super::rows::{
@@ -30,6 +31,7 @@ use super::rows::{
 };
 use super::validate;
 use crate::io::capped;
+use crate::run::pass_cost::{CostRow, PASS_COST_COLUMNS};
 
 /// One sweep's results.
 #[derive(Debug, Clone)]
@@ -53,6 +55,11 @@ pub struct Sweep {
     /// against its runs (only [`validate::summary_alone`]), so the report takes them on trust
     /// and says so.
     pub without_trials: bool,
+    /// Its `pass-cost.csv` (`sweep --pass-cost`): what a pass costs each strategy at each core
+    /// count; empty without one.
+    pub pass_costs: Vec<CostRow>,
+    /// Its `anchor.csv` (`sweep --anchor`): the OpenMP anchor's runs; empty without one.
+    pub anchor: Vec<AnchorRun>,
 }
 
 /// Reads every directory of `dirs`, refusing a directory given twice (under any path).
@@ -137,7 +144,14 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
             dropped.first().map_or("", String::as_str)
         );
     }
+    let (pass_costs, bad) =
+        read_beside(&dir.join(PASS_COST_FILE), &PASS_COST_COLUMNS, "pass cost")?;
+    dropped.extend(bad);
+    let (anchor, bad) = read_beside(&dir.join(ANCHOR_FILE), &ANCHOR_COLUMNS, "anchor")?;
+    dropped.extend(bad);
     Ok(Sweep {
+        pass_costs,
+        anchor,
         dir: dir.to_path_buf(),
         meta,
         rows,
@@ -266,6 +280,19 @@ pub fn read_trials(path: &Path) -> anyhow::Result<(Vec<TrialRow>, Vec<String>)> 
         &TRIAL_COLUMNS,
         is_older_trial_header,
         "trial",
+    )
+}
+
+/// The rows of a file a sweep writes beside its cells (`pass-cost.csv`, `anchor.csv`) and a
+/// note naming each line that is not a row; none without the file.
+fn read_beside<R: serde::de::DeserializeOwned>(
+    path: &Path,
+    columns: &[&str],
+    what: &str,
+) -> anyhow::Result<(Vec<R>, Vec<String>)> {
+    Ok(
+        read_csv_if_exists(path, capped::SUMMARY_CSV, columns, |_| false, what)?
+            .unwrap_or_default(),
     )
 }
 

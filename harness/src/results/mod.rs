@@ -20,6 +20,7 @@
 //!   of the files it wrote there (`bench-sph-files.json`, [`crate::output::record`]) and the
 //!   lock file (`bench-sph.lock`, [`crate::output::lock`]).
 
+pub mod anchor;
 pub mod dir;
 pub mod export;
 pub mod files;
@@ -39,4 +40,6 @@ pub mod stats;
 pub mod summarize;
 pub mod validate;
 
-pub use files::{META_FILE, REFERENCES_FILE, REPORT_FILE, SUMMARY_FILE, TRIALS_FILE};
+pub use files::{
+    ANCHOR_FILE, META_FILE, PASS_COST_FILE, REFERENCES_FILE, REPORT_FILE, SUMMARY_FILE, TRIALS_FILE,
+};

@@ -1,6 +1,8 @@
 //! Every parameter of a sweep: what `meta.json` records and what `--resume` reads back
 //! (checked by [`crate::sweep::params`]).
 
+use std::path::PathBuf;
+
 use serde::{Deserialize, Serialize};
 use sph_strategies::StrategyName;
 
@@ -61,6 +63,14 @@ pub struct SweepParams {
     /// Which part of the plan this sweep runs (`--shard I/K`); absent for the whole plan.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub shard: Option<Shard>,
+    /// Whether the sweep measures what a pass costs each strategy at each core count
+    /// (`--pass-cost`), after its cells, into `pass-cost.csv`.
+    #[serde(default, skip_serializing_if = "is_false")]
+    pub pass_cost: bool,
+    /// The plain loop's OpenMP build the sweep runs at each core count after its cells
+    /// (`--anchor PATH`), into `anchor.csv`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub anchor: Option<PathBuf>,
     /// Test only: trial times replacing the measured ones (see [`crate::sweep::timing`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub fake_timings: Option<String>,
@@ -92,6 +102,12 @@ impl Schedule {
             Schedule::Cells => "cells",
         }
     }
+}
+
+/// Whether a flag is off (then `meta.json` leaves it out, and the plan fingerprints of
+/// sweeps written before it stay as they were).
+fn is_false(flag: &bool) -> bool {
+    !flag
 }
 
 /// `--pin`'s default, and what sweeps written before it ran: the operating system's placement.
@@ -142,6 +158,8 @@ impl SweepParams {
             fake_contention: None,
             pin: unpinned(),
             shard: None,
+            pass_cost: false,
+            anchor: None,
         }
     }
 }

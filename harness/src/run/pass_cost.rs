@@ -14,7 +14,11 @@
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
+use anyhow::Context;
+use serde::{Deserialize, Serialize};
 use sph_strategies::{Config, Executor, KernelPanic, Session, StrategyName};
+
+use crate::results::intervals::ratio;
 
 /// Elements of a pass's output per thread: two cache lines each.
 pub const PER_CORE: usize = 16;
@@ -72,6 +76,99 @@ pub fn measure(
     Ok(super::in_session(strategy, &config, session)??)
 }
 
+/// `pass-cost.csv`'s header: [`CostRow`]'s fields.
+pub const PASS_COST_COLUMNS: [&str; 8] = [
+    "strategy",
+    "cores",
+    "work_us",
+    "pass_us",
+    "pass_low_us",
+    "pass_high_us",
+    "beyond_work_us",
+    "oversubscribed",
+];
+
+/// One strategy's pass at one core count: a line of `bench-sph overhead` and a row of a
+/// sweep's `pass-cost.csv` ([`crate::results::PASS_COST_FILE`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CostRow {
+    /// The strategy's name.
+    pub strategy: String,
+    /// Its worker threads (one chunk each).
+    pub cores: usize,
+    /// The work of a pass per thread, µs.
+    pub work_us: f64,
+    /// Typical time a pass, µs: the geometric mean of the rounds' mean times a pass (as a
+    /// sweep's cell times), and its 95 % interval.
+    pub pass_us: f64,
+    /// The interval's low end, µs.
+    pub pass_low_us: f64,
+    /// The interval's high end, µs.
+    pub pass_high_us: f64,
+    /// `pass_us` less the work a thread: the strategy's cost a pass.
+    pub beyond_work_us: f64,
+    /// More threads than the machine's hardware threads.
+    pub oversubscribed: bool,
+}
+
+/// The cells `strategies` × `cores` of a pass-cost table: a strategy that runs every pass on
+/// the calling thread (`seq`) is measured at one core only.
+pub fn cells(strategies: &[StrategyName], cores: &[usize]) -> Vec<(StrategyName, usize)> {
+    strategies
+        .iter()
+        .flat_map(|&s| {
+            let mut at: Vec<usize> = cores.iter().map(|&c| s.info().effective_cores(c)).collect();
+            at.dedup();
+            at.into_iter().map(move |c| (s, c))
+        })
+        .collect()
+}
+
+/// Measures each of `cells` (strategy, cores) for `rounds` rounds of `passes` passes with
+/// `work` a thread, the cells taking turns round by round so that a slow spell of the machine
+/// hits them all, and returns their rows (`hardware` threads flag the oversubscribed).
+/// `rounds` must be at least [`crate::results::intervals::MIN_ROUNDS`] for an interval.
+/// `stop` is asked before each measurement; when it says stop, returns `None`.
+pub fn table(
+    cells: &[(StrategyName, usize)],
+    work: Duration,
+    passes: u64,
+    rounds: usize,
+    hardware: usize,
+    stop: impl Fn() -> bool,
+) -> anyhow::Result<Option<Vec<CostRow>>> {
+    let mut times = vec![Vec::with_capacity(rounds); cells.len()];
+    for _ in 0..rounds {
+        for (&(strategy, cores), times) in cells.iter().zip(&mut times) {
+            if stop() {
+                return Ok(None);
+            }
+            let round = measure(strategy, cores, work, passes, 1)
+                .with_context(|| format!("{strategy} at {cores} cores"))?;
+            times.extend(round);
+        }
+    }
+    let us = |s: f64| s * 1e6;
+    let rows = cells.iter().zip(&times).map(|(&(strategy, cores), times)| {
+        // Every round's time is positive and finite (a pass takes time).
+        let typical = ratio(times).expect("positive times");
+        let (low, high) = typical
+            .interval
+            .map_or((f64::NAN, f64::NAN), |i| (i.low, i.high));
+        CostRow {
+            strategy: strategy.info().name.to_string(),
+            cores,
+            work_us: us(work.as_secs_f64()),
+            pass_us: us(typical.value),
+            pass_low_us: us(low),
+            pass_high_us: us(high),
+            beyond_work_us: us(typical.value) - us(work.as_secs_f64()),
+            oversubscribed: cores > hardware,
+        }
+    });
+    Ok(Some(rows.collect()))
+}
+
 struct Rounds {
     cores: usize,
     work: Duration,
@@ -111,6 +208,40 @@ mod tests {
                 "{strategy}: {rounds:?}"
             );
         }
+    }
+
+    #[test]
+    fn a_table_has_one_row_per_cell_with_its_interval_around_its_typical_pass() {
+        let cells = cells(&[StrategyName::Seq, StrategyName::RayonChunks], &[1, 2]);
+        // seq is measured once: at more cores it still runs on the calling thread.
+        assert_eq!(
+            cells,
+            [
+                (StrategyName::Seq, 1),
+                (StrategyName::RayonChunks, 1),
+                (StrategyName::RayonChunks, 2)
+            ]
+        );
+        let work = Duration::from_micros(10);
+        let rows = table(&cells, work, 10, 3, 1, || false).unwrap().unwrap();
+        assert_eq!(rows.len(), 3);
+        for r in &rows {
+            assert!(
+                r.pass_low_us <= r.pass_us && r.pass_us <= r.pass_high_us,
+                "{r:?}"
+            );
+            assert!(r.pass_us >= 10.0, "a pass takes at least its work: {r:?}");
+            assert!(
+                (r.beyond_work_us - (r.pass_us - 10.0)).abs() < 1e-9,
+                "{r:?}"
+            );
+            assert_eq!(r.oversubscribed, r.cores > 1, "{r:?}");
+        }
+        let stopped = table(&cells, work, 10, 3, 1, || true).unwrap();
+        assert!(
+            stopped.is_none(),
+            "a stop asked before a measurement ends the table"
+        );
     }
 
     #[test]

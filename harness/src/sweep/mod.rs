@@ -14,6 +14,8 @@
 //!
 //! What a results directory holds, and how it is read back, is [`crate::results`].
 
+pub mod anchor;
+pub mod beside;
 pub mod confirm;
 pub mod console;
 #[cfg(test)]
@@ -174,6 +176,16 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
     // Say what will happen before anything slow: the plan, the machine's load, then the
     // estimate (from short, bounded seq runs).
     print_plan(&opened.dir, &params, &plan, &left, hardware_threads);
+    if params.pass_cost {
+        print("  then: what a pass costs each strategy at each core count (--pass-cost)");
+    }
+    if let Some(path) = &params.anchor {
+        print(&format!(
+            "  then: the OpenMP anchor '{}' at each core count, {} (--anchor)",
+            path.display(),
+            plural(params.trials, "round", "rounds")
+        ));
+    }
     if request.wait_quiet_s > 0 {
         print(&format!(
             "  before each round, waits up to {} for a quiet machine (--wait-quiet)",
@@ -223,7 +235,24 @@ pub fn run(request: Request) -> anyhow::Result<Finished> {
     let outcome = runner.run(&kept);
     runner.progress.finish_and_clear();
     let outcome = outcome?;
-    conclude(opened, plan, outcome.rows, outcome.interrupted)
+    // Pass costs and the anchor, once every cell is measured. Where they stop or fail, the
+    // sweep ends as interrupted (its cells kept), so that `--resume` measures them.
+    let measured: Vec<&SummaryRow> = opened.finished.iter().chain(&outcome.rows).collect();
+    let grid = measured.iter().filter(|r| r.phase == Phase::Grid).count();
+    let beside = if !outcome.interrupted && grid >= plan.cells.len() {
+        beside::measure(&opened.dir, &plan, &params, &measured, hardware_threads)
+    } else {
+        Ok(true)
+    };
+    let interrupted = outcome.interrupted || !matches!(beside, Ok(true));
+    let finished = conclude(opened, plan, outcome.rows, interrupted)?;
+    beside.map_err(|e| {
+        anyhow::anyhow!(
+            "{e:#}; the cells are kept: fix it and continue with --resume {}",
+            finished.dir.display()
+        )
+    })?;
+    Ok(finished)
 }
 
 /// The runs a sweep has left: per plan position, the timed runs still to do (the grid's, plus
@@ -528,7 +557,14 @@ fn start_new(
         None => results_dir::new_default()?,
     };
     let mut claimed = results_dir::open_new(&dir, force, Command::Sweep)?;
-    claimed.record(&[TRIALS_FILE, SUMMARY_FILE, META_FILE])?;
+    let mut files = vec![TRIALS_FILE, SUMMARY_FILE, META_FILE];
+    if params.pass_cost {
+        files.push(crate::results::PASS_COST_FILE);
+    }
+    if params.anchor.is_some() {
+        files.push(crate::results::ANCHOR_FILE);
+    }
+    claimed.record(&files)?;
     let lock = claimed.lock();
     let plan = Plan::new(params);
     let meta = Meta::new(params.clone(), plan.cells.len(), session);
@@ -831,5 +867,22 @@ fn paths_text(dir: &Path, rows: &[SummaryRow]) -> String {
         "  {:<40} machine, build, command lines, parameters\n",
         dir.join(META_FILE).display().to_string()
     ));
+    for (name, what) in [
+        (
+            crate::results::PASS_COST_FILE,
+            "what a pass costs each strategy (--pass-cost)",
+        ),
+        (
+            crate::results::ANCHOR_FILE,
+            "the OpenMP anchor's runs (--anchor)",
+        ),
+    ] {
+        if dir.join(name).is_file() {
+            text.push_str(&format!(
+                "  {:<40} {what}\n",
+                dir.join(name).display().to_string()
+            ));
+        }
+    }
     text
 }

@@ -63,6 +63,13 @@ impl SweepParams {
             self.fake_contention.as_deref(),
         )?;
         if let Some(shard) = self.shard {
+            if self.pass_cost || self.anchor.is_some() {
+                anyhow::bail!(
+                    "--shard {shard} with --pass-cost or --anchor: a shard holds part of the \
+                     cells, and a merge of shards is not one machine's run; measure them in a \
+                     sweep of their own"
+                );
+            }
             let whole = super::plan::Plan::whole(self);
             if whole.shard(shard).cells.is_empty() {
                 let parts = match whole.non_reference_cells() {
@@ -76,6 +83,9 @@ impl SweepParams {
                     shard.index
                 );
             }
+        }
+        if let Some(path) = &self.anchor {
+            super::anchor::check(self, path)?;
         }
         Ok(())
     }

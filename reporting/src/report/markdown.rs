@@ -511,6 +511,12 @@ fn group(md: &mut String, v: &GroupView, found: &[Finding], input: &Input<'_>) {
     if let Some(band) = &smt {
         smt_paragraph(md, band);
     }
+    let holding: Vec<&Sweep> = input
+        .sweeps
+        .iter()
+        .filter(|s| s.rows.iter().any(|r| r.group() == *g))
+        .collect();
+    super::bends::section(md, v, &holding);
     let _ = writeln!(md, "### Findings\n");
     for finding in found {
         let _ = writeln!(md, "- {}", finding.sentence());

@@ -41,6 +41,7 @@
 //! lists them with their reason.
 
 pub mod answer;
+pub mod bends;
 pub mod cell;
 pub mod charts;
 pub mod compare;

@@ -1149,7 +1149,9 @@ mod tests {
             let full = calls.len().saturating_sub(1);
             assert!(calls[..full].iter().all(|(bits, _)| *bits == u8::MAX));
             assert!(
-                calls.iter().all(|(bits, _)| (bits + 1) & bits == 0),
+                calls
+                    .iter()
+                    .all(|(bits, _)| bits.wrapping_add(1) & bits == 0),
                 "lanes from 0"
             );
         }
