@@ -163,6 +163,12 @@ fn bad_pass_cost_or_anchor_input_is_refused_before_anything_runs() {
         &["Error: --anchor '", "no such program"],
     );
     let script = anchor(tmp.path(), "", false);
+    let plain = tmp.path().join("plain.txt");
+    std::fs::write(&plain, "not a program").unwrap();
+    refused(
+        &["--anchor", plain.to_str().unwrap()],
+        &["Error: --anchor '", "not executable"],
+    );
     refused(
         &["--anchor", script.to_str().unwrap(), "--neighbors", "grid"],
         &["Error: --anchor: the plain loop computes the seed preset with all-pairs"],

@@ -27,10 +27,22 @@ pub fn applies(group: &Group) -> bool {
     group.preset == Preset::Seed && group.neighbors == NeighborMode::AllPairs
 }
 
-/// Refuses an anchor that is not a file, or a sweep with no group it applies to.
+/// Refuses an anchor that is not an executable file, or a sweep with no group it applies to.
 pub fn check(params: &SweepParams, path: &Path) -> anyhow::Result<()> {
     if !path.is_file() {
         bail!("--anchor '{}': no such program", path.display());
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(path)?.permissions().mode();
+        if mode & 0o111 == 0 {
+            bail!(
+                "--anchor '{}': not executable (chmod +x it, or build it with \
+                 scripts/build-plain-loop.sh)",
+                path.display()
+            );
+        }
     }
     if !(params.presets.contains(&Preset::Seed)
         && params.neighbors.contains(&NeighborMode::AllPairs))
