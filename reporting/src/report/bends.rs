@@ -46,7 +46,7 @@ pub fn section(md: &mut String, v: &GroupView, sweeps: &[&Sweep]) {
         .rows
         .iter()
         .find(|r| r.is_reference() && r.is_usable())
-        .and_then(|r| Some((r.mean_s?, r.checksum.clone())))
+        .and_then(|r| Some((r.mean_s?, r.checksum.as_str())))
     else {
         let _ = writeln!(
             md,
@@ -137,7 +137,7 @@ pub fn section(md: &mut String, v: &GroupView, sweeps: &[&Sweep]) {
         });
         bends.push(bend_sentence(name, &rows, pass_us, under));
     }
-    let anchor_note = anchor_rows(&mut table, &anchor, v, &seq.1, applies);
+    let anchor_note = anchor_rows(&mut table, &anchor, v, seq, applies);
     let _ = writeln!(md, "{table}");
     for b in bends.iter().flatten() {
         let _ = writeln!(md, "- {b}");
@@ -201,12 +201,13 @@ fn bend_sentence(
 }
 
 /// Adds the anchor's speedups to `table` where they compare (the group is the plain loop's
-/// and every run computed `seq`'s state, `checksum`), and returns what to say of it.
+/// and every run computed `seq`'s state; `seq` is its mean seconds and checksum), and
+/// returns what to say of it.
 fn anchor_rows(
     table: &mut Table,
     anchor: &[AnchorRun],
     v: &GroupView,
-    checksum: &str,
+    (seq_s, checksum): (f64, &str),
     applies: bool,
 ) -> Option<String> {
     if anchor.is_empty() || !applies {
@@ -242,13 +243,28 @@ fn anchor_rows(
             ),
         ]);
     }
-    Some(
+    let mut one: Vec<f64> = anchor
+        .iter()
+        .filter(|r| r.threads == 1)
+        .map(|r| r.wall_s)
+        .collect();
+    one.sort_by(f64::total_cmp);
+    let pace = one.get(one.len() / 2).map_or(String::new(), |&median| {
+        format!(
+            " On one thread it takes {} s a run (median), {} `seq`'s {} s: each of its passes \
+             holds that much more work, so the same fork and join costs it that much less of \
+             a pass — compare speedups knowing that, and times for what each run costs.",
+            sig(median),
+            times(median / seq_s),
+            sig(seq_s)
+        )
+    });
+    Some(format!(
         "The OpenMP plain loop is `benches/plain-loop/mueller.cpp` built with `-fopenmp` \
          (each pass `omp parallel for schedule(static)`), run by the sweep after its cells on \
          the same machine, in rounds; its speedup pairs each round's run with the round's \
-         1-thread run, and it computed `seq`'s state bit for bit."
-            .into(),
-    )
+         1-thread run, and it computed `seq`'s state bit for bit.{pace}"
+    ))
 }
 
 #[cfg(test)]
