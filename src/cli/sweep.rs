@@ -27,7 +27,7 @@ const QUICK_TRIALS: usize = 3;
 ///
 /// Not an `ArgGroup` that conflicts with `--resume`: clap's error for `--resume DIR --n 5`
 /// would then list every member of the group instead of naming `--n`.
-const NEW_SWEEP_ONLY: [&str; 19] = [
+const NEW_SWEEP_ONLY: [&str; 21] = [
     "cores",
     "chunks",
     "strategies",
@@ -47,6 +47,8 @@ const NEW_SWEEP_ONLY: [&str; 19] = [
     "fake_contention",
     "shard",
     "pin",
+    "pass_cost",
+    "anchor",
 ];
 
 /// Makes each of [`NEW_SWEEP_ONLY`] conflict with `--resume` (in place, keeping clap's order).
@@ -138,7 +140,8 @@ pub struct SweepArgs {
     pub shard: Option<Shard>,
     /// After the cells, measure what a pass costs each strategy at each core count (as
     /// `bench-sph overhead` does, 5 µs of work a thread) into pass-cost.csv; the report sets it
-    /// beside the workload's own pass. Adds about a second per strategy and core count.
+    /// beside the workload's own pass. Adds about a tenth of a second per strategy and core
+    /// count (std-static: a second).
     #[arg(long)]
     pub pass_cost: bool,
     /// After the cells, run PATH, the plain C++ loop's OpenMP build
@@ -332,6 +335,13 @@ fn anchor_path(path: &Path) -> anyhow::Result<PathBuf> {
         .with_context(|| format!("--anchor '{}': no such program", path.display()))?;
     if !found.is_file() {
         anyhow::bail!("--anchor '{}': not a program file", path.display());
+    }
+    // meta.json records the path as text.
+    if found.to_str().is_none() {
+        anyhow::bail!(
+            "--anchor '{}': the path is not valid UTF-8; give a path without such characters",
+            path.display()
+        );
     }
     Ok(found)
 }

@@ -178,3 +178,22 @@ fn bad_pass_cost_or_anchor_input_is_refused_before_anything_runs() {
         &["Error: --shard 1/2 with --pass-cost or --anchor"],
     );
 }
+
+#[test]
+fn a_pass_cost_file_the_sweep_did_not_measure_is_not_reported() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let o = tiny_fake_sweep_into(&out, &["--no-plots"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // Someone's own file of that name, well-formed: not the sweep's, so not read.
+    std::fs::write(
+        out.join("pass-cost.csv"),
+        "strategy,cores,work_us,pass_us,pass_low_us,pass_high_us,beyond_work_us,oversubscribed\n\
+         rayon-chunks,2,5.0,6.5,6.4,6.6,1.5,false\n",
+    )
+    .unwrap();
+    let o = run(&["report", out.to_str().unwrap(), "--force"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
+    assert!(!report.contains("Where the curves bend"), "{report}");
+}

@@ -155,7 +155,12 @@ pub fn run(request: &Request) -> anyhow::Result<Merged> {
         ));
     }
     let meta = merged_meta(&read, &shards, &params, &whole, &merged, &warnings);
-    let mut claimed = crate::results::dir::open_new(&request.out, request.force, Command::Merge)?;
+    let mut claimed = crate::results::dir::open_new(
+        &request.out,
+        request.force,
+        Command::Merge,
+        &[REFERENCES_FILE],
+    )?;
     claimed.record(&[TRIALS_FILE, SUMMARY_FILE, REFERENCES_FILE, META_FILE])?;
     write_all(&request.out, &merged, &meta)?;
     drop(claimed);

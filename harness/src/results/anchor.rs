@@ -45,6 +45,20 @@ pub struct AnchorRun {
     pub oversubscribed: bool,
 }
 
+impl AnchorRun {
+    /// What makes the run impossible, if anything: no particles, steps or threads, no round,
+    /// or a time that is not finite and positive.
+    pub fn problem(&self) -> Option<String> {
+        if self.n == 0 || self.steps == 0 || self.threads == 0 || self.round == 0 {
+            return Some("n, steps, threads and round must each be at least 1".into());
+        }
+        if !(self.wall_s.is_finite() && self.wall_s > 0.0) {
+            return Some(format!("time {} s", self.wall_s));
+        }
+        None
+    }
+}
+
 /// The anchor's speedup at one thread count in one group.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AnchorSpeedup {

@@ -21,8 +21,8 @@ use super::files::{META_FILE, SUMMARY_FILE, TRIALS_FILE};
 use crate::output::claim::{self, Claimed, Owner};
 use crate::output::lock::{self, DirLock, LOCK_FILE};
 use crate::output::record::{self, Command, Record};
+use crate::results::REPORT_FILE;
 use crate::results::meta::Meta;
-use crate::results::{ANCHOR_FILE, PASS_COST_FILE, REFERENCES_FILE, REPORT_FILE};
 
 /// The default results directory: `results/<UTC timestamp>`, or with `-2`, `-3`, … when a
 /// sweep started in the same second took that name. Created here, exclusively.
@@ -53,10 +53,16 @@ pub fn new_default() -> anyhow::Result<PathBuf> {
     )
 }
 
-/// Locks and claims `dir` for a new sweep or merge (`command`): refuses foreign files (unless
-/// `force`, which leaves them untouched) and earlier results (unless `force`, which removes
-/// them and the report drawn there). Returns the claimed directory, still locked.
-pub fn open_new(dir: &Path, force: bool, command: Command) -> anyhow::Result<Claimed> {
+/// Locks and claims `dir` for a new sweep or merge (`command`) that writes `also` beside the
+/// results files and the report: refuses foreign files (unless `force`, which leaves them
+/// untouched) and earlier results (unless `force`, which removes them and the report drawn
+/// there). Returns the claimed directory, still locked.
+pub fn open_new(
+    dir: &Path,
+    force: bool,
+    command: Command,
+    also: &[&'static str],
+) -> anyhow::Result<Claimed> {
     if dir.exists() && !dir.is_dir() {
         bail!("--out '{}' exists and is not a directory", dir.display());
     }
@@ -64,11 +70,7 @@ pub fn open_new(dir: &Path, force: bool, command: Command) -> anyhow::Result<Cla
         .with_context(|| format!("cannot create results directory '{}'", dir.display()))?;
     // Every file of the results, and the report, must be writable before anything is.
     let mut writes = vec![TRIALS_FILE, SUMMARY_FILE, META_FILE, REPORT_FILE];
-    match command {
-        Command::Merge => writes.push(REFERENCES_FILE),
-        Command::Sweep => writes.extend([PASS_COST_FILE, ANCHOR_FILE]),
-        _ => {}
-    }
+    writes.extend(also);
     let owner = Owner {
         command,
         option: "--out",

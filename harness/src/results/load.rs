@@ -144,10 +144,26 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
             dropped.first().map_or("", String::as_str)
         );
     }
-    let (pass_costs, bad) =
-        read_beside(&dir.join(PASS_COST_FILE), &PASS_COST_COLUMNS, "pass cost")?;
+    // Read only where the sweep measured them: a file of that name is otherwise not its.
+    let (pass_costs, bad) = match meta.params.pass_cost {
+        true => read_beside(
+            &dir.join(PASS_COST_FILE),
+            &PASS_COST_COLUMNS,
+            "pass cost",
+            |r: &CostRow| r.problem(),
+        )?,
+        false => Default::default(),
+    };
     dropped.extend(bad);
-    let (anchor, bad) = read_beside(&dir.join(ANCHOR_FILE), &ANCHOR_COLUMNS, "anchor")?;
+    let (anchor, bad) = match meta.params.anchor.is_some() {
+        true => read_beside(
+            &dir.join(ANCHOR_FILE),
+            &ANCHOR_COLUMNS,
+            "anchor",
+            |r: &AnchorRun| r.problem(),
+        )?,
+        false => Default::default(),
+    };
     dropped.extend(bad);
     Ok(Sweep {
         pass_costs,
@@ -283,17 +299,32 @@ pub fn read_trials(path: &Path) -> anyhow::Result<(Vec<TrialRow>, Vec<String>)> 
     )
 }
 
-/// The rows of a file a sweep writes beside its cells (`pass-cost.csv`, `anchor.csv`) and a
-/// note naming each line that is not a row; none without the file.
+/// The rows of a file a sweep writes beside its cells (`pass-cost.csv`, `anchor.csv`), and a
+/// note naming each line that is not a row or whose numbers are impossible (`problem`); none
+/// without the file.
 fn read_beside<R: serde::de::DeserializeOwned>(
     path: &Path,
     columns: &[&str],
     what: &str,
+    problem: impl Fn(&R) -> Option<String>,
 ) -> anyhow::Result<(Vec<R>, Vec<String>)> {
-    Ok(
+    let (rows, mut bad): (Vec<R>, Vec<String>) =
         read_csv_if_exists(path, capped::SUMMARY_CSV, columns, |_| false, what)?
-            .unwrap_or_default(),
-    )
+            .unwrap_or_default();
+    let mut kept = Vec::with_capacity(rows.len());
+    for (i, row) in rows.into_iter().enumerate() {
+        match problem(&row) {
+            // The header is line 1; a row that did not parse is already noted, so the number
+            // is the row's place among those that did.
+            Some(why) => bad.push(format!(
+                "'{}' {what} row {}: left out ({why})",
+                path.display(),
+                i + 1
+            )),
+            None => kept.push(row),
+        }
+    }
+    Ok((kept, bad))
 }
 
 /// The rows and notes of [`read_csv`]; a missing file is an error.
@@ -410,5 +441,38 @@ mod tests {
             bad[0].contains("line 3: not a bench-sph summary row"),
             "{bad:?}"
         );
+    }
+
+    #[test]
+    fn a_pass_cost_row_with_impossible_numbers_is_left_out_naming_why() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(PASS_COST_FILE);
+        let header = PASS_COST_COLUMNS.join(",");
+        std::fs::write(
+            &path,
+            format!(
+                "{header}\nteam,2,5.0,6.5,6.4,6.6,1.5,false\nteam,2,5.0,NaN,6.4,6.6,NaN,false\n\
+                 team,0,5.0,6.5,6.4,6.6,1.5,false\nteam,2,5.0,6.5,6.6,6.7,1.5,false\n"
+            ),
+        )
+        .unwrap();
+        let (rows, bad): (Vec<CostRow>, _) =
+            read_beside(&path, &PASS_COST_COLUMNS, "pass cost", CostRow::problem).unwrap();
+        assert_eq!(rows.len(), 1);
+        assert_eq!(bad.len(), 3, "{bad:?}");
+        assert!(
+            bad[0].contains("row 2: left out (a time that is not finite"),
+            "{bad:?}"
+        );
+        assert!(bad[1].contains("row 3: left out (0 cores)"), "{bad:?}");
+        assert!(bad[2].contains("does not hold its time"), "{bad:?}");
+        let none: (Vec<CostRow>, _) = read_beside(
+            &dir.path().join("missing.csv"),
+            &PASS_COST_COLUMNS,
+            "pass cost",
+            CostRow::problem,
+        )
+        .unwrap();
+        assert!(none.0.is_empty() && none.1.is_empty());
     }
 }

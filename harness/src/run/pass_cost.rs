@@ -111,6 +111,31 @@ pub struct CostRow {
     pub oversubscribed: bool,
 }
 
+impl CostRow {
+    /// What makes the row impossible, if anything: no threads, or a time that is not finite
+    /// and positive, or an interval that does not hold its centre.
+    pub fn problem(&self) -> Option<String> {
+        let times = [self.pass_us, self.pass_low_us, self.pass_high_us];
+        if self.cores == 0 {
+            return Some("0 cores".into());
+        }
+        if !(self.work_us.is_finite() && self.work_us >= 0.0) {
+            return Some(format!("work {} µs", self.work_us));
+        }
+        if times.iter().any(|t| !(t.is_finite() && *t > 0.0)) {
+            return Some("a time that is not finite and positive".into());
+        }
+        if !(self.pass_low_us <= self.pass_us && self.pass_us <= self.pass_high_us) {
+            return Some("an interval that does not hold its time".into());
+        }
+        let beyond = self.pass_us - self.work_us;
+        if (self.beyond_work_us - beyond).abs() > 1e-6 * self.pass_us.max(1.0) {
+            return Some("beyond_work_us is not pass_us - work_us".into());
+        }
+        None
+    }
+}
+
 /// The cells `strategies` × `cores` of a pass-cost table: a strategy that runs every pass on
 /// the calling thread (`seq`) is measured at one core only.
 pub fn cells(strategies: &[StrategyName], cores: &[usize]) -> Vec<(StrategyName, usize)> {

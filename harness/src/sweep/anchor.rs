@@ -8,7 +8,8 @@
 
 use std::io::Read;
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, bail};
@@ -92,8 +93,11 @@ pub fn measure(
             return Ok(None);
         }
         let t = run.cell;
-        let printed = run_once(path, group, t, params.seed, limit)
-            .with_context(|| format!("--anchor '{}' on {t} threads", path.display()))?;
+        let Some(printed) = run_once(path, group, t, params.seed, limit)
+            .with_context(|| format!("--anchor '{}' on {t} threads", path.display()))?
+        else {
+            return Ok(None);
+        };
         runs.push(AnchorRun {
             n: group.n,
             steps: group.steps,
@@ -109,14 +113,15 @@ pub fn measure(
     Ok(Some(runs))
 }
 
-/// One run of the program: what it printed, checked against what it was asked.
+/// One run of the program: what it printed, checked against what it was asked; `None` when a
+/// signal asked the sweep to stop (the program is then killed, and its end is no error).
 fn run_once(
     path: &Path,
     group: &Group,
     threads: usize,
     seed: u64,
     limit: Duration,
-) -> anyhow::Result<Printed> {
+) -> anyhow::Result<Option<Printed>> {
     let mut child = Command::new(path)
         .args([
             group.n.to_string(),
@@ -129,30 +134,29 @@ fn run_once(
         .stderr(Stdio::piped())
         .spawn()
         .context("cannot start it")?;
-    let began = Instant::now();
-    let status = loop {
-        if let Some(status) = child.try_wait()? {
-            break status;
-        }
-        if began.elapsed() > limit || crate::signals::requested() {
-            // Best effort: it may have ended in between.
-            let _ = child.kill();
-            let _ = child.wait();
-            bail!(
-                "stopped after {:.0} s without an answer",
-                limit.as_secs_f64()
-            );
-        }
-        std::thread::sleep(Duration::from_millis(5));
+    // Both pipes are read while it runs, so that no amount of output stalls it.
+    let out = drain(child.stdout.take());
+    let err = drain(child.stderr.take());
+    let ended = wait_within(&mut child, limit);
+    if !matches!(ended, Ok(Some(_))) {
+        // Stopped, hung or unwaitable: it must not outlive the sweep (best effort: it may
+        // have ended in between).
+        let _ = child.kill();
+        let _ = child.wait();
+    }
+    let status = match ended? {
+        Some(status) => status,
+        None if crate::signals::requested() => return Ok(None),
+        None => bail!(
+            "stopped after {:.0} s without an answer",
+            limit.as_secs_f64()
+        ),
     };
-    let mut out = String::new();
-    let mut err = String::new();
-    if let Some(mut s) = child.stdout.take() {
-        s.read_to_string(&mut out)?;
+    if crate::signals::requested() {
+        // Ctrl-C reaches the program too: whatever it printed, the sweep stops.
+        return Ok(None);
     }
-    if let Some(mut s) = child.stderr.take() {
-        s.read_to_string(&mut err)?;
-    }
+    let (out, err) = (collected(out)?, collected(err)?);
     if !status.success() {
         bail!("it failed ({status}): {}", err.trim());
     }
@@ -174,5 +178,49 @@ fn run_once(
     if !(printed.wall_s.is_finite() && printed.wall_s > 0.0) {
         bail!("it printed the time {}", printed.wall_s);
     }
-    Ok(printed)
+    Ok(Some(printed))
+}
+
+/// Waits for `child` to end within `limit`: its status, or `None` when the limit passed or a
+/// signal asked the sweep to stop first.
+fn wait_within(child: &mut Child, limit: Duration) -> anyhow::Result<Option<ExitStatus>> {
+    let began = Instant::now();
+    loop {
+        if let Some(status) = child.try_wait()? {
+            return Ok(Some(status));
+        }
+        if began.elapsed() > limit || crate::signals::requested() {
+            return Ok(None);
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+}
+
+/// How long a pipe may stay open after its program ended (a program it started may hold it).
+const PIPE_GRACE: Duration = Duration::from_secs(5);
+
+/// Reads `pipe` to its end on a thread of its own; the text arrives on the receiver.
+fn drain(pipe: Option<impl Read + Send + 'static>) -> mpsc::Receiver<std::io::Result<String>> {
+    let (send, receive) = mpsc::channel();
+    if let Some(mut pipe) = pipe {
+        std::thread::spawn(move || {
+            let mut text = String::new();
+            let read = pipe.read_to_string(&mut text).map(|_| text);
+            let _ = send.send(read);
+        });
+    } else {
+        let _ = send.send(Ok(String::new()));
+    }
+    receive
+}
+
+/// The text [`drain`] read, once its program has ended.
+fn collected(text: mpsc::Receiver<std::io::Result<String>>) -> anyhow::Result<String> {
+    match text.recv_timeout(PIPE_GRACE) {
+        Ok(read) => Ok(read.context("cannot read its output")?),
+        Err(_) => bail!(
+            "its output stayed open {} s after it ended (a program it started holds it?)",
+            PIPE_GRACE.as_secs()
+        ),
+    }
 }

@@ -556,15 +556,15 @@ fn start_new(
         Some(dir) => dir.to_path_buf(),
         None => results_dir::new_default()?,
     };
-    let mut claimed = results_dir::open_new(&dir, force, Command::Sweep)?;
-    let mut files = vec![TRIALS_FILE, SUMMARY_FILE, META_FILE];
+    let mut beside = Vec::new();
     if params.pass_cost {
-        files.push(crate::results::PASS_COST_FILE);
+        beside.push(crate::results::PASS_COST_FILE);
     }
     if params.anchor.is_some() {
-        files.push(crate::results::ANCHOR_FILE);
+        beside.push(crate::results::ANCHOR_FILE);
     }
-    claimed.record(&files)?;
+    let mut claimed = results_dir::open_new(&dir, force, Command::Sweep, &beside)?;
+    claimed.record(&[&[TRIALS_FILE, SUMMARY_FILE, META_FILE][..], &beside].concat())?;
     let lock = claimed.lock();
     let plan = Plan::new(params);
     let meta = Meta::new(params.clone(), plan.cells.len(), session);

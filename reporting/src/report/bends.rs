@@ -6,10 +6,12 @@
 //! The model is the simplest that explains a bend: a step is `P` passes (the preset's), `seq`
 //! takes `S` a step, so a pass holds `S / P` of work and, shared by `p` threads, `W = S / (P p)`
 //! a thread. A strategy that costs `c` a pass beyond its work then takes `W + c` a pass where
-//! `seq` takes `p W`: its speedup is at most `p W / (W + c)`. The bound leaves out what else
-//! bends a curve (a step's serial parts, uneven chunks, memory bandwidth, a shared core), so a
-//! measured speedup well under it says the cost is elsewhere; and `c` is measured with a few µs
-//! of work a thread, one chunk a thread, so a strategy given many chunks pays more.
+//! `seq` takes `p W`: were that its only loss, its speedup would be `p W / (W + c)`. It is a
+//! model, not a bound: it leaves out what else bends a curve (a step's serial parts, uneven
+//! chunks, memory bandwidth, a shared core), so a measured speedup well under it says the cost
+//! is elsewhere; and `c` is measured apart, with a few µs of work a thread and one chunk a
+//! thread, so a run's passes may cost more (many chunks) or less (a quieter spell) than `c`,
+//! and a measured speedup well above it says so.
 
 use std::fmt::Write as _;
 
@@ -23,7 +25,7 @@ use sph_harness::run::pass_cost::CostRow;
 use sph_harness::topology::Pin;
 use sph_solver::solver::Pass;
 
-/// Efficiency the bound must fall under for a strategy's curve to count as bent: its pass
+/// Efficiency the model must fall under for a strategy's curve to count as bent: its pass
 /// cost is then more than a quarter of the work a thread.
 pub const BENT: f64 = 0.8;
 
@@ -64,9 +66,10 @@ pub fn section(md: &mut String, v: &GroupView, sweeps: &[&Sweep]) {
         md,
         "A step of this workload is {passes} passes; `seq` takes {} µs a step, so a pass holds \
          {} µs of work, W = {} µs / p a thread at p threads. A strategy whose pass costs c \
-         beyond its work (measured by `--pass-cost`: 5 µs of work a thread, one chunk a \
-         thread) can reach at most p·W / (W + c); it bends where c nears W. The bound leaves \
-         out the step's serial parts, uneven chunks and memory bandwidth.\n",
+         beyond its work (measured apart by `--pass-cost`: 5 µs of work a thread, one chunk a \
+         thread) would reach p·W / (W + c) were that its only loss; it bends where c nears W. \
+         The model leaves out the step's serial parts, uneven chunks, memory bandwidth and a \
+         shared core, and c moves with the machine's state.\n",
         sig(pass_us * passes as f64),
         sig(pass_us),
         sig(pass_us)
@@ -82,7 +85,7 @@ pub fn section(md: &mut String, v: &GroupView, sweeps: &[&Sweep]) {
         Column::right("cores"),
         Column::right("pass cost c, µs [95 %]"),
         Column::right("work a thread W, µs"),
-        Column::right("bound p·W/(W+c)"),
+        Column::right("model p·W/(W+c)"),
         Column::right("measured speedup [95 %]"),
     ]);
     let mut bends = Vec::new();
@@ -94,7 +97,7 @@ pub fn section(md: &mut String, v: &GroupView, sweeps: &[&Sweep]) {
             .collect();
         rows.sort_by_key(|c| c.cores);
         for c in &rows {
-            let (w, bound) = bound(c, pass_us);
+            let (w, expected) = model(c, pass_us);
             let measured = bests
                 .iter()
                 .find(|b| b.strategy == s && b.cores == c.cores)
@@ -122,20 +125,23 @@ pub fn section(md: &mut String, v: &GroupView, sweeps: &[&Sweep]) {
                     sig(c.pass_high_us - c.work_us)
                 ),
                 sig(w),
-                format!("{}{flag}", times(bound)),
+                format!("{}{flag}", times(expected)),
                 measured,
             ]);
         }
-        let under = rows.iter().find_map(|c| {
-            let (_, bound) = bound(c, pass_us);
+        let apart = rows.iter().find_map(|c| {
+            let (_, model) = model(c, pass_us);
             let b = bests
                 .iter()
                 .find(|b| b.strategy == s && b.cores == c.cores)?;
-            let high = b.speedup_ci?.high;
-            let speedup = b.speedup?;
-            (high < bound).then_some((c.cores, speedup, bound))
+            let (interval, speedup) = (b.speedup_ci?, b.speedup?);
+            (interval.high < model || interval.low > model).then_some(Apart {
+                cores: c.cores,
+                speedup,
+                model,
+            })
         });
-        bends.push(bend_sentence(name, &rows, pass_us, under));
+        bends.push(bend_sentence(name, &rows, pass_us, apart));
     }
     let anchor_note = anchor_rows(&mut table, &anchor, v, seq, applies);
     let _ = writeln!(md, "{table}");
@@ -150,31 +156,38 @@ pub fn section(md: &mut String, v: &GroupView, sweeps: &[&Sweep]) {
     }
 }
 
-/// The work a thread of a pass of `pass_us` at `c.cores` threads, W, and the speedup a pass
-/// cost of `c` allows, p·W / (W + c).
-fn bound(c: &CostRow, pass_us: f64) -> (f64, f64) {
+/// The work a thread of a pass of `pass_us` at `c.cores` threads, W, and the speedup the
+/// model gives a pass cost of `c`, p·W / (W + c).
+fn model(c: &CostRow, pass_us: f64) -> (f64, f64) {
     let w = pass_us / c.cores as f64;
     (w, c.cores as f64 * w / (w + c.beyond_work_us.max(0.0)))
 }
 
-/// Where `name`'s bound first falls under [`BENT`] efficiency, as a sentence, and where its
-/// measured speedup's interval lies under the bound (`under`: cores, speedup, bound), that the
-/// loss is elsewhere; `None` without pass costs.
+/// A core count where the measured speedup's whole interval lies off the model.
+struct Apart {
+    cores: usize,
+    speedup: f64,
+    model: f64,
+}
+
+/// Where `name`'s model first falls under [`BENT`] efficiency, as a sentence, and where its
+/// measured speedup's interval lies off the model (`apart`), what that says; `None` without
+/// pass costs.
 fn bend_sentence(
     name: &str,
     rows: &[&&CostRow],
     pass_us: f64,
-    under: Option<(usize, f64, f64)>,
+    apart: Option<Apart>,
 ) -> Option<String> {
     let last = rows.last()?;
     let bent = rows
         .iter()
-        .find(|c| bound(c, pass_us).1 / (c.cores as f64) < BENT);
+        .find(|c| model(c, pass_us).1 / (c.cores as f64) < BENT);
     let mut text = match bent {
         Some(c) => format!(
             "**{name}** bends at {} cores: its pass costs {} µs there, more than a quarter of \
-             the {} µs of work a thread, so even a perfect split of the rest stays under {:.0} % \
-             efficiency.",
+             the {} µs of work a thread, so the model stays under {:.0} % efficiency even with \
+             nothing else lost.",
             c.cores,
             sig(c.beyond_work_us),
             sig(pass_us / c.cores as f64),
@@ -186,15 +199,25 @@ fn bend_sentence(
             last.cores
         ),
     };
-    if let Some((cores, speedup, bound)) = under {
+    if let Some(Apart {
+        cores,
+        speedup,
+        model,
+    }) = apart
+    {
+        let why = if speedup < model {
+            "under its model's {model} (the whole interval): what holds it back there is not a \
+             pass's fork and join but something the model leaves out (more tasks or chunks than \
+             threads, uneven chunks, the step's serial parts, a shared core)"
+        } else {
+            "above its model's {model} (the whole interval): its passes cost it less in these \
+             runs than the pass-cost measurement, made apart, says"
+        };
         let _ = write!(
             text,
-            " At {cores} cores it measured {}, under its bound of {} (the whole interval): what \
-             holds it back there is not a pass's fork and join but something the bound leaves \
-             out (more tasks or chunks than threads, uneven chunks, the step's serial parts, \
-             a shared core).",
+            " At {cores} cores it measured {}, {}.",
             times(speedup),
-            times(bound)
+            why.replace("{model}", &times(model))
         );
     }
     Some(text)
@@ -319,7 +342,7 @@ mod tests {
     }
 
     #[test]
-    fn the_bound_is_the_work_a_thread_over_work_and_cost() {
+    fn the_model_is_the_work_a_thread_over_work_and_cost() {
         // W = 500 µs, c = 100 µs: 2 · 500 / 600 = 1.67×.
         let (v, s) = group_and_sweep(100.0, Vec::new());
         let md = render(&v, &s);
@@ -348,18 +371,23 @@ mod tests {
     }
 
     #[test]
-    fn a_measured_speedup_under_its_bound_says_the_loss_is_elsewhere() {
-        // Bound 2 · 500 / 510 = 1.96×; measured 1.5× with an interval of width 0 (equal
-        // rounds): under the bound.
+    fn a_measured_speedup_off_its_model_says_where_the_model_misses() {
+        // Model 2 · 500 / 510 = 1.96×; measured 1.5× with an interval of width 0 (equal
+        // rounds): under the model.
         let (v, s) = group_and_sweep(10.0, Vec::new());
         let md = render(&v, &s);
         assert!(
-            md.contains("At 2 cores it measured 1.50×, under its bound of 1.96×"),
+            md.contains("At 2 cores it measured 1.50×, under its model's 1.96×"),
             "{md}"
         );
-        // c = 1000 µs: bound 2 · 500 / 1500 = 0.667×, below the measured 1.5×: nothing said.
+        // c = 1000 µs: model 2 · 500 / 1500 = 0.667×, under the measured 1.5×: said too.
         let (v, s) = group_and_sweep(1000.0, Vec::new());
-        assert!(!render(&v, &s).contains("under its bound"));
+        let md = render(&v, &s);
+        assert!(!md.contains("under its model"), "{md}");
+        assert!(
+            md.contains("At 2 cores it measured 1.50×, above its model's 0.667×"),
+            "{md}"
+        );
     }
 
     #[test]
