@@ -286,7 +286,8 @@ fn anchor_rows(
         "The OpenMP plain loop is `benches/plain-loop/mueller.cpp` built with `-fopenmp` \
          (each pass `omp parallel for schedule(static)`), run by the sweep after its cells on \
          the same machine, in rounds; its speedup pairs each round's run with the round's \
-         1-thread run, and it computed `seq`'s state bit for bit.{pace}"
+         1-thread run, and it computed `seq`'s state bit for bit. It ran after the cells, so \
+         it stands beside them, not paired with them: no finding compares the two.{pace}"
     ))
 }
 
