@@ -22,6 +22,9 @@
 #   results/grid-50steps/     the grid sweep again at 50 steps (N = 1000, 10 000), and
 #   report/compare/           its comparison with results/grid (report --compare): a
 #                             stand-in for a second machine, labelled as one
+#   results/scaling/          all-pairs at N = 300 and 1000, 1000 steps, every strategy, with
+#                             what a pass costs each and (with a C++ compiler with OpenMP)
+#                             the plain loop's OpenMP build, and its own REPORT.md
 # Run it on a quiet machine: nothing else should compete for the cores while it measures.
 set -euo pipefail
 
@@ -89,3 +92,15 @@ if [ "$contended" -gt 0 ]; then
     exit 1
 fi
 echo "Done: report/REPORT.md (no contended cell)"
+
+# Where the curves bend (book/src/study.md): what a pass costs each strategy, and the plain
+# loop's OpenMP build beside them where a C++ compiler with OpenMP is installed.
+anchor=()
+if scripts/build-plain-loop.sh >/dev/null && [[ -x target/plain-loop/mueller-omp ]]; then
+    anchor=(--anchor target/plain-loop/mueller-omp)
+else
+    echo "no OpenMP build of the plain loop: results/scaling without its anchor" >&2
+fi
+"$BIN" sweep --preset seed --neighbors all-pairs --n 300,1000 --steps 1000 --cores "$CORES" \
+    --chunks 2,4,8,10,20,40 --pass-cost ${anchor[@]+"${anchor[@]}"} --wait-quiet 60 \
+    --out results/scaling --force
