@@ -25,11 +25,11 @@ pub struct OverheadArgs {
     #[arg(long, value_name = "US", default_value_t = 5, value_parser = work_us)]
     pub work_us: u64,
     /// Passes per round (1..=100000).
-    #[arg(long, default_value_t = 1000, value_parser = passes)]
+    #[arg(long, default_value_t = crate::sweep::beside::PASS_PASSES, value_parser = passes)]
     pub passes: u64,
     /// Rounds per cell (3..=100, the fewest that give an interval); the cells take turns
     /// round by round.
-    #[arg(long, default_value_t = 10, value_parser = rounds)]
+    #[arg(long, default_value_t = crate::sweep::beside::PASS_ROUNDS, value_parser = rounds)]
     pub rounds: usize,
     /// Print one JSON object instead of text.
     #[arg(long)]

@@ -145,25 +145,21 @@ pub fn load(dir: &Path) -> anyhow::Result<Sweep> {
         );
     }
     // Read only where the sweep measured them: a file of that name is otherwise not its.
-    let (pass_costs, bad) = match meta.params.pass_cost {
-        true => read_beside(
-            &dir.join(PASS_COST_FILE),
-            &PASS_COST_COLUMNS,
-            "pass cost",
-            |r: &CostRow| r.problem(),
-        )?,
-        false => Default::default(),
-    };
+    let (pass_costs, bad) = read_beside(
+        meta.params.pass_cost,
+        &dir.join(PASS_COST_FILE),
+        &PASS_COST_COLUMNS,
+        "pass cost",
+        CostRow::problem,
+    )?;
     dropped.extend(bad);
-    let (anchor, bad) = match meta.params.anchor.is_some() {
-        true => read_beside(
-            &dir.join(ANCHOR_FILE),
-            &ANCHOR_COLUMNS,
-            "anchor",
-            |r: &AnchorRun| r.problem(),
-        )?,
-        false => Default::default(),
-    };
+    let (anchor, bad) = read_beside(
+        meta.params.anchor.is_some(),
+        &dir.join(ANCHOR_FILE),
+        &ANCHOR_COLUMNS,
+        "anchor",
+        AnchorRun::problem,
+    )?;
     dropped.extend(bad);
     Ok(Sweep {
         pass_costs,
@@ -299,15 +295,19 @@ pub fn read_trials(path: &Path) -> anyhow::Result<(Vec<TrialRow>, Vec<String>)> 
     )
 }
 
-/// The rows of a file a sweep writes beside its cells (`pass-cost.csv`, `anchor.csv`), and a
-/// note naming each line that is not a row or whose numbers are impossible (`problem`); none
-/// without the file.
+/// The rows of a file a sweep writes beside its cells (`pass-cost.csv`, `anchor.csv`) where
+/// the sweep `asked` for it, and a note naming each line that is not a row or whose numbers
+/// are impossible (`problem`); none without the file or the asking.
 fn read_beside<R: serde::de::DeserializeOwned>(
+    asked: bool,
     path: &Path,
     columns: &[&str],
     what: &str,
     problem: impl Fn(&R) -> Option<String>,
 ) -> anyhow::Result<(Vec<R>, Vec<String>)> {
+    if !asked {
+        return Ok(Default::default());
+    }
     let (rows, mut bad): (Vec<R>, Vec<String>) =
         read_csv_if_exists(path, capped::SUMMARY_CSV, columns, |_| false, what)?
             .unwrap_or_default();
@@ -456,8 +456,14 @@ mod tests {
             ),
         )
         .unwrap();
-        let (rows, bad): (Vec<CostRow>, _) =
-            read_beside(&path, &PASS_COST_COLUMNS, "pass cost", CostRow::problem).unwrap();
+        let (rows, bad): (Vec<CostRow>, _) = read_beside(
+            true,
+            &path,
+            &PASS_COST_COLUMNS,
+            "pass cost",
+            CostRow::problem,
+        )
+        .unwrap();
         assert_eq!(rows.len(), 1);
         assert_eq!(bad.len(), 3, "{bad:?}");
         assert!(
@@ -467,6 +473,7 @@ mod tests {
         assert!(bad[1].contains("row 3: left out (0 cores)"), "{bad:?}");
         assert!(bad[2].contains("does not hold its time"), "{bad:?}");
         let none: (Vec<CostRow>, _) = read_beside(
+            true,
             &dir.path().join("missing.csv"),
             &PASS_COST_COLUMNS,
             "pass cost",

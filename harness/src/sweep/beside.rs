@@ -23,9 +23,9 @@ use crate::run::pass_cost;
 /// The work of a pass per thread in `pass-cost.csv`: enough that every thread takes its chunk
 /// (see [`pass_cost`]), little enough that the cost shows.
 pub const PASS_WORK: Duration = Duration::from_micros(5);
-/// Passes per round of `pass-cost.csv`, as `bench-sph overhead`'s default.
+/// Passes per round of `pass-cost.csv`, and `bench-sph overhead`'s default.
 pub const PASS_PASSES: u64 = 1000;
-/// Rounds of `pass-cost.csv`, as `bench-sph overhead`'s default.
+/// Rounds of `pass-cost.csv`, and `bench-sph overhead`'s default.
 pub const PASS_ROUNDS: usize = 10;
 
 /// Measures what `params` asks beside the cells into `dir`, the finished cells being `rows`;

@@ -21,6 +21,7 @@ use super::numbers::{interval, sig, times};
 use super::table::{Column, Table};
 use super::view::GroupView;
 use sph_harness::results::anchor::{AnchorRun, same_state, speedups};
+use sph_harness::results::stats::median;
 use sph_harness::run::pass_cost::CostRow;
 use sph_harness::topology::Pin;
 use sph_solver::solver::Pass;
@@ -266,22 +267,23 @@ fn anchor_rows(
             ),
         ]);
     }
-    let mut one: Vec<f64> = anchor
+    let one: Vec<f64> = anchor
         .iter()
         .filter(|r| r.threads == 1)
         .map(|r| r.wall_s)
         .collect();
-    one.sort_by(f64::total_cmp);
-    let pace = one.get(one.len() / 2).map_or(String::new(), |&median| {
-        format!(
-            " On one thread it takes {} s a run (median), {} `seq`'s {} s: each of its passes \
+    let pace = (!one.is_empty())
+        .then(|| median(&one))
+        .map_or(String::new(), |median| {
+            format!(
+                " On one thread it takes {} s a run (median), {} `seq`'s {} s: each of its passes \
              holds that much more work, so the same fork and join costs it that much less of \
              a pass — compare speedups knowing that, and times for what each run costs.",
-            sig(median),
-            times(median / seq_s),
-            sig(seq_s)
-        )
-    });
+                sig(median),
+                times(median / seq_s),
+                sig(seq_s)
+            )
+        });
     Some(format!(
         "The OpenMP plain loop is `benches/plain-loop/mueller.cpp` built with `-fopenmp` \
          (each pass `omp parallel for schedule(static)`), run by the sweep after its cells on \
