@@ -30,6 +30,11 @@
 # over T-thread median), beside bench-sph's paired speedups (`bench-sph speedup`,
 # REF_PAIRED_STRATEGIES) at each T >= 2, all-pairs, N = 1000; the OpenMP runs must end in the
 # plain loop's state.
+# The real workload (issue 41): the wcsph dam break of `bench-sph validate --resolution 40`
+# (grid, to T = 3.4, 6382 steps) with seq and WCSPH_STRATEGIES on 2 cores: each median wall_s,
+# its ratio to the plain loop's median (a machine-speed yardstick from the same run: the two do
+# different work), the 2-core efficiency (seq median / (2 x median)), the peak RSS per particle,
+# and that every strategy ends in seq's state.
 # Without a C++ compiler the plain loop and the ratio columns are skipped; without OpenMP, the
 # OpenMP anchor.
 # Run it on an otherwise quiet machine: it warns when the 1-minute load exceeds half the
@@ -58,12 +63,18 @@ PAIRED_STEPS=10
 # with seq at each core count from 2 to the hardware threads, "STRATEGY CHUNKS", beside the
 # plain loop's OpenMP build.
 REF_PAIRED_STRATEGIES=("team 8" "crossbeam-pool 4" "rayon-chunks 10")
+# The wcsph rows: resolution, simulated seconds (validate's T = 3.4 at a = 1 m:
+# 3.4 / sqrt(2 g / a)), and the strategies beside seq, "STRATEGY CORES CHUNKS".
+WCSPH_R=40
+WCSPH_T_END=0.7676
+WCSPH_STRATEGIES=("team 2 8" "rayon-chunks 2 10" "crossbeam-pool 2 10")
 # The N whose peak RSS per particle is reported.
 RSS_N=1000000
 # --quick replaces the step counts.
 QUICK_REF_STEPS=100
 QUICK_LARGE_SIZES=("10000 2" "100000 2" "1000000 1")
 QUICK_PAIRED_STEPS=1
+QUICK_WCSPH_T_END=0.05
 
 usage() {
     sed -n '2,/^set -euo/{/^set -euo/d;s/^# \{0,1\}//;p}' "$0"
@@ -159,6 +170,7 @@ if ((QUICK)); then
     REF_STEPS=$QUICK_REF_STEPS
     LARGE_SIZES=("${QUICK_LARGE_SIZES[@]}")
     PAIRED_STEPS=$QUICK_PAIRED_STEPS
+    WCSPH_T_END=$QUICK_WCSPH_T_END
 fi
 
 # A relative CARGO_TARGET_DIR means relative to where the script was started.
@@ -356,6 +368,14 @@ for ((run = 1; run <= RUNS; run++)); do
             done
         done
     done
+    for strat in "seq - -" "${WCSPH_STRATEGIES[@]}"; do
+        read -r strategy cores chunks <<<"$strat"
+        extra=()
+        if [[ "$cores" != - ]]; then extra+=(--cores "$cores" --chunks "$chunks"); fi
+        run_one "wcsph:$strategy:$cores:$chunks" "$BIN" simulate --json --preset wcsph \
+            --resolution "$WCSPH_R" --neighbors grid --t-end "$WCSPH_T_END" \
+            --strategy "$strategy" ${extra[@]+"${extra[@]}"}
+    done
     for strat in "${PAIRED_STRATEGIES[@]}"; do
         read -r strategy cores chunks <<<"$strat"
         run_paired "paired:$PAIRED_N:$PAIRED_STEPS:$strategy:$cores:$chunks" "$BIN" speedup \
@@ -499,6 +519,38 @@ done
 say "eff = seq median / (cores x median); RSS B/part = the largest peak RSS of the N = $RSS_N" \
     "runs / N"
 say ""
+say "The real workload: wcsph, R = $WCSPH_R (3200 fluid + 1218 wall particles), grid, to" \
+    "t = $WCSPH_T_END s (validate's T = 3.4)"
+sayf '%-34s %5s %10s %10s %10s %20s %6s %10s\n' configuration runs "min s" "median s" "max s" \
+    "this/plain median" "eff" "RSS B/part"
+# Fluid and wall particles, as the program reports them.
+wcsph_json="$("$BIN" simulate --json --preset wcsph --resolution "$WCSPH_R" --steps 1)"
+WCSPH_PARTICLES=$(($(json_field n <<<"$wcsph_json") + $(json_field walls <<<"$wcsph_json")))
+wcsph_seq=""
+for strat in "seq - -" "${WCSPH_STRATEGIES[@]}"; do
+    read -r strategy cores chunks <<<"$strat"
+    key="wcsph:$strategy:$cores:$chunks"
+    read -r lo med hi <<<"$(stats "$key")"
+    if [[ "$strategy" == seq ]]; then wcsph_seq="$med"; fi
+    ratio="-"
+    if [[ -n "$PLAIN" ]]; then
+        ratio="$(awk -v p="$pmed" -v m="$med" 'BEGIN { printf "%.2fx", m / p }')"
+    fi
+    eff="-"
+    if [[ "$cores" != - ]]; then
+        eff="$(awk -v s="$wcsph_seq" -v c="$cores" -v m="$med" 'BEGIN { printf "%.2f", s / (c * m) }')"
+    fi
+    rss="$(awk -v k="$(peak_rss "$key")" -v n="$WCSPH_PARTICLES" \
+        'BEGIN { if (k == "-") print "-"; else printf "%.0f", k * 1024 / n }')"
+    label="$strategy"
+    if [[ "$cores" != - ]]; then label+=" cores=$cores chunks=$chunks"; fi
+    sayf '%-34s %5s %10s %10s %10s %20s %6s %10s\n' "$label" "$RUNS" "$(fmt_s "$lo")" \
+        "$(fmt_s "$med")" "$(fmt_s "$hi")" "$ratio" "$eff" "$rss"
+done
+say "this/plain = median / the plain loop's median (a yardstick of the machine's speed from the"
+say "same run, not the same work); eff = seq median / (cores x median); RSS B/part = the largest"
+say "peak RSS / (fluid + wall particles), the whole process at this small size"
+say ""
 say "Paired with seq (bench-sph speedup: a step of the strategy and a step of seq in turn, one" \
     "process; grid, N = $PAIRED_N, $PAIRED_STEPS steps each; the default simd path, whatever" \
     "--simd says)"
@@ -603,7 +655,16 @@ for size in "${LARGE_SIZES[@]}"; do
         fi
     done
 done
-say "large-N strategies agree with seq bit for bit: $AGREE; every configuration repeats its" \
+sums="$(for strat in "seq - -" "${WCSPH_STRATEGIES[@]}"; do
+    read -r strategy cores chunks <<<"$strat"
+    checksums "wcsph:$strategy:$cores:$chunks"
+    echo
+done | sort -u | grep -c .)"
+if [[ "$sums" != 1 ]]; then
+    AGREE=no
+    echo "warning: the strategies disagree on the wcsph run" >&2
+fi
+say "large-N and wcsph strategies agree with seq bit for bit: $AGREE; every configuration repeats its" \
     "checksum run to run: $DETERMINISTIC"
 say "uptime: $(uptime)"
 

@@ -69,6 +69,10 @@ struct Report {
     #[serde(skip_serializing_if = "Option::is_none")]
     walls: Option<usize>,
     steps: usize,
+    /// Times `wcsph`'s kept neighbour lists were built (absent for Müller's presets, which
+    /// build them every step).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    list_builds: Option<u64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     simulated_s: Option<f64>,
     wall_s: f64,
@@ -138,6 +142,7 @@ pub fn run(args: &SimulateArgs) -> anyhow::Result<()> {
         resolution: args.scene.wcsph_resolution(),
         walls: (walls > 0).then_some(walls),
         steps: sim.steps_done,
+        list_builds: sim.list_builds(),
         simulated_s: args.t_end.map(|_| sim.time_s),
         wall_s: elapsed.wall_s,
         cpu_s: elapsed.cpu_s,
@@ -190,6 +195,12 @@ fn print_report(r: &Report, json: bool) -> anyhow::Result<()> {
     }
     if let Some(t) = r.simulated_s {
         say(&format!("simulated time {t:.6} s"))?;
+    }
+    if let Some(b) = r.list_builds {
+        say(&format!(
+            "neighbour lists built {b} times in {} steps",
+            r.steps
+        ))?;
     }
     say(&format!(
         "wall {:.3} s, CPU {:.3} s (user+sys), {:.3e} particle-steps/s",

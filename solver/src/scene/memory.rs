@@ -21,6 +21,7 @@ use std::mem::size_of;
 use crate::MAX_PARTICLES;
 use crate::models::Physics;
 use crate::models::Preset;
+use crate::models::wcsph::kept::MOVED_BLOCK;
 use crate::models::wcsph::params::WcParams;
 use crate::models::{mueller, wcsph};
 use crate::solver::SPEED_BLOCK;
@@ -57,8 +58,9 @@ pub enum MemoryError {
 /// the module docs). Saturates instead of overflowing, so any `n` gives an answer.
 ///
 /// For `wcsph`, `n` is mapped to its resolution as the commands map it, and the count is of
-/// fluid and wall particles: lists of [`WCSPH_SLOTS`] for every particle, and a density rate
-/// and a 1/256 share of a speed block per fluid particle.
+/// fluid and wall particles: lists of [`WCSPH_SLOTS`] for every particle, the position its
+/// list was built at, its kicked velocity and a 1/512 share of a displacement block, and a
+/// density rate and a 1/256 share of a speed block per fluid particle.
 pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
     let (physics, domain, n, lists_of, fluid_scratch) = match preset {
         Preset::Wcsph => {
@@ -66,7 +68,9 @@ pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
             let fluid = wcsph::scene::dam_break_particles(r);
             let physics = Physics::from(WcParams::new(r, fluid));
             let total = fluid + wcsph::scene::wall_particles(r);
-            let scratch = 8 * (fluid as u64 + fluid.div_ceil(SPEED_BLOCK) as u64);
+            // Per particle: where its list was built and its kicked velocity (x and y each).
+            let kept = 4 * total as u64 + total.div_ceil(MOVED_BLOCK) as u64;
+            let scratch = 8 * (fluid as u64 + fluid.div_ceil(SPEED_BLOCK) as u64 + kept);
             (physics, wcsph::scene::domain(), total, WCSPH_SLOTS, scratch)
         }
         Preset::Seed | Preset::Cpp => {
@@ -78,6 +82,8 @@ pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
     // A list's count, and its slots in the search's keys: `u32` for all-pairs, and for the
     // grid those its size gets (`u32` while they fit in a cache budget, `u8` past it).
     let key_bytes = match neighbors {
+        // `wcsph`'s grid lists hold index keys at every size.
+        NeighborMode::Grid if preset == Preset::Wcsph => GridKeys::Index.slot_bytes(),
         NeighborMode::Grid => GridKeys::for_lists(n, lists_of).slot_bytes(),
         NeighborMode::AllPairs => size_of::<u32>(),
     };

@@ -23,9 +23,9 @@ use crate::simd::{self, AnyLanes, SimdPath};
 use crate::solver::model::{AnyScratch, Model, Particles};
 use crate::solver::search::with_search;
 use crate::sph::neighbors::{
-    self, AnyNeighbors, CellOrderNeedsGrid, GridKeys, NeighborMode, Neighbors, SumOrder,
+    self, AnyNeighbors, CellOrderNeedsGrid, GridKeys, NeighborMode, SumOrder,
 };
-use crate::sph::state::{Domain, Positions, State};
+use crate::sph::state::{Domain, State};
 
 /// Why a step failed.
 #[derive(Debug, thiserror::Error)]
@@ -96,6 +96,10 @@ impl Simulation {
         let lists = with_model!(physics, m => m.lists(n));
         let radius = physics.search_radius();
         let neighbors = neighbors::build(mode, bounds, radius, n, lists);
+        let neighbors = match with_model!(&physics, m => m.grid_keys()) {
+            Some(keys) => neighbors.with_grid_keys(keys),
+            None => neighbors,
+        };
         let scratch = with_model!(&physics, m => AnyScratch::of_model(m, n));
         Simulation {
             physics,
@@ -130,6 +134,7 @@ impl Simulation {
     pub fn with_list_slots(mut self, width: usize) -> Self {
         assert!(width >= 1, "a neighbour list needs its scratch slot");
         self.neighbors.with_list_slots(width);
+        self.search_replaced();
         self
     }
 
@@ -140,7 +145,15 @@ impl Simulation {
     /// Cell order with all-pairs, which has no cells.
     pub fn with_sum_order(mut self, order: SumOrder) -> Result<Self, CellOrderNeedsGrid> {
         self.neighbors = self.neighbors.with_sum_order(order)?;
+        self.search_replaced();
         Ok(self)
+    }
+
+    /// Forgets what the model kept of the search it had (`wcsph`'s lists), so that the next
+    /// step builds them for the new one.
+    fn search_replaced(&mut self) {
+        let n = self.state.len();
+        self.scratch = with_model!(&self.physics, m => AnyScratch::of_model(m, n));
     }
 
     /// The order sums over neighbours run in.
@@ -153,6 +166,7 @@ impl Simulation {
     /// same bits, only speed and memory differ (tests use it to run both keys at any size).
     pub fn with_grid_keys(mut self, keys: GridKeys) -> Self {
         self.neighbors = self.neighbors.with_grid_keys(keys);
+        self.search_replaced();
         self
     }
 
@@ -163,9 +177,8 @@ impl Simulation {
 
     /// The SIMD path the run's vector code runs on, so that `--json` and `meta.json` name
     /// what ran: the chosen one for all-pairs' neighbour tests, for Müller's force pass (two
-    /// neighbours at once) and for the grid's packed scan (AVX-512); `portable` for a `wcsph`
-    /// run on the grid on another path, which uses none of them (the grid then tests its few
-    /// candidates per row one by one).
+    /// neighbours at once), for `wcsph`'s momentum and continuity passes (eight pairs at once)
+    /// and for the grid's packed scan (AVX-512).
     pub fn simd(&self) -> SimdPath {
         let on_grid = with_model!(&self.physics, m => m.lanes_on_grid());
         match (&self.neighbors, on_grid, self.lanes.path()) {
@@ -186,6 +199,18 @@ impl Simulation {
         self.physics.fluid(self.state.len())
     }
 
+    /// Particles whose neighbour list did not fit its slots when it was last written (their
+    /// passes search again: slower, the same bits).
+    pub fn unlisted(&self) -> usize {
+        with_search!(&self.neighbors, (_nb, lists) => lists.unusable())
+    }
+
+    /// Times the neighbour lists were built so far where the model keeps them from step to
+    /// step (`wcsph`); `None` where they are built every step.
+    pub fn list_builds(&self) -> Option<u64> {
+        with_model!(&self.physics, m => m.list_builds(self.scratch.of()))
+    }
+
     /// The time step of the last step (WCSPH's adapts to the flow), s.
     pub fn last_dt(&self) -> f64 {
         with_model!(&self.physics, m => m.last_dt(self.scratch.of()))
@@ -193,11 +218,19 @@ impl Simulation {
 
     /// Brings the neighbour search up to date with the current positions, on `exec`.
     pub fn rebuild_neighbors_on<E: Executor>(&mut self, exec: &E) -> Result<(), KernelPanic> {
-        let pos = Positions {
-            x: &self.state.x,
-            y: &self.state.y,
+        let (physics, on, scratch) = self.parts();
+        with_model!(physics, m => m.rebuild_search(exec, on, scratch.of_mut()))
+    }
+
+    /// The model, what its passes run over, and its scratch, borrowed apart.
+    fn parts(&mut self) -> (&Physics, Particles<'_>, &mut AnyScratch) {
+        let on = Particles {
+            state: &mut self.state,
+            neighbors: &mut self.neighbors,
+            lanes: self.lanes,
+            domain: self.domain,
         };
-        with_search!(&mut self.neighbors, (nb, _lists) => nb.rebuild(exec, pos))
+        (&self.physics, on, &mut self.scratch)
     }
 
     /// Brings the neighbour search up to date with the current positions, on this thread.
@@ -214,14 +247,8 @@ impl Simulation {
     /// # Panics
     /// If `pass` is not one of the model's passes.
     pub fn run_pass<E: Executor>(&mut self, exec: &E, pass: Pass) -> Result<(), KernelPanic> {
-        let on = Particles {
-            state: &mut self.state,
-            neighbors: &mut self.neighbors,
-            lanes: self.lanes,
-            domain: self.domain,
-        };
-        let scratch = &mut self.scratch;
-        with_model!(&self.physics, m => m.run_pass(exec, pass, on, scratch.of_mut()))
+        let (physics, on, scratch) = self.parts();
+        with_model!(physics, m => m.run_pass(exec, pass, on, scratch.of_mut()))
     }
 
     /// Bytes held by the neighbour search, lists and the model's scratch arrays, for memory

@@ -12,8 +12,9 @@ use sph_strategies::{Executor, KernelPanic};
 use super::pass::Pass;
 use crate::models::Preset;
 use crate::simd::AnyLanes;
-use crate::sph::neighbors::AnyNeighbors;
-use crate::sph::state::{Domain, State};
+use crate::solver::search::with_search;
+use crate::sph::neighbors::{AnyNeighbors, GridKeys, Neighbors};
+use crate::sph::state::{Domain, Positions, State};
 
 /// The units a model computes in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,6 +52,12 @@ pub trait Model: Copy + Debug {
     /// The neighbour lists of `n` particles: how many particles have one, and its slots.
     fn lists(&self, n: usize) -> (usize, usize);
 
+    /// The keys the grid's lists hold, where the model needs one kind (`wcsph`'s passes read
+    /// their lists as indices); `None` lets the run's size choose ([`GridKeys::for_lists`]).
+    fn grid_keys(&self) -> Option<GridKeys> {
+        None
+    }
+
     /// The units the model computes in.
     fn units(&self) -> Units;
 
@@ -68,6 +75,23 @@ pub trait Model: Copy + Debug {
     /// The scratch of a run of `n` particles.
     fn scratch(&self, n: usize) -> Self::Scratch;
 
+    /// Brings the neighbour search up to date with the positions of `on` (once per step,
+    /// before the passes), on `exec`. By default it is rebuilt; a model whose lists outlive a
+    /// step rebuilds it only when they are built again (`wcsph`'s kept lists).
+    fn rebuild_search<E: Executor>(
+        &self,
+        exec: &E,
+        on: Particles<'_>,
+        scratch: &mut Self::Scratch,
+    ) -> Result<(), KernelPanic> {
+        let _ = scratch;
+        let pos = Positions {
+            x: &on.state.x,
+            y: &on.state.y,
+        };
+        with_search!(on.neighbors, (nb, _lists) => nb.rebuild(exec, pos))
+    }
+
     /// Runs `pass` on `exec` over `on`: each pass needs an up-to-date search and what the
     /// passes before it in the step wrote.
     ///
@@ -80,6 +104,13 @@ pub trait Model: Copy + Debug {
         on: Particles<'_>,
         scratch: &mut Self::Scratch,
     ) -> Result<(), KernelPanic>;
+
+    /// Times the neighbour lists were built so far, for a model that keeps them between steps
+    /// (`wcsph`); `None` for one that builds them every step.
+    fn list_builds(&self, scratch: &Self::Scratch) -> Option<u64> {
+        let _ = scratch;
+        None
+    }
 
     /// The time step of the last step, s or the model's unit.
     fn last_dt(&self, scratch: &Self::Scratch) -> f64;

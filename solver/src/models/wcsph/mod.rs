@@ -13,7 +13,10 @@
 //! with the kicked velocities vⁿ⁺¹ = vⁿ + dt·a; then each particle kicks, updates ρ and p,
 //! and drifts with vⁿ⁺¹. (Updating ρ with the old velocity makes a still tank blow up.)
 
+pub mod by_eight;
+pub mod kept;
 pub mod model;
+pub mod pairs;
 pub mod params;
 pub mod passes;
 pub mod scene;

@@ -7,14 +7,18 @@ use glam::DVec2;
 use sph_strategies::{Executor, KernelPanic};
 
 use crate::models::Preset;
+use crate::models::wcsph::by_eight;
+use crate::models::wcsph::kept::KeptLists;
+use crate::models::wcsph::pairs::ContinuityInputs;
 use crate::models::wcsph::params::{COLUMN_WIDTH, WcParams};
-use crate::models::wcsph::passes::{self, ContinuityInputs};
+use crate::models::wcsph::passes::{self, Listed};
 use crate::simd::Lanes;
 use crate::solver::model::{self, Model, Particles, Units, no_such_pass};
 use crate::solver::pass::Pass;
 use crate::solver::search::{with_search, with_search_lanes};
-use crate::sph::neighbors::{NeighborLists, Neighbors, WCSPH_SLOTS};
+use crate::sph::neighbors::{GridKeys, NeighborLists, Neighbors, WCSPH_SLOTS};
 use crate::sph::state::{Domain, Fields, Positions, State};
+use crate::with_lanes;
 
 /// Fluid particles per block of the largest-speed reduction.
 pub const SPEED_BLOCK: usize = 256;
@@ -28,22 +32,33 @@ pub struct Scratch {
     pub block_max: Vec<f64>,
     /// This step's time step, s.
     pub dt: f64,
+    /// Velocity x of every particle after this step's kick (from the momentum pass; walls 0),
+    /// m/s.
+    pub kicked_x: Vec<f64>,
+    /// Velocity y after the kick.
+    pub kicked_y: Vec<f64>,
+    /// Where the neighbour lists were built, and whether to build them again.
+    pub kept: KeptLists,
 }
 
 impl Scratch {
-    /// Room for `fluid` fluid particles.
-    pub fn new(fluid: usize) -> Scratch {
+    /// Room for `fluid` fluid particles of `n`.
+    pub fn new(fluid: usize, n: usize) -> Scratch {
         Scratch {
             drho: vec![0.0; fluid],
             block_max: vec![0.0; fluid.div_ceil(SPEED_BLOCK)],
             dt: 0.0,
+            kicked_x: vec![0.0; n],
+            kicked_y: vec![0.0; n],
+            kept: KeptLists::new(n),
         }
     }
 }
 
 impl model::Scratch for Scratch {
     fn heap_bytes(&self) -> usize {
-        8 * (self.drho.capacity() + self.block_max.capacity())
+        let kicked = self.kicked_x.capacity() + self.kicked_y.capacity();
+        8 * (self.drho.capacity() + self.block_max.capacity() + kicked) + self.kept.heap_bytes()
     }
 }
 
@@ -54,16 +69,18 @@ impl Model for WcParams {
         &Pass::WCSPH
     }
 
+    // The momentum and continuity passes compute eight pair terms at once on any search.
     fn lanes_on_grid(&self) -> bool {
-        false
+        true
     }
 
     fn preset(&self) -> Preset {
         Preset::Wcsph
     }
 
+    // The lists' radius: 2h and the skin.
     fn search_radius(&self) -> f64 {
-        self.support
+        self.list_radius
     }
 
     fn fluid(&self, n: usize) -> usize {
@@ -77,6 +94,11 @@ impl Model for WcParams {
     // Walls need lists too (of their fluid neighbours).
     fn lists(&self, n: usize) -> (usize, usize) {
         (n, WCSPH_SLOTS)
+    }
+
+    // The momentum and continuity passes read eight lists at once by slot (`by_eight`).
+    fn grid_keys(&self) -> Option<GridKeys> {
+        Some(GridKeys::Index)
     }
 
     fn units(&self) -> Units {
@@ -100,7 +122,24 @@ impl Model for WcParams {
     }
 
     fn scratch(&self, n: usize) -> Scratch {
-        Scratch::new(self.fluid(n))
+        Scratch::new(self.fluid(n), n)
+    }
+
+    /// Rebuilds the search (and has the neighbour pass build the lists) only when some
+    /// particle has moved half the skin since the last build ([`KeptLists`]).
+    fn rebuild_search<E: Executor>(
+        &self,
+        exec: &E,
+        on: Particles<'_>,
+        scratch: &mut Scratch,
+    ) -> Result<(), KernelPanic> {
+        let s = &*on.state;
+        let pos = Positions { x: &s.x, y: &s.y };
+        if scratch.kept.stale(exec, pos, self.relist_sq)? {
+            with_search!(on.neighbors, (nb, _lists) => nb.rebuild(exec, pos))?;
+            scratch.kept.rebuilt_at(exec, pos)?;
+        }
+        Ok(())
     }
 
     fn run_pass<E: Executor>(
@@ -118,17 +157,46 @@ impl Model for WcParams {
         } = on;
         match pass {
             Pass::MaxSpeed => max_speed(exec, s, scratch, self),
-            Pass::Neighbors => {
+            Pass::Neighbors if scratch.kept.take_relist() => {
                 with_search_lanes!(nb, lanes, (nb, lists, l) => neighbors(exec, l, &*nb, lists, s, self))
             }
-            Pass::Walls => with_search!(nb, (nb, lists) => walls(exec, &*nb, lists, s, self)),
-            Pass::Momentum => with_search!(nb, (nb, lists) => momentum(exec, &*nb, lists, s, self)),
+            // The lists still serve.
+            Pass::Neighbors => Ok(()),
+            Pass::Walls => {
+                let built = scratch.kept.positions();
+                with_search!(nb, (nb, lists) => walls(exec, Listed { nb: &*nb, lists, built }, s, self))
+            }
+            Pass::Momentum => {
+                let Scratch {
+                    kept,
+                    kicked_x,
+                    kicked_y,
+                    dt,
+                    ..
+                } = scratch;
+                let built = kept.positions();
+                let kicked = (&mut kicked_x[..self.fluid], &mut kicked_y[..self.fluid]);
+                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => momentum(exec, l, Listed { nb: &*nb, lists, built }, s, kicked, *dt, self)))
+            }
             Pass::Continuity => {
-                with_search!(nb, (nb, lists) => continuity(exec, &*nb, lists, s, scratch, self))
+                let Scratch {
+                    kept,
+                    drho,
+                    kicked_x,
+                    kicked_y,
+                    ..
+                } = scratch;
+                let built = kept.positions();
+                let kicked = (&kicked_x[..], &kicked_y[..]);
+                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => continuity(exec, l, Listed { nb: &*nb, lists, built }, s, kicked, drho, self)))
             }
             Pass::Integrate => integrate(exec, s, scratch, self),
             other => no_such_pass(self.preset(), other),
         }
+    }
+
+    fn list_builds(&self, scratch: &Scratch) -> Option<u64> {
+        Some(scratch.kept.builds())
     }
 
     fn last_dt(&self, scratch: &Scratch) -> f64 {
@@ -212,8 +280,7 @@ pub fn neighbors<E: Executor, N: Neighbors, L: Lanes>(
 /// Writes the walls' rho and p; reads the fluid's positions, rho and p and the lists.
 pub fn walls<E: Executor, N: Neighbors>(
     exec: &E,
-    nb: &N,
-    lists: &NeighborLists<N::Key>,
+    listed: Listed<'_, N>,
     s: &mut State,
     prm: &WcParams,
 ) -> Result<(), KernelPanic> {
@@ -223,49 +290,88 @@ pub fn walls<E: Executor, N: Neighbors>(
     exec.for_each_chunk((wall_rho, wall_p), |first, (rho, p)| {
         for (k, (rho, p)) in rho.iter_mut().zip(p).enumerate() {
             let w = prm.fluid + first + k;
-            (*rho, *p) = passes::wall_state(w, &f, lists.of(w), nb, prm);
+            (*rho, *p) = passes::wall_state(w, &f, &listed, prm);
         }
     })
 }
 
-/// Writes the fluid's acceleration (into fx, fy); reads every field and the lists.
-pub fn momentum<E: Executor, N: Neighbors>(
+/// Writes the fluid's acceleration (into fx, fy) and its velocity after this step's kick
+/// (into `kicked`, for the continuity pass); reads every field and the lists.
+#[allow(clippy::too_many_arguments)]
+pub fn momentum<E: Executor, N: Neighbors, L: Lanes>(
     exec: &E,
-    nb: &N,
-    lists: &NeighborLists<N::Key>,
+    lanes: L,
+    listed: Listed<'_, N>,
     s: &mut State,
+    kicked: (&mut [f64], &mut [f64]),
+    dt: f64,
     prm: &WcParams,
 ) -> Result<(), KernelPanic> {
     let f = Fields::new((&s.x, &s.y), (&s.vx, &s.vy), &s.rho, &s.p);
-    let out = (&mut s.fx[..prm.fluid], &mut s.fy[..prm.fluid]);
-    exec.for_each_chunk(out, |first, (ax, ay)| {
-        for (k, (ax, ay)) in ax.iter_mut().zip(ay).enumerate() {
-            let a = passes::acceleration(first + k, &f, lists.of(first + k), nb, prm);
-            (*ax, *ay) = (a.x, a.y);
-        }
+    let out = ((&mut s.fx[..prm.fluid], &mut s.fy[..prm.fluid]), kicked);
+    exec.for_each_chunk(out, |first, ((ax, ay), (kx, ky))| {
+        lanes.vectorize(
+            #[inline(always)]
+            || {
+                let len = ax.len();
+                let mut write = |k: usize, a: DVec2| {
+                    let i = first + k;
+                    let v = passes::kick(DVec2::new(f.vx[i], f.vy[i]), a, dt);
+                    (ax[k], ay[k], kx[k], ky[k]) = (a.x, a.y, v.x, v.y);
+                };
+                let mut k = 0;
+                while k + 8 <= len {
+                    match by_eight::accelerations(first + k, &f, &listed, prm) {
+                        Some(a) => (0..8).for_each(|j| write(k + j, a[j])),
+                        None => (k..k + 8).for_each(|k| {
+                            write(k, passes::acceleration(first + k, &f, &listed, prm))
+                        }),
+                    }
+                    k += 8;
+                }
+                for k in k..len {
+                    write(k, passes::acceleration(first + k, &f, &listed, prm));
+                }
+            },
+        )
     })
 }
 
-/// Writes the fluid's dρ/dt; reads every field, the accelerations and the lists.
-pub fn continuity<E: Executor, N: Neighbors>(
+/// Writes the fluid's dρ/dt; reads every field, the kicked velocities and the lists.
+pub fn continuity<E: Executor, N: Neighbors, L: Lanes>(
     exec: &E,
-    nb: &N,
-    lists: &NeighborLists<N::Key>,
+    lanes: L,
+    listed: Listed<'_, N>,
     s: &State,
-    scratch: &mut Scratch,
+    (kicked_x, kicked_y): (&[f64], &[f64]),
+    drho: &mut [f64],
     prm: &WcParams,
 ) -> Result<(), KernelPanic> {
     let input = ContinuityInputs {
         fields: Fields::new((&s.x, &s.y), (&s.vx, &s.vy), &s.rho, &s.p),
-        ax: &s.fx,
-        ay: &s.fy,
-        dt: scratch.dt,
+        kicked_x,
+        kicked_y,
     };
-    exec.for_each_chunk(&mut scratch.drho[..], |first, drho| {
-        for (k, d) in drho.iter_mut().enumerate() {
-            let a = first + k;
-            *d = passes::density_rate(a, &input, lists.of(a), nb, prm);
-        }
+    exec.for_each_chunk(drho, |first, drho| {
+        lanes.vectorize(
+            #[inline(always)]
+            || {
+                let len = drho.len();
+                let mut k = 0;
+                while k + 8 <= len {
+                    match by_eight::density_sums(first + k, &input, &listed, prm) {
+                        Some(sum) => (0..8).for_each(|j| drho[k + j] = prm.mass * sum[j]),
+                        None => (k..k + 8).for_each(|k| {
+                            drho[k] = passes::density_rate(first + k, &input, &listed, prm)
+                        }),
+                    }
+                    k += 8;
+                }
+                for (k, d) in drho.iter_mut().enumerate().skip(k) {
+                    *d = passes::density_rate(first + k, &input, &listed, prm);
+                }
+            },
+        )
     })
 }
 

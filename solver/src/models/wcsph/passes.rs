@@ -10,8 +10,9 @@
 use crate::simd::{Lanes, Portable};
 use glam::DVec2;
 
+use super::pairs::{self, ContinuityInputs, ContinuitySide, MomentumSide};
 use super::params::WcParams;
-use crate::sph::neighbors::{ListWriter, Neighbors, distance_squared};
+use crate::sph::neighbors::{ListWriter, NeighborLists, Neighbors, distance_squared};
 use crate::sph::state::{Fields, Positions};
 
 /// The largest squared speed among the given velocities (0 for none), m²/s². `max` is exact
@@ -23,8 +24,9 @@ pub fn max_speed_squared(vx: &[f64], vy: &[f64]) -> f64 {
         .fold(0.0, |m: f64, (&x, &y)| m.max(x * x + y * y))
 }
 
-/// Particle `i`'s neighbours within the kernel support, in the search's visit order: for a fluid particle
-/// every other particle, for a wall particle the fluid ones only (walls never read walls).
+/// Particle `i`'s neighbours within the lists' radius (2h and the skin, see
+/// [`crate::models::wcsph::kept`]), in the search's visit order: for a fluid particle every
+/// other particle, for a wall particle the fluid ones only (walls never read walls).
 ///
 /// They are written to `list`; the returned count is its [`ListWriter::finish`] (see
 /// [`crate::sph::neighbors::NeighborLists`]).
@@ -44,7 +46,7 @@ pub fn neighbors<N: Neighbors>(
         lanes,
         i,
         pos,
-        prm.support_sq,
+        prm.list_radius_sq,
         #[inline(always)]
         |j, _, key| {
             list.push(key, j != i && j < limit);
@@ -53,39 +55,112 @@ pub fn neighbors<N: Neighbors>(
     list.finish()
 }
 
-/// Calls `pair(b, r2)` for each of particle `i`'s neighbours ([`neighbors`]) in visit order:
-/// from its list when it fit (in its slots, and its keys in their type), else by asking the
-/// search again.
+/// The search, its lists and the positions both were built at: what a pass needs to visit a
+/// particle's neighbours.
+#[derive(Debug)]
+pub struct Listed<'a, N: Neighbors> {
+    /// The search, as built at `built`.
+    pub nb: &'a N,
+    /// Every particle's list, built at `built` with the lists' radius.
+    pub lists: &'a NeighborLists<N::Key>,
+    /// The positions of the last build.
+    pub built: Positions<'a>,
+}
+
+/// Calls `pair(b, r2)` for each of particle `i`'s neighbours now within 2h (`r2` at `pos`, the
+/// positions now), in the order its list holds them: from its list when it fit (in its slots,
+/// and its keys in their type), else by asking the search again at the positions it was
+/// built at. Either way the same particles in the same order: those within the lists' radius
+/// at the build, which hold every particle within 2h now ([`crate::models::wcsph::kept`]).
 #[inline(always)]
 fn for_each_neighbor<N: Neighbors>(
     i: usize,
     pos: Positions<'_>,
-    list: Option<&[N::Key]>,
-    nb: &N,
+    listed: &Listed<'_, N>,
     prm: &WcParams,
     mut pair: impl FnMut(usize, f64),
 ) {
     let (xi, yi) = (pos.x[i], pos.y[i]);
-    match list {
-        Some(list) => nb.for_each_listed(
-            i,
-            pos,
-            list,
-            #[inline(always)]
-            |b| {
-                pair(b, distance_squared(xi, yi, pos.x[b], pos.y[b]));
-            },
-        ),
+    for_each_in_list(i, listed, prm, |b| {
+        let r2 = distance_squared(xi, yi, pos.x[b], pos.y[b]);
+        if r2 < prm.support_sq {
+            pair(b, r2);
+        }
+    });
+}
+
+/// Calls `visit(b)` for each particle b of particle `i`'s list, in its order: from the list
+/// when it fit (in its slots, and its keys in their type), else by asking the search again at
+/// the positions it was built at (the same particles in the same order).
+#[inline(always)]
+fn for_each_in_list<N: Neighbors>(
+    i: usize,
+    listed: &Listed<'_, N>,
+    prm: &WcParams,
+    mut visit: impl FnMut(usize),
+) {
+    match listed.lists.of(i) {
+        Some(list) => listed.nb.for_each_listed(i, listed.built, list, visit),
         None => {
             let limit = if i < prm.fluid { usize::MAX } else { prm.fluid };
             // An unusable list (too long for its slots, or a grid key past 255) is rare: the
             // portable lanes serve (same hits).
             let scratch = &mut N::Scratch::default();
-            nb.for_each_within(scratch, Portable, i, pos, prm.support_sq, |b, r2, _| {
-                if b != i && b < limit {
-                    pair(b, r2);
-                }
-            });
+            let hsq = prm.list_radius_sq;
+            listed
+                .nb
+                .for_each_within(scratch, Portable, i, listed.built, hsq, |b, _, _| {
+                    if b != i && b < limit {
+                        visit(b);
+                    }
+                });
+        }
+    }
+}
+
+/// Calls `eight(b, len)` for particle `i`'s listed neighbours eight at a time, in the order
+/// [`for_each_neighbor`] visits them: `b[..len]` are the next `len` of them (eight but in the
+/// last call), the other lanes hold `i`. Each lane is a neighbour of the lists' radius; a pass
+/// computes its pair term in all eight lanes at once, as the same scalar operations, takes
+/// zero for a lane past `len` or with `r2` at or beyond 2h, and adds the lanes in order: a
+/// zero changes no sum (a sum from +0 is never −0), so the bits are those of the pairs
+/// within 2h summed one by one.
+#[inline(always)]
+fn for_each_eight<N: Neighbors>(
+    i: usize,
+    listed: &Listed<'_, N>,
+    prm: &WcParams,
+    mut eight: impl FnMut(&[usize; 8], usize),
+) {
+    let mut batch = Eight { b: [i; 8], len: 0 };
+    for_each_in_list(
+        i,
+        listed,
+        prm,
+        #[inline(always)]
+        |j| batch.push(j, &mut eight),
+    );
+    if batch.len > 0 {
+        batch.b[batch.len..].fill(i);
+        eight(&batch.b, batch.len);
+    }
+}
+
+/// The neighbours of [`for_each_eight`] not yet handed on.
+struct Eight {
+    b: [usize; 8],
+    len: usize,
+}
+
+impl Eight {
+    /// Adds `j`, and hands on all eight when they are eight.
+    #[inline(always)]
+    fn push(&mut self, j: usize, eight: &mut impl FnMut(&[usize; 8], usize)) {
+        self.b[self.len] = j;
+        self.len += 1;
+        if self.len == 8 {
+            eight(&self.b, 8);
+            self.len = 0;
         }
     }
 }
@@ -97,13 +172,12 @@ fn for_each_neighbor<N: Neighbors>(
 pub fn wall_state<N: Neighbors>(
     w: usize,
     f: &Fields<'_>,
-    list: Option<&[N::Key]>,
-    nb: &N,
+    listed: &Listed<'_, N>,
     prm: &WcParams,
 ) -> (f64, f64) {
     let xw = f.pos.at(w);
     let (mut num, mut den) = (0.0, 0.0);
-    for_each_neighbor(w, f.pos, list, nb, prm, |j, r2| {
+    for_each_neighbor(w, f.pos, listed, prm, |j, r2| {
         let kernel = prm.kernel(r2);
         let r_wf = xw - f.pos.at(j);
         num += (f.p[j] + f.rho[j] * prm.gravity.dot(r_wf)) * kernel;
@@ -117,125 +191,63 @@ pub fn wall_state<N: Neighbors>(
 /// dv_a/dt = −Σ_b m (p_a/ρ_a² + p_b/ρ_b² + Π_ab) ∇_a W_ab + g, with Monaghan's artificial
 /// viscosity Π_ab = −α c0 μ_ab / ρ̄_ab, μ_ab = h v_ab·r_ab / (r² + 0.01 h²), where
 /// v_ab·r_ab < 0, between fluid particles only.
-#[inline]
+#[inline(always)]
 pub fn acceleration<N: Neighbors>(
     a: usize,
     f: &Fields<'_>,
-    list: Option<&[N::Key]>,
-    nb: &N,
+    listed: &Listed<'_, N>,
     prm: &WcParams,
 ) -> DVec2 {
-    let me = Me::of(a, f);
-    let own = me.p / (me.rho * me.rho);
-    let mut sum = DVec2::ZERO;
-    for_each_neighbor(a, f.pos, list, nb, prm, |b, r2| {
-        sum += momentum_term(&me, own, b, r2, f, prm);
-    });
-    -prm.mass * sum + prm.gravity
-}
-
-/// What the pair terms need of particle a.
-struct Me {
-    x: DVec2,
-    v: DVec2,
-    rho: f64,
-    p: f64,
-}
-
-impl Me {
-    #[inline(always)]
-    fn of(a: usize, f: &Fields<'_>) -> Me {
-        Me {
-            x: f.pos.at(a),
-            v: DVec2::new(f.vx[a], f.vy[a]),
-            rho: f.rho[a],
-            p: f.p[a],
-        }
-    }
-}
-
-/// (p_a/ρ_a² + p_b/ρ_b² + Π_ab) ∇_a W_ab for neighbour b at squared distance `r2`.
-#[inline(always)]
-fn momentum_term(me: &Me, own: f64, b: usize, r2: f64, f: &Fields<'_>, prm: &WcParams) -> DVec2 {
-    let r_ab = me.x - f.pos.at(b);
-    let (rho_b, p_b) = (f.rho[b], f.p[b]);
-    let mut scalar = own + p_b / (rho_b * rho_b);
-    if b < prm.fluid {
-        let v_ab = me.v - DVec2::new(f.vx[b], f.vy[b]);
-        let vr = v_ab.dot(r_ab);
-        if vr < 0.0 {
-            // Π = −α c0 μ / ρ̄ with μ = h v·r / (r² + 0.01 h²), as one division.
-            scalar += prm.viscosity * vr / ((r2 + prm.viscosity_eps_sq) * (0.5 * (me.rho + rho_b)));
-        }
-    }
-    (scalar * prm.gradient_factor(r2)) * r_ab
-}
-
-/// Read-only inputs of the continuity pass: the fields at the start of the step and this
-/// step's accelerations, from which the kicked velocities v + dt·a are recomputed exactly
-/// as [`integrate`] computes them.
-#[derive(Debug, Clone, Copy)]
-pub struct ContinuityInputs<'a> {
-    /// The fields at the start of the step.
-    pub fields: Fields<'a>,
-    /// Acceleration x of every fluid particle, m/s².
-    pub ax: &'a [f64],
-    /// Acceleration y.
-    pub ay: &'a [f64],
-    /// This step's time step, s.
-    pub dt: f64,
-}
-
-impl ContinuityInputs<'_> {
-    /// Particle b's velocity after this step's kick (walls stay at rest).
-    #[inline(always)]
-    fn kicked(&self, b: usize, fluid: usize) -> DVec2 {
-        if b < fluid {
-            kick(
-                DVec2::new(self.fields.vx[b], self.fields.vy[b]),
-                DVec2::new(self.ax[b], self.ay[b]),
-                self.dt,
-            )
-        } else {
-            DVec2::ZERO
-        }
-    }
+    let me = MomentumSide::splat(a, f);
+    let (mut sx, mut sy) = (0.0, 0.0);
+    for_each_eight(
+        a,
+        listed,
+        prm,
+        #[inline(always)]
+        |b, len| {
+            let (tx, ty) = pairs::momentum(&me, b, pairs::first(len), f, prm);
+            for k in 0..len {
+                sx += tx[k];
+                sy += ty[k];
+            }
+        },
+    );
+    pairs::acceleration(sx, sy, prm)
 }
 
 /// The rate of change of fluid particle `a`'s density, with the kicked velocities:
 /// dρ_a/dt = Σ_b m (ρ_a/ρ_b) v_ab·∇_a W_ab + δ h c0 Σ_b (m/ρ_b) ψ_ab·∇_a W_ab, with
 /// ψ_ab = 2 (ρ_a − ρ_b) r_ab / |r_ab|² (Molteni & Colagrossi 2009) over fluid neighbours
 /// only; since r_ab·r_ab = |r_ab|², ψ_ab·∇_a W_ab = 2 (ρ_a − ρ_b) g(r). kg/(m³ s).
-#[inline]
+#[inline(always)]
 pub fn density_rate<N: Neighbors>(
     a: usize,
     input: &ContinuityInputs<'_>,
-    list: Option<&[N::Key]>,
-    nb: &N,
+    listed: &Listed<'_, N>,
     prm: &WcParams,
 ) -> f64 {
-    let f = &input.fields;
-    let x_a = f.pos.at(a);
-    let v_a = input.kicked(a, prm.fluid);
-    let rho_a = f.rho[a];
-    let diffusion = 2.0 * prm.delta * prm.h * prm.c0;
+    let me = ContinuitySide::splat(a, input);
     let mut sum = 0.0;
-    for_each_neighbor(a, f.pos, list, nb, prm, |b, r2| {
-        let r_ab = x_a - f.pos.at(b);
-        let v_ab = v_a - input.kicked(b, prm.fluid);
-        let rho_b = f.rho[b];
-        let mut flux = rho_a * v_ab.dot(r_ab);
-        if b < prm.fluid {
-            flux += diffusion * (rho_a - rho_b);
-        }
-        sum += prm.gradient_factor(r2) / rho_b * flux;
-    });
+    for_each_eight(
+        a,
+        listed,
+        prm,
+        #[inline(always)]
+        |b, len| {
+            let term = pairs::continuity(&me, b, pairs::first(len), input, prm);
+            for &t in &term[..len] {
+                sum += t;
+            }
+        },
+    );
     prm.mass * sum
 }
 
-/// v + dt·a: the kick, in the one grouping that the continuity pass and [`integrate`] share.
+/// v + dt·a: the kick, in the one grouping that the momentum pass (for the continuity pass)
+/// and [`integrate`] share.
 #[inline(always)]
-fn kick(v: DVec2, a: DVec2, dt: f64) -> DVec2 {
+pub fn kick(v: DVec2, a: DVec2, dt: f64) -> DVec2 {
     v + dt * a
 }
 

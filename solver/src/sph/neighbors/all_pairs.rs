@@ -13,6 +13,7 @@ pub struct AllPairs;
 /// A list names a neighbour by its index.
 impl Neighbors for AllPairs {
     type Key = u32;
+    const KEYS_ARE_INDICES: bool = true;
     type Scratch = ();
     fn rebuild<E: Executor>(&mut self, _exec: &E, _pos: Positions<'_>) -> Result<(), KernelPanic> {
         Ok(())

@@ -7,8 +7,7 @@
 //! [`GridKeys`](crate::sph::neighbors::GridKeys)).
 //!
 //! A particle has a fixed number of slots ([`SLOTS`] for Müller's presets,
-//! [`WCSPH_SLOTS`] for `wcsph`, whose kernel reaches about 21 fluid neighbours and as many
-//! wall particles in a corner). Its count is the number of neighbours listed (j ≠ i within the
+//! [`WCSPH_SLOTS`] for `wcsph`, whose lists reach about 20). Its count is the number of neighbours listed (j ≠ i within the
 //! search radius); the list holds at most `slots - 1` of them (the last slot is scratch, so a
 //! pass can write every hit without branching). When there are more, or a neighbour's key does
 //! not fit the list's key type, the list is not used: the passes that read it ask the search
@@ -26,8 +25,11 @@ use sph_strategies::Split;
 /// a step. One-byte keys keep 32 slots in the bytes 8 indices took.
 pub const SLOTS: usize = 32;
 
-/// Neighbour slots per particle of the `wcsph` preset.
-pub const WCSPH_SLOTS: usize = 64;
+/// Neighbour slots per particle of the `wcsph` preset: its lists reach 2.15 h (2.8 spacings:
+/// 20 neighbours in the initial lattice, about as many in the flow), and are read by index
+/// (`u32`), so a slot costs four bytes at every size; 32 slots made a run at R = 200 take 1.51×
+/// the memory of the lists built every step (one-byte keys, 64 slots), 28 about 1.45×.
+pub const WCSPH_SLOTS: usize = 28;
 
 /// A count that marks a list as not usable (a key did not fit).
 const UNLISTED: u32 = u32::MAX;
@@ -196,6 +198,14 @@ impl<K: ListKey> NeighborLists<K> {
         let count = self.count[i] as usize;
         let w = self.width;
         (count < w).then(|| &self.slots[i * w..i * w + count])
+    }
+
+    /// Particles whose list did not fit at its last writing (its passes search again).
+    pub fn unusable(&self) -> usize {
+        self.count
+            .iter()
+            .filter(|&&c| c as usize >= self.width)
+            .count()
     }
 
     /// Heap bytes held (capacity): what `scene::memory::estimate` must predict (its test

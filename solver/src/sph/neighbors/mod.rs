@@ -105,6 +105,10 @@ pub trait Neighbors: Sync {
     /// [`Neighbors::for_each_listed`].
     type Key: ListKey;
 
+    /// Whether a key is the neighbour's index ([`Neighbors::for_each_listed`] visits the keys
+    /// themselves), so that a pass may read a list's slots as indices.
+    const KEYS_ARE_INDICES: bool;
+
     /// Working memory of one [`Neighbors::for_each_within`] call, made once for a run of
     /// particles and handed to each call in turn (its contents between calls mean nothing).
     type Scratch: Default;

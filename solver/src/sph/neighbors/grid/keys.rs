@@ -77,8 +77,12 @@ mod tests {
         assert_eq!(GridKeys::for_lists(4096, SLOTS), GridKeys::Index);
         assert_eq!(GridKeys::for_lists(4097, SLOTS), GridKeys::Position);
         assert_eq!(GridKeys::for_lists(10_000, SLOTS), GridKeys::Position);
-        assert_eq!(GridKeys::for_lists(2048, WCSPH_SLOTS), GridKeys::Index);
-        assert_eq!(GridKeys::for_lists(2049, WCSPH_SLOTS), GridKeys::Position);
+        let most = INDEX_KEYS_MAX_BYTES / (4 * WCSPH_SLOTS);
+        assert_eq!(GridKeys::for_lists(most, WCSPH_SLOTS), GridKeys::Index);
+        assert_eq!(
+            GridKeys::for_lists(most + 1, WCSPH_SLOTS),
+            GridKeys::Position
+        );
         assert_eq!(GridKeys::for_lists(usize::MAX, 2), GridKeys::Position);
     }
 }

@@ -161,6 +161,7 @@ impl<K, O> Grid<K, O> {
 /// break has at most a few dozen candidates).
 impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
     type Key = K;
+    const KEYS_ARE_INDICES: bool = K::BY_INDEX;
     type Scratch = GridScratch;
 
     /// Cell numbers (per particle) and the gather of sorted positions (per slot) run on the
