@@ -164,7 +164,7 @@ impl Model for WcParams {
             Pass::Neighbors => Ok(()),
             Pass::Walls => {
                 let built = scratch.kept.positions();
-                with_search!(nb, (nb, lists) => walls(exec, Listed { nb: &*nb, lists, built }, s, self))
+                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => walls(exec, l, Listed { nb: &*nb, lists, built }, s, self)))
             }
             Pass::Momentum => {
                 let Scratch {
@@ -277,9 +277,12 @@ pub fn neighbors<E: Executor, N: Neighbors, L: Lanes>(
     })
 }
 
-/// Writes the walls' rho and p; reads the fluid's positions, rho and p and the lists.
-pub fn walls<E: Executor, N: Neighbors>(
+/// Writes the walls' rho and p; reads the fluid's positions, rho and p and the lists. Eight
+/// consecutive walls at a time where their lists allow ([`by_eight::wall_sums`]), each summing
+/// its list in its order, as one alone does.
+pub fn walls<E: Executor, N: Neighbors, L: Lanes>(
     exec: &E,
+    lanes: L,
     listed: Listed<'_, N>,
     s: &mut State,
     prm: &WcParams,
@@ -288,10 +291,26 @@ pub fn walls<E: Executor, N: Neighbors>(
     let (fluid_p, wall_p) = s.p.split_at_mut(prm.fluid);
     let f = Fields::new((&s.x, &s.y), (&s.vx, &s.vy), fluid_rho, fluid_p);
     exec.for_each_chunk((wall_rho, wall_p), |first, (rho, p)| {
-        for (k, (rho, p)) in rho.iter_mut().zip(p).enumerate() {
-            let w = prm.fluid + first + k;
-            (*rho, *p) = passes::wall_state(w, &f, &listed, prm);
-        }
+        lanes.vectorize(
+            #[inline(always)]
+            || {
+                let w0 = prm.fluid + first;
+                let one = |k: usize| passes::wall_state(w0 + k, &f, &listed, prm);
+                let mut k = 0;
+                while k + 8 <= rho.len() {
+                    match by_eight::wall_sums(w0 + k, &f, &listed, prm) {
+                        Some((num, den)) => (0..8).for_each(|j| {
+                            (rho[k + j], p[k + j]) = passes::wall_from_sums(num[j], den[j], prm)
+                        }),
+                        None => (k..k + 8).for_each(|k| (rho[k], p[k]) = one(k)),
+                    }
+                    k += 8;
+                }
+                for k in k..rho.len() {
+                    (rho[k], p[k]) = one(k);
+                }
+            },
+        )
     })
 }
 

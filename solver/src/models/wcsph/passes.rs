@@ -183,6 +183,13 @@ pub fn wall_state<N: Neighbors>(
         num += (f.p[j] + f.rho[j] * prm.gravity.dot(r_wf)) * kernel;
         den += kernel;
     });
+    wall_from_sums(num, den, prm)
+}
+
+/// (ρ_w, p_w) from the sums of [`wall_state`]: p_w = num / den clipped at ≥ 0, 0 with no fluid
+/// near.
+#[inline(always)]
+pub fn wall_from_sums(num: f64, den: f64, prm: &WcParams) -> (f64, f64) {
     let p = if den > 0.0 { (num / den).max(0.0) } else { 0.0 };
     (prm.density(p), p)
 }

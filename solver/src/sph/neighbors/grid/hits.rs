@@ -17,10 +17,11 @@ const _: () = assert!(INLINE_HITS.is_power_of_two());
 /// the grid's `for_each_within`.
 pub(super) const ONE_LOOP_MAX: u32 = 32;
 
-/// The most hits put in order by [`rank_sort`]: its cost grows with the square of the hits,
-/// so more (`wcsph` has about 20–45) are sorted by comparison instead. Either gives the one
-/// increasing order of distinct indices.
-pub(super) const RANK_SORT_MAX: usize = 24;
+/// The most hits put in order by [`rank_sort`]: each hit is compared with this many indices,
+/// in whole registers (two of sixteen on AVX-512), so more (`wcsph`'s lists hold about 20–28
+/// within their radius, a search of 2h near a wall up to about 45) are sorted by comparison
+/// instead. Either gives the one increasing order of distinct indices.
+pub(super) const RANK_SORT_MAX: usize = 32;
 
 /// The most hits put in order by [`sort_small`], whose work is fixed: no branch depends on the
 /// number of hits. Müller's particles have about 6 hits (self included) once the dam has
@@ -72,12 +73,20 @@ pub(super) fn position_of(hit: u64) -> u32 {
     hit as u32
 }
 
-/// Puts the distinct values of `src` in increasing order into `dst` by counting, for each, how
-/// many are smaller: quadratic but branch-free, which beats branching sorts on a few dozen.
+/// Puts the hits `src` (at most [`RANK_SORT_MAX`], of distinct indices) in increasing order
+/// into `dst` by counting, for each, how many indices are smaller: quadratic but branch-free,
+/// which beats branching sorts on a few dozen. The indices are compared as 32-bit words, all
+/// [`RANK_SORT_MAX`] places at once (the places past the hits hold `u32::MAX`, smaller than
+/// none), so that the count has no loop end that depends on the number of hits.
 #[inline]
 pub(super) fn rank_sort(src: &[u64], dst: &mut [u64]) {
+    let mut indices = [u32::MAX; RANK_SORT_MAX];
+    for (index, &h) in indices.iter_mut().zip(src) {
+        *index = index_of(h);
+    }
     for &h in src {
-        let rank: u32 = src.iter().map(|&w| u32::from(w < h)).sum();
+        let i = index_of(h);
+        let rank: u32 = indices.iter().map(|&w| u32::from(w < i)).sum();
         dst[rank as usize] = h;
     }
 }
@@ -151,6 +160,19 @@ mod tests {
         assert!(!in_order(&with_padding(&[hit(4, 0), hit(1, 5), hit(9, 2)])));
         assert!(!in_order(&[u64::MAX, hit(1, 0)]));
         assert!(in_order(&[]) && in_order(&padding));
+    }
+
+    #[test]
+    fn a_rank_sort_orders_as_many_hits_as_it_takes() {
+        // RANK_SORT_MAX distinct indices, shuffled by a fixed stride: sorted as the std sort.
+        let src: Vec<u64> = (0..RANK_SORT_MAX as u32)
+            .map(|k| hit((k * 13) % RANK_SORT_MAX as u32 * 7 + 1, k))
+            .collect();
+        let mut dst = vec![0u64; RANK_SORT_MAX];
+        rank_sort(&src, &mut dst);
+        let mut expected = src.clone();
+        expected.sort_unstable();
+        assert_eq!(dst, expected);
     }
 
     #[test]
