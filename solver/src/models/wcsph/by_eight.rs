@@ -82,12 +82,12 @@ pub fn wall_sums<N: Neighbors>(
     prm: &WcParams,
 ) -> Option<(F8, F8)> {
     let lists = Eight::of(w0, listed)?;
-    let at: F8 = f.pos.x[w0..w0 + 8].try_into().expect("eight walls");
-    let yt: F8 = f.pos.y[w0..w0 + 8].try_into().expect("eight walls");
+    let xw: F8 = f.pos.x[w0..w0 + 8].try_into().expect("eight walls");
+    let yw: F8 = f.pos.y[w0..w0 + 8].try_into().expect("eight walls");
     let (mut num, mut den) = ([0.0; 8], [0.0; 8]);
     for m in 0..lists.most {
         let (b, keep) = lists.column(m);
-        let (tn, td) = pairs::wall((&at, &yt), &b, keep, f, prm);
+        let (tn, td) = pairs::wall((&xw, &yw), &b, keep, f, prm);
         for k in 0..8 {
             num[k] += tn[k];
             den[k] += td[k];
