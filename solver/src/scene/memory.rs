@@ -58,9 +58,10 @@ pub enum MemoryError {
 /// the module docs). Saturates instead of overflowing, so any `n` gives an answer.
 ///
 /// For `wcsph`, `n` is mapped to its resolution as the commands map it, and the count is of
-/// fluid and wall particles: lists of [`WCSPH_SLOTS`] for every particle, the position its
-/// list was built at, its kicked velocity and a 1/512 share of a displacement block, and a
-/// density rate and a 1/256 share of a speed block per fluid particle.
+/// fluid and wall particles: lists of [`WCSPH_SLOTS`] for every particle, its kicked velocity,
+/// a 1/512 share of a displacement block and, with all-pairs, the position its list was built
+/// at (the grid's own copies serve), and a density rate and a 1/256 share of a speed block
+/// per fluid particle.
 pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
     let (physics, domain, n, lists_of, fluid_scratch) = match preset {
         Preset::Wcsph => {
@@ -68,8 +69,14 @@ pub fn estimate(preset: Preset, neighbors: NeighborMode, n: usize) -> u64 {
             let fluid = wcsph::scene::dam_break_particles(r);
             let physics = Physics::from(WcParams::new(r, fluid));
             let total = fluid + wcsph::scene::wall_particles(r);
-            // Per particle: where its list was built and its kicked velocity (x and y each).
-            let kept = 4 * total as u64 + total.div_ceil(MOVED_BLOCK) as u64;
+            // Per particle: its kicked velocity and, with all-pairs, where its list was built
+            // (x and y each).
+            let copies = if neighbors == NeighborMode::AllPairs {
+                2
+            } else {
+                0
+            };
+            let kept = (2 + copies) * total as u64 + total.div_ceil(MOVED_BLOCK) as u64;
             let scratch = 8 * (fluid as u64 + fluid.div_ceil(SPEED_BLOCK) as u64 + kept);
             (physics, wcsph::scene::domain(), total, WCSPH_SLOTS, scratch)
         }

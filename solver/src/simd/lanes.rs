@@ -83,6 +83,12 @@ pub trait Lanes: Copy + Send + Sync + Quad {
         (0..8).fold(0, |m, k| m | (u8::from(v[k] != x) << k))
     }
 
+    /// Bit k set where `v[k] < x`.
+    #[inline(always)]
+    fn below16(self, v: [u32; 16], x: u32) -> u16 {
+        (0..16).fold(0, |m, k| m | (u16::from(v[k] < x) << k))
+    }
+
     /// The values of `v` whose bit is set in `mask`, packed at the front in lane order (the
     /// other places zero).
     #[inline(always)]
@@ -244,6 +250,17 @@ mod x86 {
                 || {
                     let v4 = self.0;
                     v4.avx512f._mm256_cmpneq_epu32_mask(cast(v), cast(v4.splat_u32x8(x)))
+                },
+            )
+        }
+
+        #[inline(always)]
+        fn below16(self, v: [u32; 16], x: u32) -> u16 {
+            self.vectorize(
+                #[inline(always)]
+                || {
+                    let v4 = self.0;
+                    v4.avx512f._mm512_cmplt_epu32_mask(cast(v), cast(v4.splat_u32x16(x)))
                 },
             )
         }
@@ -564,6 +581,10 @@ mod tests {
         );
         assert_eq!(Portable.compress8(v, u8::MAX), v);
         assert_eq!(Portable.compress8(v, 0), [0; 8]);
+        let mut sixteen = [u32::MAX; 16];
+        sixteen[..8].copy_from_slice(&v);
+        assert_eq!(Portable.below16(sixteen, 5), 0b0000_0000_1100_1010);
+        assert_eq!(Portable.below16(sixteen, u32::MAX), 0x00ff);
         for path in SimdPath::available() {
             for x in [3, 0, 4_000_000_000, 11] {
                 let got = crate::with_lanes!(path.lanes().unwrap(), l => l.ne8(v, x));
@@ -572,6 +593,11 @@ mod tests {
             for mask in 0..=u8::MAX {
                 let got = crate::with_lanes!(path.lanes().unwrap(), l => l.compress8(v, mask));
                 assert_eq!(got, Portable.compress8(v, mask), "{path}: {mask:08b}");
+            }
+            let sixteen: [u32; 16] = std::array::from_fn(|k| v[k % 8] ^ (k as u32 >> 3));
+            for x in [0, 3, 4, 5, 91, 4_000_000_000, u32::MAX] {
+                let got = crate::with_lanes!(path.lanes().unwrap(), l => l.below16(sixteen, x));
+                assert_eq!(got, Portable.below16(sixteen, x), "{path}: {x}");
             }
         }
     }

@@ -100,7 +100,7 @@ impl Simulation {
             Some(keys) => neighbors.with_grid_keys(keys),
             None => neighbors,
         };
-        let scratch = with_model!(&physics, m => AnyScratch::of_model(m, n));
+        let scratch = with_model!(&physics, m => AnyScratch::of_model(m, n, &neighbors));
         Simulation {
             physics,
             domain,
@@ -153,7 +153,7 @@ impl Simulation {
     /// step builds them for the new one.
     fn search_replaced(&mut self) {
         let n = self.state.len();
-        self.scratch = with_model!(&self.physics, m => AnyScratch::of_model(m, n));
+        self.scratch = with_model!(&self.physics, m => AnyScratch::of_model(m, n, &self.neighbors));
     }
 
     /// The order sums over neighbours run in.

@@ -72,8 +72,8 @@ pub trait Model: Copy + Debug {
     /// The densities a picture colours against.
     fn density_range(&self) -> (f64, f64);
 
-    /// The scratch of a run of `n` particles.
-    fn scratch(&self, n: usize) -> Self::Scratch;
+    /// The scratch of a run of `n` particles searched by `search`.
+    fn scratch(&self, n: usize, search: &AnyNeighbors) -> Self::Scratch;
 
     /// Brings the neighbour search up to date with the positions of `on` (once per step,
     /// before the passes), on `exec`. By default it is rebuilt; a model whose lists outlive a
@@ -167,9 +167,10 @@ impl Scratch for () {
 pub struct AnyScratch(Box<dyn Erased>);
 
 impl AnyScratch {
-    /// The scratch of `model` for a run of `n` particles ([`Model::scratch`]).
-    pub fn of_model<M: Model>(model: &M, n: usize) -> Self {
-        AnyScratch(Box::new(model.scratch(n)))
+    /// The scratch of `model` for a run of `n` particles searched by `search`
+    /// ([`Model::scratch`]).
+    pub fn of_model<M: Model>(model: &M, n: usize, search: &AnyNeighbors) -> Self {
+        AnyScratch(Box::new(model.scratch(n, search)))
     }
 
     /// The scratch, as the model that made it knows it.

@@ -13,7 +13,7 @@ use crate::simd::Lanes;
 use crate::solver::model::{Model, Particles, Units, no_such_pass};
 use crate::solver::pass::Pass;
 use crate::solver::search::{with_search, with_search_lanes};
-use crate::sph::neighbors::{NeighborLists, Neighbors, SLOTS};
+use crate::sph::neighbors::{AnyNeighbors, NeighborLists, Neighbors, SLOTS};
 use crate::sph::state::{Domain, Fields, Positions, State};
 use crate::with_lanes;
 
@@ -73,7 +73,7 @@ impl Model for Params {
         (own, 4.0 * own)
     }
 
-    fn scratch(&self, _: usize) {}
+    fn scratch(&self, _: usize, _: &AnyNeighbors) {}
 
     fn run_pass<E: Executor>(
         &self,

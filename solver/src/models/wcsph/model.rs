@@ -16,7 +16,7 @@ use crate::simd::Lanes;
 use crate::solver::model::{self, Model, Particles, Units, no_such_pass};
 use crate::solver::pass::Pass;
 use crate::solver::search::{with_search, with_search_lanes};
-use crate::sph::neighbors::{GridKeys, NeighborLists, Neighbors, WCSPH_SLOTS};
+use crate::sph::neighbors::{AnyNeighbors, GridKeys, NeighborLists, Neighbors, WCSPH_SLOTS};
 use crate::sph::state::{Domain, Fields, Positions, State};
 use crate::with_lanes;
 
@@ -42,15 +42,15 @@ pub struct Scratch {
 }
 
 impl Scratch {
-    /// Room for `fluid` fluid particles of `n`.
-    pub fn new(fluid: usize, n: usize) -> Scratch {
+    /// Room for `fluid` fluid particles of `n`, searched by `search`.
+    pub fn new(fluid: usize, n: usize, search: &AnyNeighbors) -> Scratch {
         Scratch {
             drho: vec![0.0; fluid],
             block_max: vec![0.0; fluid.div_ceil(SPEED_BLOCK)],
             dt: 0.0,
             kicked_x: vec![0.0; n],
             kicked_y: vec![0.0; n],
-            kept: KeptLists::new(n),
+            kept: with_search!(search, (nb, _lists) => KeptLists::new(n, nb)),
         }
     }
 }
@@ -121,8 +121,8 @@ impl Model for WcParams {
         (self.rho0, 1.01 * self.rho0)
     }
 
-    fn scratch(&self, n: usize) -> Scratch {
-        Scratch::new(self.fluid(n), n)
+    fn scratch(&self, n: usize, search: &AnyNeighbors) -> Scratch {
+        Scratch::new(self.fluid(n), n, search)
     }
 
     /// Rebuilds the search (and has the neighbour pass build the lists) only when some
@@ -135,9 +135,11 @@ impl Model for WcParams {
     ) -> Result<(), KernelPanic> {
         let s = &*on.state;
         let pos = Positions { x: &s.x, y: &s.y };
-        if scratch.kept.stale(exec, pos, self.relist_sq)? {
+        let kept = &mut scratch.kept;
+        let stale = with_search!(&*on.neighbors, (nb, _lists) => kept.stale(exec, pos, nb, self.relist_sq))?;
+        if stale {
             with_search!(on.neighbors, (nb, _lists) => nb.rebuild(exec, pos))?;
-            scratch.kept.rebuilt_at(exec, pos)?;
+            kept.rebuilt(exec, pos)?;
         }
         Ok(())
     }
@@ -163,32 +165,27 @@ impl Model for WcParams {
             // The lists still serve.
             Pass::Neighbors => Ok(()),
             Pass::Walls => {
-                let built = scratch.kept.positions();
-                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => walls(exec, l, Listed { nb: &*nb, lists, built }, s, self)))
+                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => walls(exec, l, Listed { nb: &*nb, lists }, s, self)))
             }
             Pass::Momentum => {
                 let Scratch {
-                    kept,
                     kicked_x,
                     kicked_y,
                     dt,
                     ..
                 } = scratch;
-                let built = kept.positions();
                 let kicked = (&mut kicked_x[..self.fluid], &mut kicked_y[..self.fluid]);
-                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => momentum(exec, l, Listed { nb: &*nb, lists, built }, s, kicked, *dt, self)))
+                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => momentum(exec, l, Listed { nb: &*nb, lists }, s, kicked, *dt, self)))
             }
             Pass::Continuity => {
                 let Scratch {
-                    kept,
                     drho,
                     kicked_x,
                     kicked_y,
                     ..
                 } = scratch;
-                let built = kept.positions();
                 let kicked = (&kicked_x[..], &kicked_y[..]);
-                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => continuity(exec, l, Listed { nb: &*nb, lists, built }, s, kicked, drho, self)))
+                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => continuity(exec, l, Listed { nb: &*nb, lists }, s, kicked, drho, self)))
             }
             Pass::Integrate => integrate(exec, s, scratch, self),
             other => no_such_pass(self.preset(), other),

@@ -55,23 +55,17 @@ pub fn neighbors<N: Neighbors>(
     list.finish()
 }
 
-/// The search, its lists and the positions both were built at: what a pass needs to visit a
-/// particle's neighbours.
+/// The search and its lists: what a pass needs to visit a particle's neighbours.
 #[derive(Debug)]
 pub struct Listed<'a, N: Neighbors> {
-    /// The search, as built at `built`.
+    /// The search, as last rebuilt.
     pub nb: &'a N,
-    /// Every particle's list, built at `built` with the lists' radius.
+    /// Every particle's list, built at the search's last rebuild with the lists' radius.
     pub lists: &'a NeighborLists<N::Key>,
-    /// The positions of the last build.
-    pub built: Positions<'a>,
 }
 
 /// Calls `pair(b, r2)` for each of particle `i`'s neighbours now within 2h (`r2` at `pos`, the
-/// positions now), in the order its list holds them: from its list when it fit (in its slots,
-/// and its keys in their type), else by asking the search again at the positions it was
-/// built at. Either way the same particles in the same order: those within the lists' radius
-/// at the build, which hold every particle within 2h now ([`crate::models::wcsph::kept`]).
+/// positions now), in index order: those of its list ([`for_each_in_list`]) now within 2h.
 #[inline(always)]
 fn for_each_neighbor<N: Neighbors>(
     i: usize,
@@ -81,7 +75,7 @@ fn for_each_neighbor<N: Neighbors>(
     mut pair: impl FnMut(usize, f64),
 ) {
     let (xi, yi) = (pos.x[i], pos.y[i]);
-    for_each_in_list(i, listed, prm, |b| {
+    for_each_in_list(i, pos, listed, prm, |b| {
         let r2 = distance_squared(xi, yi, pos.x[b], pos.y[b]);
         if r2 < prm.support_sq {
             pair(b, r2);
@@ -89,18 +83,23 @@ fn for_each_neighbor<N: Neighbors>(
     });
 }
 
-/// Calls `visit(b)` for each particle b of particle `i`'s list, in its order: from the list
-/// when it fit (in its slots, and its keys in their type), else by asking the search again at
-/// the positions it was built at (the same particles in the same order).
+/// Calls `visit(b)` for each particle b of particle `i`'s list, in index order: the list when
+/// it fit (in its slots, and its keys in their type). Else the search is asked again, with the
+/// lists' radius, for i at `pos`, the positions now: all-pairs tests the others at `pos` too,
+/// the grid its copies of where they were at the rebuild, among the candidates of i's cell
+/// then. Each way visits every particle now within 2h of i, none having moved half the skin
+/// since the rebuild ([`crate::models::wcsph::kept`]), in index order, and the passes sum only
+/// those: the same bits.
 #[inline(always)]
 fn for_each_in_list<N: Neighbors>(
     i: usize,
+    pos: Positions<'_>,
     listed: &Listed<'_, N>,
     prm: &WcParams,
     mut visit: impl FnMut(usize),
 ) {
     match listed.lists.of(i) {
-        Some(list) => listed.nb.for_each_listed(i, listed.built, list, visit),
+        Some(list) => listed.nb.for_each_listed(i, pos, list, visit),
         None => {
             let limit = if i < prm.fluid { usize::MAX } else { prm.fluid };
             // An unusable list (too long for its slots, or a grid key past 255) is rare: the
@@ -109,7 +108,7 @@ fn for_each_in_list<N: Neighbors>(
             let hsq = prm.list_radius_sq;
             listed
                 .nb
-                .for_each_within(scratch, Portable, i, listed.built, hsq, |b, _, _| {
+                .for_each_within(scratch, Portable, i, pos, hsq, |b, _, _| {
                     if b != i && b < limit {
                         visit(b);
                     }
@@ -128,6 +127,7 @@ fn for_each_in_list<N: Neighbors>(
 #[inline(always)]
 fn for_each_eight<N: Neighbors>(
     i: usize,
+    pos: Positions<'_>,
     listed: &Listed<'_, N>,
     prm: &WcParams,
     mut eight: impl FnMut(&[usize; 8], usize),
@@ -135,6 +135,7 @@ fn for_each_eight<N: Neighbors>(
     let mut batch = Eight { b: [i; 8], len: 0 };
     for_each_in_list(
         i,
+        pos,
         listed,
         prm,
         #[inline(always)]
@@ -209,6 +210,7 @@ pub fn acceleration<N: Neighbors>(
     let (mut sx, mut sy) = (0.0, 0.0);
     for_each_eight(
         a,
+        f.pos,
         listed,
         prm,
         #[inline(always)]
@@ -238,6 +240,7 @@ pub fn density_rate<N: Neighbors>(
     let mut sum = 0.0;
     for_each_eight(
         a,
+        input.fields.pos,
         listed,
         prm,
         #[inline(always)]

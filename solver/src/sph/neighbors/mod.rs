@@ -99,6 +99,16 @@ impl std::fmt::Display for NeighborMode {
     }
 }
 
+/// Positions a search was rebuilt at, as it keeps them ([`Neighbors::rebuilt_at`]):
+/// particle `of[k]` was at `(at.x[k], at.y[k])`.
+#[derive(Debug, Clone, Copy)]
+pub struct Rebuilt<'a> {
+    /// The positions, in the search's order.
+    pub at: Positions<'a>,
+    /// The particle at each place.
+    pub of: &'a [u32],
+}
+
 /// A neighbour search over a set of positions.
 pub trait Neighbors: Sync {
     /// How a neighbour list names a particle this search found: see
@@ -117,12 +127,20 @@ pub trait Neighbors: Sync {
     /// per-particle parts of the work run on `exec`.
     fn rebuild<E: Executor>(&mut self, exec: &E, pos: Positions<'_>) -> Result<(), KernelPanic>;
 
+    /// The positions of the last [`Neighbors::rebuild`], where the search keeps copies of
+    /// them: the grid does, in its own order; all-pairs keeps none.
+    fn rebuilt_at(&self) -> Option<Rebuilt<'_>> {
+        None
+    }
+
     /// Calls `visit(j, r2, key)` for every particle j (including `i` itself) whose squared
     /// distance `r2 = dx*dx + dy*dy` (with `d = x_j − x_i`) is below `hsq`, in the search's
     /// visit order (increasing j, unless a grid in [`SumOrder::Cell`]),
     /// testing candidates in `lanes` where the search uses them (all-pairs does, the grid does
     /// not); every path finds the same j with the same r2. `pos` must be the positions of the
-    /// last [`Neighbors::rebuild`] (the grid tests copies of them).
+    /// last [`Neighbors::rebuild`] for r2 to be theirs. The grid finds j by testing i at `pos`
+    /// against its copies of the others' positions at the rebuild, among the candidates of
+    /// i's cell then (`wcsph`'s kept lists ask it so at positions since, and read only j).
     ///
     /// `key` names j in a list of i's neighbours ([`Neighbors::for_each_listed`]); it may
     /// exceed [`ListKey::MAX`] (the grid's, among more candidates than a key counts), and such
@@ -205,8 +223,9 @@ pub trait Neighbors: Sync {
     }
 
     /// Calls `visit(j)` for the neighbour each key of `list` names, in order: `list` holds keys
-    /// that [`Neighbors::for_each_within`] gave for particle `i` since the last rebuild, with
-    /// `pos` unchanged.
+    /// that [`Neighbors::for_each_within`] gave for particle `i` since the last rebuild. (No
+    /// search here reads `pos`: the grid's position keys are decoded in i's cell at the
+    /// rebuild.)
     fn for_each_listed(
         &self,
         i: usize,

@@ -5,6 +5,8 @@
 //! candidates ([`hit`]): indices are distinct, so sorting the words sorts by index, and the low
 //! word alone gives the candidates' order.
 
+use crate::simd::Lanes;
+
 /// Candidates of one particle collected in [`GridScratch`]; a particle with more (a pile in a
 /// corner) collects its hits in a vector. Müller's presets have about 12–30 candidates, `wcsph`
 /// up to about 100 next to a wall.
@@ -22,6 +24,9 @@ pub(super) const ONE_LOOP_MAX: u32 = 32;
 /// within their radius, a search of 2h near a wall up to about 45) are sorted by comparison
 /// instead. Either gives the one increasing order of distinct indices.
 pub(super) const RANK_SORT_MAX: usize = 32;
+
+// The rank sort compares two registers of sixteen.
+const _: () = assert!(RANK_SORT_MAX == 32);
 
 /// The most hits put in order by [`sort_small`], whose work is fixed: no branch depends on the
 /// number of hits. Müller's particles have about 6 hits (self included) once the dam has
@@ -76,17 +81,21 @@ pub(super) fn position_of(hit: u64) -> u32 {
 /// Puts the hits `src` (at most [`RANK_SORT_MAX`], of distinct indices) in increasing order
 /// into `dst` by counting, for each, how many indices are smaller: quadratic but branch-free,
 /// which beats branching sorts on a few dozen. The indices are compared as 32-bit words, all
-/// [`RANK_SORT_MAX`] places at once (the places past the hits hold `u32::MAX`, smaller than
-/// none), so that the count has no loop end that depends on the number of hits.
-#[inline]
-pub(super) fn rank_sort(src: &[u64], dst: &mut [u64]) {
+/// [`RANK_SORT_MAX`] places at once in `lanes` (the places past the hits hold `u32::MAX`,
+/// smaller than none), so that the count has no loop end that depends on the number of hits:
+/// on AVX-512 two compares into mask registers and their population counts. (A sum of the
+/// comparisons took each bit out of the mask on its own.)
+#[inline(always)]
+pub(super) fn rank_sort<L: Lanes>(lanes: L, src: &[u64], dst: &mut [u64]) {
     let mut indices = [u32::MAX; RANK_SORT_MAX];
     for (index, &h) in indices.iter_mut().zip(src) {
         *index = index_of(h);
     }
+    let low: [u32; 16] = std::array::from_fn(|k| indices[k]);
+    let high: [u32; 16] = std::array::from_fn(|k| indices[16 + k]);
     for &h in src {
         let i = index_of(h);
-        let rank: u32 = indices.iter().map(|&w| u32::from(w < i)).sum();
+        let rank = lanes.below16(low, i).count_ones() + lanes.below16(high, i).count_ones();
         dst[rank as usize] = h;
     }
 }
@@ -128,6 +137,8 @@ pub(super) fn sort_small(hits: &mut [u64; SMALL]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::simd::{Portable, SimdPath};
+    use crate::with_lanes;
 
     #[test]
     fn the_small_network_sorts_every_input() {
@@ -168,18 +179,20 @@ mod tests {
         let src: Vec<u64> = (0..RANK_SORT_MAX as u32)
             .map(|k| hit((k * 13) % RANK_SORT_MAX as u32 * 7 + 1, k))
             .collect();
-        let mut dst = vec![0u64; RANK_SORT_MAX];
-        rank_sort(&src, &mut dst);
         let mut expected = src.clone();
         expected.sort_unstable();
-        assert_eq!(dst, expected);
+        for path in SimdPath::available() {
+            let mut dst = vec![0u64; RANK_SORT_MAX];
+            with_lanes!(path.lanes().unwrap(), l => rank_sort(l, &src, &mut dst));
+            assert_eq!(dst, expected, "{path}");
+        }
     }
 
     #[test]
     fn a_rank_sort_orders_distinct_hits_by_index() {
         let src = [hit(9, 0), hit(3, 1), hit(12, 2), hit(4, 3)];
         let mut dst = [0u64; 4];
-        rank_sort(&src, &mut dst);
+        rank_sort(Portable, &src, &mut dst);
         assert_eq!(dst.map(index_of), [3, 4, 9, 12]);
         assert_eq!(dst.map(position_of), [1, 3, 0, 2]);
     }

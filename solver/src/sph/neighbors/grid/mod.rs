@@ -43,7 +43,7 @@ pub use sort::PARALLEL_SORT;
 use sort::{CellSort, GridArrays};
 
 use super::list::written_zeros;
-use super::{Bounds, Eight, Neighbors, SumOrder, distance_squared};
+use super::{Bounds, Eight, Neighbors, Rebuilt, SumOrder, distance_squared};
 use crate::simd::{Lanes, Row8};
 use crate::sph::state::Positions;
 
@@ -212,6 +212,17 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         )
     }
 
+    fn rebuilt_at(&self) -> Option<Rebuilt<'_>> {
+        let at = Positions {
+            x: &self.sorted_x,
+            y: &self.sorted_y,
+        };
+        Some(Rebuilt {
+            at,
+            of: &self.order,
+        })
+    }
+
     #[inline(always)]
     fn for_each_within<L: Lanes>(
         &self,
@@ -295,7 +306,7 @@ impl<K: GridKey, O: VisitOrder> Neighbors for Grid<K, O> {
         } else if in_order(&hits[..len]) {
             &hits[..len]
         } else if len <= RANK_SORT_MAX {
-            rank_sort(&hits[..len], &mut ranked[..len]);
+            rank_sort(lanes, &hits[..len], &mut ranked[..len]);
             &ranked[..len]
         } else {
             hits[..len].sort_unstable();
