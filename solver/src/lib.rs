@@ -15,6 +15,8 @@
 //! command line (the workspace's dependencies keep it so; `tests/it/layers.rs` checks it).
 
 pub mod checksum;
+#[cfg(test)]
+mod cutting;
 pub mod io;
 pub mod models;
 pub mod scene;

@@ -19,7 +19,7 @@
 use glam::DVec2;
 
 use super::params::WcParams;
-use crate::sph::state::{Fields, Positions};
+use crate::sph::state::Fields;
 
 /// Eight lanes.
 pub type F8 = [f64; 8];
@@ -168,9 +168,8 @@ pub fn momentum<const W: usize>(
     prm: &WcParams,
 ) -> (Lanes<W>, Lanes<W>) {
     let b = Neighbours(*b);
-    let (dx, dy, r2) = separations(&me.x, &me.y, &b, f.pos);
-    let (rho, p) = (b.gather(f.rho), b.gather(f.p));
-    let (vx, vy) = (b.gather(f.vx), b.gather(f.vy));
+    let [x, y, vx, vy, rho, p] = b.gather([f.pos.x, f.pos.y, f.vx, f.vy, f.rho, f.p]);
+    let (dx, dy, r2) = separations(&me.x, &me.y, &x, &y);
     let g = gradient_factors(&r2, prm);
     let (mut tx, mut ty) = ([0.0; W], [0.0; W]);
     for k in 0..W {
@@ -204,9 +203,8 @@ pub fn continuity<const W: usize>(
     let f = &input.fields;
     let diffusion = 2.0 * prm.delta * prm.h * prm.c0;
     let b = Neighbours(*b);
-    let (dx, dy, r2) = separations(&me.x, &me.y, &b, f.pos);
-    let rho = b.gather(f.rho);
-    let (vx, vy) = (b.gather(input.kicked_x), b.gather(input.kicked_y));
+    let [x, y, vx, vy, rho] = b.gather([f.pos.x, f.pos.y, input.kicked_x, input.kicked_y, f.rho]);
+    let (dx, dy, r2) = separations(&me.x, &me.y, &x, &y);
     let g = gradient_factors(&r2, prm);
     let mut term = [0.0; W];
     for k in 0..W {
@@ -238,8 +236,9 @@ pub fn wall(
         fluid[k] = if keep[k] { b[k] } else { 0 };
     }
     let b = Neighbours(fluid);
-    let (dx, dy, r2) = separations(xw, yw, &b, f.pos);
-    let (rho, p) = (b.gather(f.rho), b.gather(f.p));
+    let [x, y] = b.gather([f.pos.x, f.pos.y]);
+    let (dx, dy, r2) = separations(xw, yw, &x, &y);
+    let [rho, p] = b.gather([f.rho, f.p]);
     let (mut num, mut den) = ([0.0; 8], [0.0; 8]);
     for k in 0..8 {
         let q = r2[k].sqrt() * prm.inv_h;
@@ -269,39 +268,46 @@ fn gradient_factors<const W: usize>(r2: &Lanes<W>, prm: &WcParams) -> Lanes<W> {
     g
 }
 
-/// x_a − x_b and y_a − y_b of the eight pairs, and their squared distance: (x_b − x_a)² is
-/// (x_a − x_b)², bit for bit, so it is `distance_squared`'s value.
+/// x_a − x_b and y_a − y_b of the eight pairs (b's coordinates in `xb`, `yb`), and their
+/// squared distance: (x_b − x_a)² is (x_a − x_b)², bit for bit, so it is `distance_squared`'s
+/// value.
 #[inline(always)]
 fn separations<const W: usize>(
     xa: &Lanes<W>,
     ya: &Lanes<W>,
-    b: &Neighbours<W>,
-    pos: Positions<'_>,
+    xb: &Lanes<W>,
+    yb: &Lanes<W>,
 ) -> (Lanes<W>, Lanes<W>, Lanes<W>) {
-    let (x, y) = (b.gather(pos.x), b.gather(pos.y));
     let (mut dx, mut dy, mut r2) = ([0.0; W], [0.0; W], [0.0; W]);
     for k in 0..W {
-        dx[k] = xa[k] - x[k];
-        dy[k] = ya[k] - y[k];
+        dx[k] = xa[k] - xb[k];
+        dy[k] = ya[k] - yb[k];
         r2[k] = dx[k] * dx[k] + dy[k] * dy[k];
     }
     (dx, dy, r2)
 }
 
-/// The neighbours of the lanes, one a lane, from which the passes gather their fields. Each
-/// load is bounds-checked on its own, which keeps the loads scalar: checking each index once
-/// before the loads let the compiler fetch a field's lanes with one gather instruction
-/// (`vgatherqpd`), and the continuity pass in sixteen lanes took 360–440 ms per 1500 steps at
-/// R = 40 so, 275 ms with the loads checked one by one (the momentum pass the same either way).
+/// The neighbours of the lanes, one a lane, from which the passes gather their fields. The
+/// fields a pass reads are cut to one length, so that each lane's index is bounds-checked once
+/// for all of them, before that lane's loads: the checks keep the loads scalar (checking every
+/// index before any load let the compiler fetch a field's lanes with one gather instruction,
+/// `vgatherqpd`, and the continuity pass in sixteen lanes took 360–440 ms per 1500 steps at
+/// R = 40 so, against 275 ms with the loads checked one by one).
 struct Neighbours<const W: usize>([usize; W]);
 
 impl<const W: usize> Neighbours<W> {
-    /// `values` (one per particle) of the lanes' neighbours.
+    /// The lanes' neighbours' values in each of `fields` (one value per particle, all of the
+    /// first field's length).
     #[inline(always)]
-    fn gather(&self, values: &[f64]) -> Lanes<W> {
-        let mut out = [0.0; W];
+    fn gather<const F: usize>(&self, fields: [&[f64]; F]) -> [Lanes<W>; F] {
+        let n = fields.first().map_or(0, |f| f.len());
+        let fields = fields.map(|f| &f[..n]);
+        let mut out = [[0.0; W]; F];
         for k in 0..W {
-            out[k] = values[self.0[k]];
+            let j = self.0[k];
+            for (lanes, field) in out.iter_mut().zip(&fields) {
+                lanes[k] = field[j];
+            }
         }
         out
     }

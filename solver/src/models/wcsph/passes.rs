@@ -65,7 +65,8 @@ pub struct Listed<'a, N: Neighbors> {
 }
 
 /// Calls `pair(b, r2)` for each of particle `i`'s neighbours now within 2h (`r2` at `pos`, the
-/// positions now), in index order: those of its list ([`for_each_in_list`]) now within 2h.
+/// positions now), in the order its list holds them: those of its list ([`for_each_in_list`])
+/// now within 2h.
 #[inline(always)]
 fn for_each_neighbor<N: Neighbors>(
     i: usize,
@@ -83,13 +84,15 @@ fn for_each_neighbor<N: Neighbors>(
     });
 }
 
-/// Calls `visit(b)` for each particle b of particle `i`'s list, in index order: the list when
-/// it fit (in its slots, and its keys in their type). Else the search is asked again, with the
-/// lists' radius, for i at `pos`, the positions now: all-pairs tests the others at `pos` too,
-/// the grid its copies of where they were at the rebuild, among the candidates of i's cell
-/// then. Each way visits every particle now within 2h of i, none having moved half the skin
-/// since the rebuild ([`crate::models::wcsph::kept`]), in index order, and the passes sum only
-/// those: the same bits.
+/// Calls `visit(b)` for each particle b of particle `i`'s list, in its order (the search's
+/// visit order: by index, or the grid's candidate order in its cell at the rebuild under
+/// `--order cell`): the list when it fit (in its slots, and its keys in their type). Else the
+/// search is asked again, with the lists' radius, for i at `pos`, the positions now: all-pairs
+/// tests the others at `pos` too, the grid its copies of where they were at the rebuild, among
+/// the candidates of i's cell then, in the same order. Each way visits every particle now
+/// within 2h of i, none having moved half the skin since the rebuild
+/// ([`crate::models::wcsph::kept`]), in the list's order, and the passes sum only those: the
+/// same bits.
 #[inline(always)]
 fn for_each_in_list<N: Neighbors>(
     i: usize,

@@ -137,10 +137,11 @@ pub trait Neighbors: Sync {
     /// distance `r2 = dx*dx + dy*dy` (with `d = x_j − x_i`) is below `hsq`, in the search's
     /// visit order (increasing j, unless a grid in [`SumOrder::Cell`]),
     /// testing candidates in `lanes` where the search uses them (all-pairs does, the grid does
-    /// not); every path finds the same j with the same r2. `pos` must be the positions of the
-    /// last [`Neighbors::rebuild`] for r2 to be theirs. The grid finds j by testing i at `pos`
-    /// against its copies of the others' positions at the rebuild, among the candidates of
-    /// i's cell then (`wcsph`'s kept lists ask it so at positions since, and read only j).
+    /// not); every path finds the same j with the same r2 when `pos` holds the positions of
+    /// the last [`Neighbors::rebuild`]. The grid finds j by testing i at `pos` against its
+    /// copies of the others' positions at the rebuild, among the candidates of i's cell then
+    /// (`wcsph`'s kept lists ask it so at positions since, and read only j: the paths' r2 may
+    /// then differ, a crowded block's being computed from `pos`).
     ///
     /// `key` names j in a list of i's neighbours ([`Neighbors::for_each_listed`]); it may
     /// exceed [`ListKey::MAX`] (the grid's, among more candidates than a key counts), and such

@@ -1,36 +1,15 @@
 //! The grid's sort in bands ([`super::sort`]) against the serial sort, through a whole rebuild
 //! of the grid: a file of its own, since it needs both the grid and the sort.
 
-use sph_strategies::{Executor, KernelPanic};
+use sph_strategies::Executor;
 
 use super::Grid;
 use super::sort::PARALLEL_SORT;
+use crate::cutting::Cutting;
 use crate::scene::splitmix::SplitMix64;
 use crate::sph::neighbors::{Bounds, Neighbors};
 use crate::sph::state::Positions;
 use sph_strategies::seq::SeqExecutor;
-use sph_strategies::{Split, balanced_chunks};
-
-/// Runs every pass in `chunks` balanced chunks, one after another, and says it has two
-/// threads: the grid then sorts in bands, cut as a parallel strategy would cut them.
-struct Cutting(usize);
-
-impl Executor for Cutting {
-    fn for_each_chunk<O, F>(&self, out: O, kernel: F) -> Result<(), KernelPanic>
-    where
-        O: Split,
-        F: Fn(usize, O) + Sync,
-    {
-        for (first, chunk) in balanced_chunks(out, self.0) {
-            kernel(first, chunk);
-        }
-        Ok(())
-    }
-
-    fn threads(&self) -> usize {
-        2
-    }
-}
 
 /// The grid's arrays after a rebuild over `x`, `y` on `exec`.
 fn rebuilt(exec: &impl Executor, bounds: Bounds, x: &[f64], y: &[f64]) -> [Vec<u64>; 5] {
