@@ -44,7 +44,7 @@ pub fn install(stop: Stop) {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         let mut wanted = vec![SIGINT, SIGTERM];
-        if !ignored_at_start(SIGHUP) {
+        if !sighup_ignored_at_start() {
             wanted.push(SIGHUP);
         }
         let Ok(mut signals) = Signals::new(&wanted) else {
@@ -91,13 +91,13 @@ fn on_signal(stop: Stop, signal: i32) {
     }
 }
 
-/// Whether `signal` was ignored when this process started (`nohup` ignores SIGHUP): the
-/// `SigIgn` mask of `/proc/self/status`, one bit per signal number from 1. False where that
-/// cannot be read.
-fn ignored_at_start(signal: i32) -> bool {
+/// Whether SIGHUP was ignored when this process started (`nohup` ignores it, and a child
+/// inherits that): the `SigIgn` mask of `/proc/self/status`. False where that cannot be read.
+/// A command started from such a process keeps running when its terminal closes.
+pub fn sighup_ignored_at_start() -> bool {
     std::fs::read_to_string("/proc/self/status")
         .ok()
-        .and_then(|status| ignored_in(&status, signal))
+        .and_then(|status| ignored_in(&status, SIGHUP))
         .unwrap_or(false)
 }
 
