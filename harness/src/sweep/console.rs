@@ -365,12 +365,41 @@ pub fn best_cells(plan: &Plan, rows: &[SummaryRow]) -> String {
                     );
                 }
                 None => {
-                    let _ = writeln!(text, "  {name:<w$} (no successful cell)");
+                    let _ = writeln!(
+                        text,
+                        "  {name:<w$} {}",
+                        unconfirmed(rows, group, strategy, pin)
+                    );
                 }
             }
         }
     }
     text
+}
+
+/// What the best-cell table says of a strategy with no row in its phase: a strategy the
+/// confirmation left out (its best grid cell took more than
+/// [`OUT_OF_THE_RUNNING`](super::confirm::OUT_OF_THE_RUNNING) times the fastest's mean) is named
+/// as such, with its grid figure; only a strategy none of whose cells finished has no
+/// successful cell.
+fn unconfirmed(
+    rows: &[SummaryRow],
+    group: &plan::Group,
+    strategy: StrategyName,
+    pin: Pin,
+) -> String {
+    let grid = rows.iter().filter(|r| {
+        r.phase == Phase::Grid && r.group() == *group && r.strategy == strategy && r.pin == pin
+    });
+    match fastest(grid, Contended::Compete) {
+        Some(r) => format!(
+            "not confirmed: out of the running in the grid rounds (best {} at {}, biased fast)",
+            r.speedup
+                .map_or_else(|| "-".to_owned(), |s| format!("{s:.2}× over seq")),
+            plural(r.cores, "core", "cores"),
+        ),
+        None => "(no successful cell)".to_owned(),
+    }
 }
 
 #[cfg(test)]
@@ -503,5 +532,46 @@ mod tests {
             .unwrap();
         assert!(line.contains("2.000"), "{text}");
         assert!(text.contains("seq"), "{text}");
+    }
+
+    #[test]
+    fn a_strategy_the_confirmation_left_out_is_named_so_not_called_unsuccessful() {
+        let p = Plan::new(&SweepParams {
+            strategies: vec![StrategyName::RayonChunks, StrategyName::RayonSpawn],
+            cores: vec![1],
+            ..SweepParams::small()
+        });
+        let strategy = |s| {
+            let at = p.cells.iter().position(|c| c.strategy.as_str() == s);
+            at.map(|at| &p.cells[at]).unwrap()
+        };
+        let (seq, fast, slow) = (
+            &p.cells[0],
+            strategy("rayon-chunks"),
+            strategy("rayon-spawn"),
+        );
+        let grid = |cell, walls: &[f64]| row(cell, walls, None);
+        let confirm = |cell, walls: &[f64]| SummaryRow {
+            phase: Phase::Confirm,
+            ..row(cell, walls, None)
+        };
+        let mut rows = vec![grid(seq, &[4.0]), grid(fast, &[2.0]), grid(slow, &[16.0])];
+        rows.extend([confirm(seq, &[4.0]), confirm(fast, &[2.0])]);
+        let text = best_cells(&p, &rows);
+        let line = |s: &str| {
+            let found = text.lines().find(|l| l.trim_start().starts_with(s));
+            found.unwrap().to_owned()
+        };
+        assert!(line("rayon-chunks").contains("2.000"), "{text}");
+        let spawn = line("rayon-spawn");
+        assert!(spawn.contains("not confirmed"), "{text}");
+        assert!(spawn.contains("best 0.25× over seq at 1 core"), "{text}");
+        // A strategy none of whose cells finished has no successful cell.
+        rows[2] = row(slow, &[16.0], Some("boom"));
+        let text = best_cells(&p, &rows);
+        assert!(
+            text.contains("rayon-spawn") && text.contains("(no successful cell)"),
+            "{text}"
+        );
     }
 }
