@@ -20,8 +20,10 @@
 //! one atomic store and closes it with one read-modify-write; a worker joins with one
 //! compare-and-swap and leaves with one subtraction (`TeamBoard`, in `erased_job`); each
 //! chunk is taken with one compare-and-swap on its share's word (a cache line of its own, the
-//! owner's unless others help) and moved out of its slot under an uncontended lock. No queue,
-//! nothing per element. Between passes a thread
+//! owner's unless others help) and moved out of its slot under an uncontended lock. Nobody
+//! resets the shares for a new pass (each word carries its pass's tag; see `Share`), so a
+//! share's line stays with its owner from pass to pass. No queue, nothing per element. Between
+//! passes a thread
 //! watches the pass word for up to 200 µs (spinning, then yielding its core between checks;
 //! see `spin_wait`) before it sleeps on a condition variable, so back-to-back passes need no
 //! wake-up; the watching shows up as CPU time.
@@ -89,7 +91,8 @@ impl Strategy for Team {
             board: &board,
             threads: self.cores,
             chunks: self.chunks,
-            shares: (0..self.cores).map(|_| Share::new(0, 0)).collect(),
+            shares: (0..self.cores).map(|_| Share::new()).collect(),
+            passes: Cell::new(0),
             not_sync: PhantomData,
         };
         let (cores, placement, board) = (self.cores, self.placement, &board);
@@ -132,51 +135,85 @@ struct TeamExecutor<'a> {
     chunks: usize,
     /// One per thread, kept from pass to pass.
     shares: Vec<Share>,
+    /// The last pass's tag (see [`Share`]).
+    passes: Cell<u64>,
     not_sync: PhantomData<Cell<()>>,
 }
 
-/// The chunks a thread owns in a pass: a range of chunk indices, `front` in the high half
-/// of the word and `back` (exclusive) in the low half. The owner takes chunks from the front,
-/// a thread whose own range is done takes them from the back; each take is one
-/// compare-and-swap that moves one end, so every chunk is taken exactly once.
+/// Bits of a share's word that tag it with its pass, and that hold each end of its range.
+const TAG_BITS: u32 = 16;
+const END_BITS: u32 = 24;
+const END: u64 = (1 << END_BITS) - 1;
+const TAGS: u64 = 1 << TAG_BITS;
+
+/// The most chunks a pass is cut into: a share's ends are 24-bit fields of its word. Above
+/// `--chunks`' range (10⁷), so from the command line a pass makes min(`--chunks`, N) chunks.
+const MOST_CHUNKS: usize = END as usize;
+
+/// The chunks a thread owns in a pass: a range of chunk indices, tagged with the pass. The
+/// word holds the tag (the high 16 bits), `front` and `back` (exclusive; 24 bits each). The
+/// owner takes chunks from the front, a thread whose own range is done takes them from the
+/// back; each take is one compare-and-swap that moves one end, so every chunk is taken exactly
+/// once.
+///
+/// Nobody resets a share for a new pass: a word tagged with an earlier pass stands for the
+/// pass's whole range, which every thread computes alike (`fresh`), and the first take
+/// replaces it. So between passes a share's cache line stays with the thread that took from
+/// it last — its owner, as a rule — instead of moving to the thread that opens the pass and
+/// back. A tag repeats after 2¹⁶ passes, so the opener resets every share when the tag comes
+/// round to 0 ([`Share::reset`]); no word is then older than the last 2¹⁶ passes, and a word
+/// with the current tag was written in this pass.
 struct Share(CachePadded<AtomicU64>);
 
+/// The pass a take is in: its tag, and the share's range in it before any take.
+#[derive(Clone, Copy)]
+struct InPass {
+    tag: u64,
+    fresh: (u64, u64),
+}
+
 impl Share {
-    fn new(front: usize, back: usize) -> Share {
-        Share(CachePadded::new(AtomicU64::new(Self::word(front, back))))
+    fn new() -> Share {
+        Share(CachePadded::new(AtomicU64::new(0)))
     }
 
-    /// Makes the share `front..back` again: only between passes, when nobody takes.
-    fn reset(&self, front: usize, back: usize) {
-        self.0.store(Self::word(front, back), Ordering::Relaxed);
+    /// Makes the share `fresh` with `tag`: only between passes, when nobody takes.
+    fn reset(&self, pass: InPass) {
+        let (front, back) = pass.fresh;
+        self.0
+            .store(Self::word(pass.tag, front, back), Ordering::Relaxed);
     }
 
-    fn word(front: usize, back: usize) -> u64 {
-        ((front as u64) << 32) | back as u64
+    fn word(tag: u64, front: u64, back: u64) -> u64 {
+        (tag << (2 * END_BITS)) | (front << END_BITS) | back
     }
 
     /// The next chunk from the front, for the owner.
-    fn take_front(&self) -> Option<usize> {
-        self.take(|front, back| (front + 1, back, front))
+    fn take_front(&self, pass: InPass) -> Option<usize> {
+        self.take(pass, |front, back| (front + 1, back, front))
     }
 
     /// The last chunk not yet taken, for a helper.
-    fn take_back(&self) -> Option<usize> {
-        self.take(|front, back| (front, back - 1, back - 1))
+    fn take_back(&self, pass: InPass) -> Option<usize> {
+        self.take(pass, |front, back| (front, back - 1, back - 1))
     }
 
     /// Applies `step(front, back)` = (new front, new back, chunk taken) while any is left.
-    fn take(&self, step: impl Fn(u64, u64) -> (u64, u64, u64)) -> Option<usize> {
+    fn take(&self, pass: InPass, step: impl Fn(u64, u64) -> (u64, u64, u64)) -> Option<usize> {
         let mut word = self.0.load(Ordering::Acquire);
         loop {
-            let (front, back) = (word >> 32, word & u64::from(u32::MAX));
+            let (front, back) = if word >> (2 * END_BITS) == pass.tag {
+                ((word >> END_BITS) & END, word & END)
+            } else {
+                pass.fresh
+            };
             if front >= back {
                 return None;
             }
             let (front, back, taken) = step(front, back);
             match self.0.compare_exchange_weak(
                 word,
-                (front << 32) | back,
+                Self::word(pass.tag, front, back),
                 Ordering::AcqRel,
                 Ordering::Acquire,
             ) {
@@ -197,17 +234,24 @@ impl Executor for TeamExecutor<'_> {
             return Ok(());
         }
         // Each chunk is moved out by the one thread whose compare-and-swap took its index.
-        // At most 2³² chunks: a share's ends are 32-bit halves of one word.
-        let most = self.chunks.min(u32::MAX as usize);
-        let chunks: Vec<Mutex<Option<(usize, O)>>> = balanced_chunks(out, most)
-            .into_iter()
-            .map(|chunk| Mutex::new(Some(chunk)))
-            .collect();
-        let (n, threads) = (chunks.len(), self.threads);
-        // Set before the pass opens (the board's opening store publishes them).
+        let chunks: Vec<Mutex<Option<(usize, O)>>> =
+            balanced_chunks(out, self.chunks.min(MOST_CHUNKS))
+                .into_iter()
+                .map(|chunk| Mutex::new(Some(chunk)))
+                .collect();
+        let (n, threads) = (chunks.len() as u64, self.threads as u64);
+        let tag = (self.passes.get() + 1) % TAGS;
+        self.passes.set(tag);
+        let in_pass = |t: usize| InPass {
+            tag,
+            fresh: (t as u64 * n / threads, (t as u64 + 1) * n / threads),
+        };
         let shares = &self.shares;
-        for (t, share) in shares.iter().enumerate() {
-            share.reset(t * n / threads, (t + 1) * n / threads);
+        if tag == 0 {
+            // Before the pass opens (the board's opening store publishes it).
+            for (t, share) in shares.iter().enumerate() {
+                share.reset(in_pass(t));
+            }
         }
         let panics = FirstPanic::default();
         let run = |i: usize| {
@@ -224,11 +268,12 @@ impl Executor for TeamExecutor<'_> {
         // the next threads' first. A panicking kernel is caught in `run`; the first panic is
         // kept.
         let job = |me: usize| {
-            while let Some(i) = shares[me].take_front() {
+            while let Some(i) = shares[me].take_front(in_pass(me)) {
                 run(i);
             }
+            let threads = shares.len();
             for other in (1..threads).map(|k| (me + k) % threads) {
-                while let Some(i) = shares[other].take_back() {
+                while let Some(i) = shares[other].take_back(in_pass(other)) {
                     run(i);
                 }
             }
@@ -246,24 +291,65 @@ impl Executor for TeamExecutor<'_> {
 mod tests {
     use super::*;
     use crate::testing::{distinct, run_counting, thread_ids_per_pass};
+    use std::iter;
 
     #[test]
     fn a_share_gives_every_chunk_once_to_its_owner_at_the_front_or_a_helper_at_the_back() {
-        let share = Share::new(10, 1010);
-        let (front, back) = std::thread::scope(|s| {
-            let owner = s.spawn(|| std::iter::from_fn(|| share.take_front()).collect::<Vec<_>>());
-            let helper = s.spawn(|| std::iter::from_fn(|| share.take_back()).collect::<Vec<_>>());
-            (owner.join().unwrap(), helper.join().unwrap())
-        });
-        assert!(front.windows(2).all(|w| w[0] < w[1]), "the owner goes up");
-        assert!(
-            back.windows(2).all(|w| w[0] > w[1]),
-            "the helper comes down"
-        );
-        let mut all = [front, back].concat();
-        all.sort_unstable();
-        assert_eq!(all, (10..1010).collect::<Vec<_>>());
-        assert_eq!((share.take_front(), share.take_back()), (None, None));
+        let share = Share::new();
+        // Each pass's range stands in a word left by the pass before, which took it all.
+        for (tag, fresh) in [(1, (10, 1010)), (2, (0, 500)), (3, (7, 8))] {
+            let pass = InPass { tag, fresh };
+            let (front, back) = std::thread::scope(|s| {
+                let owner =
+                    s.spawn(|| iter::from_fn(|| share.take_front(pass)).collect::<Vec<_>>());
+                let helper =
+                    s.spawn(|| iter::from_fn(|| share.take_back(pass)).collect::<Vec<_>>());
+                (owner.join().unwrap(), helper.join().unwrap())
+            });
+            assert!(front.windows(2).all(|w| w[0] < w[1]), "the owner goes up");
+            assert!(
+                back.windows(2).all(|w| w[0] > w[1]),
+                "the helper comes down"
+            );
+            let mut all = [front, back].concat();
+            all.sort_unstable();
+            let (from, to) = (fresh.0 as usize, fresh.1 as usize);
+            assert_eq!(all, (from..to).collect::<Vec<_>>(), "pass {tag}");
+            assert_eq!(
+                (share.take_front(pass), share.take_back(pass)),
+                (None, None)
+            );
+        }
+    }
+
+    #[test]
+    fn every_pass_runs_every_chunk_while_the_tags_come_round() {
+        // No worker serves the board, so the dispatcher takes every share's chunks, its own
+        // from the front and the others' from the back; the passes' lengths change, so a word
+        // left by one pass is never the next one's range. The first pass has tag 0, which the
+        // new shares' words carry too: words as if left 2¹⁶ passes before, which only the
+        // reset tells from this pass's.
+        let board = TeamBoard::new();
+        let executor = TeamExecutor {
+            board: &board,
+            threads: 3,
+            chunks: 5,
+            shares: (0..3).map(|_| Share::new()).collect(),
+            passes: Cell::new(TAGS - 1),
+            not_sync: PhantomData,
+        };
+        let mut out = vec![0u64; 9];
+        for pass in 1..=8u64 {
+            let len = [9, 2, 7][pass as usize % 3];
+            executor
+                .for_each_chunk(&mut out[..len], |_, chunk: &mut [u64]| chunk.fill(pass))
+                .unwrap();
+            assert!(
+                out[..len].iter().all(|&x| x == pass),
+                "pass {pass}: {out:?}"
+            );
+        }
+        assert_eq!(executor.passes.get(), 7);
     }
 
     #[test]

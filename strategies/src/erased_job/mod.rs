@@ -9,7 +9,8 @@
 //! returns; and the dispatcher's `run` returns only after every thread that joined has said it
 //! is done with the job:
 //! - [`JobBoard`] (`crossbeam-pool`) keeps its books under one mutex;
-//! - [`TeamBoard`] (`team`) keeps them in one atomic word, so that a pass costs the
+//! - [`TeamBoard`] (`team`) keeps them in one atomic word, with the job on its cache line
+//!   (written only between passes, read only by a worker inside one), so that a pass costs the
 //!   dispatcher one store and one read-modify-write on it (and two on a flag that only it
 //!   touches) and each worker two, and takes a lock only to sleep, to wake a sleeper, or to
 //!   keep a panic.

@@ -4,12 +4,14 @@
 //! workers are inside its job (low 31 bits). The dispatcher opens a pass with one store, a
 //! worker joins it with a compare-and-swap that succeeds only while the pass is open, and
 //! leaves it with a subtraction; the dispatcher closes it with an `and`, after which no
-//! compare-and-swap can succeed, and waits until the count is zero. Everything else —
+//! compare-and-swap can succeed, and waits until the count is zero. The pass's job sits on the
+//! word's cache line, so a worker that sees the pass open has its job too. Everything else —
 //! sleeping after a short watch, waking sleepers, keeping the first panic — happens only when
 //! somebody sleeps or something panicked.
 
+use std::cell::UnsafeCell;
 use std::mem;
-use std::sync::atomic::{AtomicBool, AtomicPtr, AtomicU64, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
 use std::time::Duration;
 
@@ -31,6 +33,21 @@ const EPOCH: u64 = 1 << 32;
 /// lets the operating system move a descheduled worker onto it.
 const LAST_OUT: Duration = Duration::from_micros(20);
 
+/// What a worker reads to join a pass.
+struct PassLine {
+    /// Epoch, open, inside (see the module's docs).
+    word: AtomicU64,
+    /// The last pass's job. Written by the dispatcher only between passes — after the last
+    /// worker of the previous pass counted itself out, before the opening store — and read by
+    /// a worker only inside a pass it joined, so a read and a write never overlap (see `run`
+    /// and `serve`).
+    job: UnsafeCell<ErasedJob>,
+}
+
+// SAFETY: `word` is atomic; `job` is written and read only as its docs say, so every read of
+// it happens after the write it reads and before the next one.
+unsafe impl Sync for PassLine {}
+
 fn epoch(word: u64) -> u64 {
     word >> 32
 }
@@ -40,12 +57,9 @@ fn epoch(word: u64) -> u64 {
 /// joined it, so a job must help until done — at a lower cost per pass (see the module's
 /// docs). Each serving thread has an index, which it passes to the job; the dispatcher's is 0.
 pub(crate) struct TeamBoard {
-    /// Epoch, open, inside (see the module's docs). On a cache line of its own: the workers
-    /// watch it.
-    pass: CachePadded<AtomicU64>,
-    /// The open pass's job, on the dispatcher's stack; read by a worker only once it has
-    /// joined the pass.
-    job: AtomicPtr<ErasedJob>,
+    /// The pass word and its job, on a cache line of their own: the workers watch it, and
+    /// one transfer of the line brings a worker both.
+    pass: CachePadded<PassLine>,
     /// A `run` is between opening its pass and returning.
     in_flight: AtomicBool,
     shutdown: AtomicBool,
@@ -68,8 +82,10 @@ impl TeamBoard {
     /// A board with no pass yet.
     pub(crate) fn new() -> Self {
         TeamBoard {
-            pass: CachePadded::new(AtomicU64::new(0)),
-            job: AtomicPtr::new(std::ptr::null_mut()),
+            pass: CachePadded::new(PassLine {
+                word: AtomicU64::new(0),
+                job: UnsafeCell::new(ErasedJob::new(&|_| {})),
+            }),
             in_flight: AtomicBool::new(false),
             shutdown: AtomicBool::new(false),
             escaped: Mutex::new(None),
@@ -100,18 +116,20 @@ impl TeamBoard {
             !self.in_flight.swap(true, Ordering::Acquire),
             "a team board runs one pass at a time"
         );
-        let erased = ErasedJob::new(job);
         // From opening the pass until no worker is inside it, an unwind out of `run` would
-        // free `erased` and the job under a running worker: the guard turns any unwind in that
+        // end the borrow of `job` under a running worker: the guard turns any unwind in that
         // window into an abort.
         let guard = AbortOnUnwind;
-        self.job
-            .store(std::ptr::from_ref(&erased).cast_mut(), Ordering::Relaxed);
+        // SAFETY: no worker reads `job` now: the previous pass's workers all counted
+        // themselves out before that pass's `run` returned, and none can join until the store
+        // below opens this pass; the store's release publishes the write to those that join.
+        unsafe { *self.pass.job.get() = ErasedJob::new(job) };
         // The previous pass ended with nobody inside and closed, so the word is its epoch.
-        let opened = (self.pass.load(Ordering::Relaxed) & !(OPEN | INSIDE)).wrapping_add(EPOCH);
+        let opened =
+            (self.pass.word.load(Ordering::Relaxed) & !(OPEN | INSIDE)).wrapping_add(EPOCH);
         // SeqCst, with `workers_asleep` below and in `wait_for_pass`: either a worker going
         // to sleep sees the new epoch, or this thread sees it counted as asleep.
-        self.pass.store(opened | OPEN, Ordering::SeqCst);
+        self.pass.word.store(opened | OPEN, Ordering::SeqCst);
         if self.workers_asleep.load(Ordering::SeqCst) > 0 {
             drop(self.lock());
             self.to_workers.notify_all();
@@ -125,7 +143,7 @@ impl TeamBoard {
         // pass, so when the count reads zero no thread is inside the job or can enter it.
         // Nothing below can panic (lock poisoning is ignored, and the guard aborts on any
         // unwind all the same), so `run` cannot return before that.
-        let inside = self.pass.fetch_and(!OPEN, Ordering::AcqRel) & INSIDE;
+        let inside = self.pass.word.fetch_and(!OPEN, Ordering::AcqRel) & INSIDE;
         if inside > 0 {
             self.wait_for_workers();
         }
@@ -157,14 +175,13 @@ impl TeamBoard {
             }
             let guard = AbortOnUnwind;
             // SAFETY: `join` counted this worker into the open pass, and the `Acquire` of its
-            // compare-and-swap makes the dispatcher's store of `job` visible, so `job` points
-            // at the `ErasedJob` on the stack of a dispatcher inside `run`, where it and the
-            // borrow behind it stay alive until this worker counts itself out (see `run`).
-            // `catch` keeps an unwinding job from skipping the count-out below, and the guard
-            // aborts should an unwind escape `catch` all the same.
-            let job = unsafe { *self.job.load(Ordering::Relaxed) };
-            // SAFETY: as above, the borrow behind `job` lives until this worker counts itself
-            // out, below.
+            // compare-and-swap makes the dispatcher's write of `job` visible; the dispatcher
+            // writes it again only after this worker has counted itself out (see `run`).
+            let job = unsafe { *self.pass.job.get() };
+            // SAFETY: `job` is the open pass's, whose dispatcher is inside `run`, where the
+            // borrow behind it stays alive until this worker counts itself out, below. `catch`
+            // keeps an unwinding job from skipping the count-out, and the guard aborts should
+            // an unwind escape `catch` all the same.
             let outcome = panic::catch(|| unsafe { job.call(index) });
             if let Err(p) = outcome {
                 self.escaped
@@ -176,7 +193,7 @@ impl TeamBoard {
             // Counted out: from here on `job` is never read again. SeqCst, with
             // `dispatcher_asleep` in `wait_for_workers`: either the dispatcher sees the count
             // fall, or this thread sees it asleep.
-            let before = self.pass.fetch_sub(1, Ordering::SeqCst);
+            let before = self.pass.word.fetch_sub(1, Ordering::SeqCst);
             mem::forget(guard);
             let last_out = before & INSIDE == 1 && before & OPEN == 0;
             if last_out && self.dispatcher_asleep.load(Ordering::SeqCst) {
@@ -198,7 +215,7 @@ impl TeamBoard {
     fn join(&self, mut word: u64) -> bool {
         let opened = epoch(word);
         while word & OPEN != 0 && epoch(word) == opened {
-            match self.pass.compare_exchange_weak(
+            match self.pass.word.compare_exchange_weak(
                 word,
                 word + 1,
                 Ordering::Acquire,
@@ -214,7 +231,7 @@ impl TeamBoard {
     /// Waits until a pass after epoch `seen` has been opened (its word), or the board shuts
     /// down (`None`): watching first (see `spin_wait`), then asleep.
     fn wait_for_pass(&self, seen: u64) -> Option<u64> {
-        let news = |order| self.shutdown.load(order) || epoch(self.pass.load(order)) != seen;
+        let news = |order| self.shutdown.load(order) || epoch(self.pass.word.load(order)) != seen;
         if !spin_wait::spin_then_yield(|| news(Ordering::Acquire)) {
             let mut sleep = self.lock();
             self.workers_asleep.fetch_add(1, Ordering::SeqCst);
@@ -229,12 +246,12 @@ impl TeamBoard {
         if self.shutdown.load(Ordering::Acquire) {
             return None;
         }
-        Some(self.pass.load(Ordering::Acquire))
+        Some(self.pass.word.load(Ordering::Acquire))
     }
 
     /// Waits until no worker is inside the closed pass: watching first, then asleep.
     fn wait_for_workers(&self) {
-        let drained = |order| self.pass.load(order) & INSIDE == 0;
+        let drained = |order| self.pass.word.load(order) & INSIDE == 0;
         if spin_wait::spin_then_yield_for(LAST_OUT, || drained(Ordering::Acquire)) {
             return;
         }
