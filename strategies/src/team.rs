@@ -20,11 +20,10 @@
 //! one atomic store and closes it with one read-modify-write; a worker joins with one
 //! compare-and-swap and leaves with one subtraction (`TeamBoard`, in `erased_job`); each
 //! chunk is taken with one compare-and-swap on its share's word (a cache line of its own, the
-//! owner's unless others help) and moved out of its slot under an uncontended lock. Nobody
-//! resets the shares for a new pass (each word carries its pass's tag; see `Share`), so a
-//! share's line stays with its owner from pass to pass. No queue, nothing per element. Between
-//! passes a thread
-//! watches the pass word for up to 200 µs (spinning, then yielding its core between checks;
+//! owner's unless others help) and moved out of its slot under an uncontended lock. The
+//! thread that opens a pass does not reset the shares (each word carries its pass's tag; see
+//! `Share`), so a share's line does not travel to it and back every pass. No queue, nothing
+//! per element. Between passes a thread watches the pass word for up to 200 µs (spinning, then yielding its core between checks;
 //! see `spin_wait`) before it sleeps on a condition variable, so back-to-back passes need no
 //! wake-up; the watching shows up as CPU time.
 //!
@@ -156,13 +155,14 @@ const MOST_CHUNKS: usize = END as usize;
 /// back; each take is one compare-and-swap that moves one end, so every chunk is taken exactly
 /// once.
 ///
-/// Nobody resets a share for a new pass: a word tagged with an earlier pass stands for the
-/// pass's whole range, which every thread computes alike (`fresh`), and the first take
-/// replaces it. So between passes a share's cache line stays with the thread that took from
-/// it last — its owner, as a rule — instead of moving to the thread that opens the pass and
-/// back. A tag repeats after 2¹⁶ passes, so the opener resets every share when the tag comes
-/// round to 0 ([`Share::reset`]); no word is then older than the last 2¹⁶ passes, and a word
-/// with the current tag was written in this pass.
+/// The opener does not reset a share for a new pass: a word tagged with an earlier pass
+/// stands for the pass's whole range, which every thread computes alike (`fresh`), and the
+/// first take replaces it. So the opener never writes a share's cache line; the owner's first
+/// take of a pass finds it in its own cache (shared at most with the threads that looked for
+/// chunks to help with at the end of the last pass). A tag repeats after 2¹⁶ passes, so the
+/// opener does reset every share when the tag comes round to 0 ([`Share::reset`]); no word is
+/// then older than the last 2¹⁶ passes, and a word with the current tag was written in this
+/// pass.
 struct Share(CachePadded<AtomicU64>);
 
 /// The pass a take is in: its tag, and the share's range in it before any take.
@@ -239,7 +239,7 @@ impl Executor for TeamExecutor<'_> {
                 .into_iter()
                 .map(|chunk| Mutex::new(Some(chunk)))
                 .collect();
-        let (n, threads) = (chunks.len() as u64, self.threads as u64);
+        let (n, threads) = (chunks.len() as u64, self.shares.len() as u64);
         let tag = (self.passes.get() + 1) % TAGS;
         self.passes.set(tag);
         let in_pass = |t: usize| InPass {
@@ -268,12 +268,14 @@ impl Executor for TeamExecutor<'_> {
         // the next threads' first. A panicking kernel is caught in `run`; the first panic is
         // kept.
         let job = |me: usize| {
-            while let Some(i) = shares[me].take_front(in_pass(me)) {
+            let mine = in_pass(me);
+            while let Some(i) = shares[me].take_front(mine) {
                 run(i);
             }
             let threads = shares.len();
             for other in (1..threads).map(|k| (me + k) % threads) {
-                while let Some(i) = shares[other].take_back(in_pass(other)) {
+                let theirs = in_pass(other);
+                while let Some(i) = shares[other].take_back(theirs) {
                     run(i);
                 }
             }
@@ -296,7 +298,8 @@ mod tests {
     #[test]
     fn a_share_gives_every_chunk_once_to_its_owner_at_the_front_or_a_helper_at_the_back() {
         let share = Share::new();
-        // Each pass's range stands in a word left by the pass before, which took it all.
+        // Each pass's range stands in a word left by the pass before, which took it all (the
+        // first in the new share's word).
         for (tag, fresh) in [(1, (10, 1010)), (2, (0, 500)), (3, (7, 8))] {
             let pass = InPass { tag, fresh };
             let (front, back) = std::thread::scope(|s| {
@@ -323,12 +326,35 @@ mod tests {
     }
 
     #[test]
+    fn a_share_at_the_largest_tag_and_ends_keeps_them_apart() {
+        let share = Share::new();
+        let pass = InPass {
+            tag: TAGS - 1,
+            fresh: (END - 3, END),
+        };
+        let word = |share: &Share| share.0.load(Ordering::Relaxed);
+        assert_eq!(share.take_front(pass), Some(MOST_CHUNKS - 3));
+        assert_eq!(word(&share), Share::word(TAGS - 1, END - 2, END));
+        assert_eq!(share.take_back(pass), Some(MOST_CHUNKS - 1));
+        assert_eq!(share.take_front(pass), Some(MOST_CHUNKS - 2));
+        assert_eq!(
+            (share.take_front(pass), share.take_back(pass)),
+            (None, None)
+        );
+        assert_eq!(
+            word(&share) >> (2 * END_BITS),
+            TAGS - 1,
+            "the tag is intact"
+        );
+    }
+
+    #[test]
     fn every_pass_runs_every_chunk_while_the_tags_come_round() {
         // No worker serves the board, so the dispatcher takes every share's chunks, its own
-        // from the front and the others' from the back; the passes' lengths change, so a word
-        // left by one pass is never the next one's range. The first pass has tag 0, which the
-        // new shares' words carry too: words as if left 2¹⁶ passes before, which only the
-        // reset tells from this pass's.
+        // from the front and the others' from the back, over passes of changing lengths. The
+        // first pass has tag 0, which the new shares' words carry too: words as if left 2¹⁶
+        // passes before, which only the reset tells from this pass's (without it, the first
+        // pass would take no chunk).
         let board = TeamBoard::new();
         let executor = TeamExecutor {
             board: &board,

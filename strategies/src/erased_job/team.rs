@@ -37,10 +37,10 @@ const LAST_OUT: Duration = Duration::from_micros(20);
 struct PassLine {
     /// Epoch, open, inside (see the module's docs).
     word: AtomicU64,
-    /// The last pass's job. Written by the dispatcher only between passes — after the last
-    /// worker of the previous pass counted itself out, before the opening store — and read by
-    /// a worker only inside a pass it joined, so a read and a write never overlap (see `run`
-    /// and `serve`).
+    /// The last pass's job (before the first, a no-op that is never called). Written by the
+    /// dispatcher only between passes — after the last worker of the previous pass counted
+    /// itself out, before the opening store — and read by a worker only inside a pass it
+    /// joined, so a read and a write never overlap (see `run` and `serve`).
     job: UnsafeCell<ErasedJob>,
 }
 
@@ -120,9 +120,11 @@ impl TeamBoard {
         // end the borrow of `job` under a running worker: the guard turns any unwind in that
         // window into an abort.
         let guard = AbortOnUnwind;
-        // SAFETY: no worker reads `job` now: the previous pass's workers all counted
-        // themselves out before that pass's `run` returned, and none can join until the store
-        // below opens this pass; the store's release publishes the write to those that join.
+        // SAFETY: no worker reads `job` now: every worker of the previous pass read it before
+        // its `fetch_sub` in `serve`, which that pass's `run` saw (its `fetch_and`, or the
+        // loads of `wait_for_workers`) before returning — and `in_flight`'s release and
+        // acquire carry that to a dispatcher on another thread; none can join until the store
+        // below opens this pass, whose release publishes the write to those that join.
         unsafe { *self.pass.job.get() = ErasedJob::new(job) };
         // The previous pass ended with nobody inside and closed, so the word is its epoch.
         let opened =
