@@ -1,10 +1,10 @@
-//! Criterion benches: each pass (density, forces) and a full step, for every strategy in the
-//! registry, at 1 core and at all hardware threads, on the paper's all-pairs N = 1000 and on
-//! the grid at N = 100 000, each from the seed dam break after 100 steps. Chunked strategies
-//! use 10 chunks per core. The `simd/...` groups run `seq` on each SIMD path this CPU has
-//! (`--simd`): the density pass, where the neighbour tests run, and a whole step, on both
-//! scenes and on the grid at N = 1000 in cell order. Run with `cargo bench` or
-//! `cargo criterion` (install it with `cargo install cargo-criterion`).
+//! Criterion benches: each pass (density; forces, which also move the particles) and a full
+//! step, for every strategy in the registry, at 1 core and at all hardware threads, on the
+//! paper's all-pairs N = 1000 and on the grid at N = 100 000, each from the seed dam break
+//! after 100 steps. Chunked strategies use 10 chunks per core. The `simd/...` groups run
+//! `seq` on each SIMD path this CPU has (`--simd`): the density pass, where the neighbour
+//! tests run, and a whole step, on both scenes and on the grid at N = 1000 in cell order. Run
+//! with `cargo bench` or `cargo criterion` (install it with `cargo install cargo-criterion`).
 
 use std::time::{Duration, Instant};
 
@@ -45,8 +45,8 @@ const SETTLE_STEPS: usize = 100;
 
 /// Times `iters` repetitions of one benchmark's work inside a strategy's session (the
 /// strategy's threads are started before the session, outside the timing). Every repetition
-/// starts from `start`: a pass rewrites only its own outputs, and a step is timed from a
-/// fresh copy (made outside the timing), so every strategy measures the same work.
+/// starts from a fresh copy of `start` (made outside the timing; the force pass moves the
+/// particles), so every strategy measures the same work.
 struct TimedIters<'s> {
     start: &'s Simulation,
     sim: &'s mut Simulation,
@@ -60,19 +60,12 @@ impl Session for TimedIters<'_> {
     fn run<E: Executor>(self, exec: &E) -> Duration {
         let mut total = Duration::ZERO;
         for _ in 0..self.iters {
-            let begin = match self.work {
-                Work::Pass(pass) => {
-                    let begin = Instant::now();
-                    self.sim.run_pass(exec, pass).expect("pass runs");
-                    begin
-                }
-                Work::Step => {
-                    self.sim.clone_from(self.start);
-                    let begin = Instant::now();
-                    self.sim.advance(exec, 1).expect("step runs");
-                    begin
-                }
-            };
+            self.sim.clone_from(self.start);
+            let begin = Instant::now();
+            match self.work {
+                Work::Pass(pass) => self.sim.run_pass(exec, pass).expect("pass runs"),
+                Work::Step => self.sim.advance(exec, 1).expect("step runs"),
+            }
             total += begin.elapsed();
         }
         total
@@ -97,8 +90,8 @@ fn time_iters(
     sph_strategies::run(strategy, config, timed).expect("strategy builds")
 }
 
-/// The seed dam break of `n` particles after [`SETTLE_STEPS`] steps, with this step's
-/// neighbour lists, densities and forces in place (so a single pass can be timed).
+/// The seed dam break of `n` particles after [`SETTLE_STEPS`] steps, with the next step's
+/// neighbour lists and densities in place (so either pass can be timed alone).
 fn settled(mode: NeighborMode, n: usize) -> Simulation {
     let mut sim = Simulation::new(
         Preset::Seed.params(),
@@ -109,9 +102,8 @@ fn settled(mode: NeighborMode, n: usize) -> Simulation {
     sim.advance(&SeqExecutor, SETTLE_STEPS)
         .expect("settling runs");
     sim.rebuild_neighbors();
-    for pass in [Pass::Density, Pass::Forces] {
-        sim.run_pass(&SeqExecutor, pass).expect("pass runs");
-    }
+    sim.run_pass(&SeqExecutor, Pass::Density)
+        .expect("the density pass runs");
     sim
 }
 

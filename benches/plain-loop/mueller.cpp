@@ -2,9 +2,12 @@
 //
 // What it is: the `seed` preset's dam break (shared/SOLVER.md, Müller, Charypar & Gross 2003
 // as the seed paper's Haskell program evaluates it), written the way the C++ original
-// (cerrno/mueller-sph, src/main.cpp) is written: one std::vector of particle structs and three
-// plain O(N^2) loops per step. No SIMD intrinsics, no grid, and no threads unless it is built
-// with -fopenmp: then each pass's loop over particles is `omp parallel for schedule(static)`,
+// (cerrno/mueller-sph, src/main.cpp) is written: one std::vector of particle structs and plain
+// O(N^2) loops. As in bench-sph, a step is two passes: density, then forces, each particle
+// moved as soon as its force is known (into a second vector, swapped in after the pass, so
+// that the other particles' forces read the old positions; the original runs the update as a
+// third loop, with the same bits). No SIMD intrinsics, no grid, and no threads unless it is
+// built with -fopenmp: then each pass's loop over particles is `omp parallel for schedule(static)`,
 // the OpenMP team the strategies are measured against (a particle's sums do not depend on
 // how the particles are split, so the bits and the checksum are the same). Speed figures of
 // bench-sph are reported as ratios to this program's time, measured in the same run
@@ -133,11 +136,38 @@ void compute_density_pressure(std::vector<Particle>& ps) {
     }
 }
 
-void compute_forces(std::vector<Particle>& ps) {
+// Particle `a`'s own update from its force and density, then the walls.
+void move(Particle& a, double width, double height) {
+    // Symplectic Euler, the seed preset's grouping: v + DT * (f / rho).
+    a.vx = a.vx + DT * (a.fx / a.rho);
+    a.vy = a.vy + DT * (a.fy / a.rho);
+    a.x = a.x + DT * a.vx;
+    a.y = a.y + DT * a.vy;
+    if (a.x - EPS < 0.0) {
+        a.vx *= BOUND_DAMPING;
+        a.x = EPS;
+    }
+    if (a.x + EPS > width) {
+        a.vx *= BOUND_DAMPING;
+        a.x = width - EPS;
+    }
+    if (a.y - EPS < 0.0) {
+        a.vy *= BOUND_DAMPING;
+        a.y = EPS;
+    }
+    if (a.y + EPS > height) {
+        a.vy *= BOUND_DAMPING;
+        a.y = height - EPS;
+    }
+}
+
+// Forces from `ps`, then each particle moved: the results go to `next` (same size).
+void forces_and_moves(const std::vector<Particle>& ps, std::vector<Particle>& next,
+                      double width, double height) {
     const std::size_t n = ps.size();
 #pragma omp parallel for schedule(static)
     for (std::size_t i = 0; i < n; ++i) {
-        Particle& pi = ps[i];
+        const Particle& pi = ps[i];
         double fpress_x = 0.0, fpress_y = 0.0;
         double fvisc_x = 0.0, fvisc_y = 0.0;
         for (std::size_t j = 0; j < n; ++j) {
@@ -160,37 +190,11 @@ void compute_forces(std::vector<Particle>& ps) {
                 fvisc_y += (((VISC_MASS * (pj.vy - pi.vy)) / pj.rho) * VISC_LAP) * hr;
             }
         }
-        pi.fx = (fpress_x + fvisc_x) + GX * pi.rho;
-        pi.fy = (fpress_y + fvisc_y) + GY * pi.rho;
-    }
-}
-
-void integrate(std::vector<Particle>& ps, double width, double height) {
-    const std::size_t n = ps.size();
-#pragma omp parallel for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) {
-        Particle& a = ps[i];
-        // Symplectic Euler, the seed preset's grouping: v + DT * (f / rho).
-        a.vx = a.vx + DT * (a.fx / a.rho);
-        a.vy = a.vy + DT * (a.fy / a.rho);
-        a.x = a.x + DT * a.vx;
-        a.y = a.y + DT * a.vy;
-        if (a.x - EPS < 0.0) {
-            a.vx *= BOUND_DAMPING;
-            a.x = EPS;
-        }
-        if (a.x + EPS > width) {
-            a.vx *= BOUND_DAMPING;
-            a.x = width - EPS;
-        }
-        if (a.y - EPS < 0.0) {
-            a.vy *= BOUND_DAMPING;
-            a.y = EPS;
-        }
-        if (a.y + EPS > height) {
-            a.vy *= BOUND_DAMPING;
-            a.y = height - EPS;
-        }
+        Particle& a = next[i];
+        a = pi;
+        a.fx = (fpress_x + fvisc_x) + GX * pi.rho;
+        a.fy = (fpress_y + fvisc_y) + GY * pi.rho;
+        move(a, width, height);
     }
 }
 
@@ -239,12 +243,13 @@ int main(int argc, char** argv) {
     const double width = BASE_WIDTH + 2.0 * SPACING * static_cast<double>(columns - BASE_COLUMNS);
     const double height = BASE_HEIGHT;
     std::vector<Particle> ps = init_dam(n, seed);
+    std::vector<Particle> next = ps;
 
     const auto t0 = std::chrono::steady_clock::now();
     for (std::uint64_t s = 0; s < steps; ++s) {
         compute_density_pressure(ps);
-        compute_forces(ps);
-        integrate(ps, width, height);
+        forces_and_moves(ps, next, width, height);
+        ps.swap(next);
     }
     const auto t1 = std::chrono::steady_clock::now();
     const double wall_s = std::chrono::duration<double>(t1 - t0).count();

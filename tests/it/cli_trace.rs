@@ -22,7 +22,7 @@ const N: usize = 200;
 const STEPS: usize = 2;
 const CORES: usize = 2;
 const CHUNKS: usize = 7;
-const PASSES: [&str; 3] = ["density", "forces", "integrate"];
+const PASSES: [&str; 2] = ["density", "forces"];
 const STATS_HEADER: &str = "kind,name,threads,kernel_calls,busy_ms,span_ms,idle_pct,imbalance";
 
 fn trace(strategy: StrategyName, out: &Path, extra: &[&str]) -> Output {
@@ -474,8 +474,8 @@ fn a_trace_too_large_is_refused_before_it_runs_naming_the_estimate_and_what_to_l
     ]);
     one_error_line(
         &o,
-        "a trace of rayon-spawn with N = 20000 over 50 steps would record about 3000100 events \
-         (about 510 MB of trace.json); the most is 1000000: lower --steps or --n",
+        "a trace of rayon-spawn with N = 20000 over 50 steps would record about 2000100 events \
+         (about 340 MB of trace.json); the most is 1000000: lower --steps or --n",
     );
     assert!(!out.exists(), "nothing was created");
 }

@@ -37,7 +37,7 @@ pub struct Plan {
     pub cores: usize,
     /// Recorded steps.
     pub steps: usize,
-    /// The model's passes per step (3 for Müller's presets, 6 for `wcsph`).
+    /// The model's passes per step (2 for Müller's presets, 6 for `wcsph`).
     pub passes: usize,
     /// Neighbour search: the grid's rebuild adds two kernel calls per step and chunk, three
     /// from [`PARALLEL_SORT`] particles on (counted whatever the cores: an upper bound).

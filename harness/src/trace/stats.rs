@@ -214,7 +214,7 @@ fn ms(ns: u64) -> f64 {
 
 /// Writes `stats.csv` (header [`CSV_HEADER`]): one `worker` row per worker track (`name` the
 /// worker index, `threads` how many OS threads held it, `span_ms` the step loop's wall time),
-/// one `pass` row per pass (`name` density, forces, integrate, preceded by `grid rebuild` when
+/// one `pass` row per pass (`name` the model's passes, Müller's density and forces, preceded by `grid rebuild` when
 /// the grid's rebuild ran kernel calls; `span_ms` summed over steps, `imbalance` as in
 /// [`PassStats`]), and
 /// one `total` row (`threads` the distinct worker threads, `kernel_calls` the tasks created).
@@ -287,7 +287,7 @@ mod tests {
                 k(Pass::Density, 1, 1, 0, 100),
                 k(Pass::Forces, 1, 0, 300, 500),
                 k(Pass::Forces, 1, 1, 300, 400),
-                k(Pass::Integrate, 1, 0, 500, 600),
+                k(Pass::Forces, 1, 0, 500, 600),
             ],
             serial: vec![SerialEvent {
                 work: SerialWork::Check,
@@ -324,10 +324,18 @@ mod tests {
     #[test]
     fn imbalance_is_the_busiest_worker_over_the_mean_worker() {
         let s = compute(&two_workers());
-        // density: 300 vs 100 -> 300 / 200; forces: 200 vs 100 -> 200 / 150; integrate: all
-        // on one worker -> 2 (= workers).
+        // density: 300 vs 100 -> 300 / 200; forces: 200 + 100 vs 100 -> 300 / 200.
         let imb: Vec<f64> = s.passes.iter().map(|p| p.imbalance.unwrap()).collect();
-        assert_eq!(imb, [1.5, 200.0 / 150.0, 2.0]);
+        assert_eq!(imb, [1.5, 1.5]);
+        // All of a pass on one worker: as unbalanced as two workers can be.
+        let mut t = two_workers();
+        t.kernels.retain(|e| e.worker == 0);
+        let imb: Vec<f64> = compute(&t)
+            .passes
+            .iter()
+            .map(|p| p.imbalance.unwrap())
+            .collect();
+        assert_eq!(imb, [2.0, 2.0]);
         assert_eq!(s.passes[0].span_ns, 300);
         assert_eq!(s.passes[0].busy_ns, 400);
         assert!((s.passes[0].idle_pct - 100.0 / 3.0).abs() < 1e-12);
@@ -363,11 +371,11 @@ mod tests {
     fn a_pass_without_calls_has_no_imbalance_and_an_idle_worker_no_threads() {
         let mut t = two_workers();
         t.kernels
-            .retain(|e| e.phase != Phase::Pass(Pass::Integrate) && e.worker == 0);
+            .retain(|e| e.phase != Phase::Pass(Pass::Forces) && e.worker == 0);
         t.threads.truncate(1);
         let s = compute(&t);
-        assert_eq!(s.passes[2].imbalance, None);
-        assert_eq!(s.passes[2].kernel_calls, 0);
+        assert_eq!(s.passes[1].imbalance, None);
+        assert_eq!(s.passes[1].kernel_calls, 0);
         assert_eq!(s.workers[1].thread_label(), "idle");
         assert_eq!(s.workers[1].idle_pct, 100.0);
         assert_eq!((s.total.workers_used, s.workers.len()), (1, 2));
@@ -390,7 +398,7 @@ mod tests {
 
     #[test]
     fn the_grid_rebuild_gets_its_own_row_only_when_it_ran_kernel_calls() {
-        assert_eq!(compute(&two_workers()).passes.len(), 3);
+        assert_eq!(compute(&two_workers()).passes.len(), 2);
         let mut t = two_workers();
         t.kernels.push(KernelEvent {
             phase: Phase::Rebuild,
@@ -398,7 +406,7 @@ mod tests {
         });
         let s = compute(&t);
         let names: Vec<&str> = s.passes.iter().map(|p| p.phase.as_str()).collect();
-        assert_eq!(names, ["grid rebuild", "density", "forces", "integrate"]);
+        assert_eq!(names, ["grid rebuild", "density", "forces"]);
         assert_eq!(s.workers[1].busy_ns, 250);
     }
 
@@ -409,12 +417,12 @@ mod tests {
         let text = String::from_utf8(bytes).unwrap();
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines[0], CSV_HEADER);
-        assert_eq!(lines.len(), 1 + 2 + 3 + 1);
+        assert_eq!(lines.len(), 1 + 2 + 2 + 1);
         assert_eq!(lines[1], "worker,0,1,3,0.0006,0.001,40.0,");
         assert_eq!(
             lines[3],
             "pass,density,,2,0.0004,0.0003,33.333333333333336,1.5"
         );
-        assert_eq!(lines[6], "total,all,2,5,0.0008,0.001,60.0,");
+        assert_eq!(lines[5], "total,all,2,5,0.0008,0.001,60.0,");
     }
 }

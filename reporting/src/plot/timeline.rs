@@ -423,15 +423,14 @@ mod tests {
     use sph_solver::models::Preset;
     use sph_solver::sph::neighbors::NeighborMode;
 
-    /// The phases of a step of Müller's model.
-    const MUELLER_PHASES: [Phase; 4] = [
+    /// The phases of a step of Müller's model on the grid.
+    const PHASES: [Phase; 3] = [
         Phase::Rebuild,
         Phase::Pass(Pass::Density),
         Phase::Pass(Pass::Forces),
-        Phase::Pass(Pass::Integrate),
     ];
 
-    /// Two steps on two workers: per step a grid rebuild, then density, forces and integrate
+    /// Two steps on two workers: per step a grid rebuild, then density and forces
     /// calls of 100 µs each, with the caller's rebuild and check between them.
     fn trace() -> Trace {
         let mut kernels = Vec::new();
@@ -444,7 +443,7 @@ mod tests {
                 start_ns: t,
                 end_ns: t + 50_000,
             });
-            for (k, &phase) in MUELLER_PHASES.iter().enumerate() {
+            for (k, &phase) in PHASES.iter().enumerate() {
                 for worker in 0..2 {
                     let start_ns = t + 100_000 + k as u64 * 200_000 + worker as u64 * 20_000;
                     kernels.push(KernelEvent {
@@ -522,9 +521,10 @@ mod tests {
                 .filter(|p| p == &[c.0, c.1, c.2])
                 .count()
         };
-        // Every phase shows, in the shade its place in a worker's alternation gives it (4
-        // calls a step: the rebuild and forces light, density and integrate dark).
-        for (&phase, dark) in MUELLER_PHASES.iter().zip([false, true, false, true]) {
+        // Every phase shows in both shades: a worker alternates them from call to call, and a
+        // step has three calls (the first step's rebuild and forces light, density dark; the
+        // second's the other way round).
+        for (&phase, dark) in PHASES.iter().flat_map(|p| [(p, false), (p, true)]) {
             let n = colour_count(phase_color(phase, dark));
             assert!(n > 100, "{phase:?} dark={dark}: {n} pixels");
         }

@@ -302,12 +302,13 @@ mod tests {
 
     const NONE: Pin = Pin::None;
 
-    /// The tests' group (N = 60, 3 steps of 3 passes) with `seq` at 9 ms a run: a pass holds
-    /// 1000 µs of work, 500 µs a thread at 2 threads; rayon-chunks at 2 cores takes 6 ms.
+    /// The tests' group (N = 60, 3 steps of Müller's 2 passes) with `seq` at 6 ms a run: a
+    /// pass holds 1000 µs of work, 500 µs a thread at 2 threads; rayon-chunks at 2 cores takes
+    /// 4 ms.
     fn group_and_sweep(cost_us: f64, anchor: Vec<AnchorRun>) -> (GroupView, Sweep) {
         let v = view(&[
-            (Seq, 1, None, NONE, &[0.009, 0.009, 0.009]),
-            (RayonChunks, 2, Some(10), NONE, &[0.006, 0.006, 0.006]),
+            (Seq, 1, None, NONE, &[0.006, 0.006, 0.006]),
+            (RayonChunks, 2, Some(10), NONE, &[0.004, 0.004, 0.004]),
         ]);
         let mut s = sweep_on("results/a", "cpu", 2, v.rows.clone());
         s.pass_costs = vec![CostRow {
@@ -350,7 +351,7 @@ mod tests {
         let (v, s) = group_and_sweep(100.0, Vec::new());
         let md = render(&v, &s);
         assert!(
-            md.contains("`seq` takes 3000 µs a step, so a pass holds 1000 µs"),
+            md.contains("`seq` takes 2000 µs a step, so a pass holds 1000 µs"),
             "{md}"
         );
         assert!(

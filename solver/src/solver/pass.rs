@@ -5,10 +5,10 @@
 pub enum Pass {
     /// Müller: density and pressure (and each particle's neighbour list).
     Density,
-    /// Müller: pressure, viscosity and gravity forces.
+    /// Müller: pressure, viscosity and gravity forces, and from them each particle's update
+    /// (symplectic Euler and the walls), written apart until the pass has finished.
     Forces,
-    /// Both: each particle's own update (Müller: symplectic Euler and the walls; WCSPH: kick,
-    /// density, drift).
+    /// WCSPH: each particle's own update (kick, density, drift).
     Integrate,
     /// WCSPH: the largest fluid speed, a reduction, and from it the time step.
     MaxSpeed,
@@ -23,8 +23,8 @@ pub enum Pass {
 }
 
 impl Pass {
-    /// Müller's three passes in step order.
-    pub const MUELLER: [Pass; 3] = [Pass::Density, Pass::Forces, Pass::Integrate];
+    /// Müller's two passes in step order.
+    pub const MUELLER: [Pass; 2] = [Pass::Density, Pass::Forces];
 
     /// The WCSPH step's six passes in step order.
     pub const WCSPH: [Pass; 6] = [
@@ -36,7 +36,7 @@ impl Pass {
         Pass::Integrate,
     ];
 
-    /// Every pass: Müller's, then those only WCSPH has.
+    /// Every pass: Müller's two, then WCSPH's (its update first).
     pub const ALL: [Pass; 8] = [
         Pass::Density,
         Pass::Forces,

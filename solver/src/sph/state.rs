@@ -188,6 +188,20 @@ impl<'a> Fields<'a> {
         }
     }
 
+    /// The same fields of particles `range` only.
+    ///
+    /// # Panics
+    /// If `range` reaches past an array.
+    pub fn of_range(&self, range: std::ops::Range<usize>) -> Fields<'a> {
+        let cut = |a: &'a [f64]| &a[range.clone()];
+        Fields::new(
+            (cut(self.pos.x), cut(self.pos.y)),
+            (cut(self.vx), cut(self.vy)),
+            cut(self.rho),
+            cut(self.p),
+        )
+    }
+
     /// The same fields, each cut to the number of particles (the positions' length): in a
     /// loop that reads all six at one index, a single bounds check then covers them.
     ///
@@ -263,5 +277,19 @@ mod tests {
                 assert!(s.guarded_fields_finite(0..n));
             }
         }
+    }
+
+    #[test]
+    fn fields_of_a_range_are_those_particles_of_every_array() {
+        let a: Vec<f64> = (0..10).map(f64::from).collect();
+        let b: Vec<f64> = a.iter().map(|v| 10.0 * v).collect();
+        let all = Fields::new((&a, &b), (&b, &a), &a, &b);
+        let some = all.of_range(3..6);
+        assert_eq!((some.pos.x, some.pos.y), (&a[3..6], &b[3..6]));
+        assert_eq!(
+            (some.vx, some.vy, some.rho, some.p),
+            (&b[3..6], &a[3..6], &a[3..6], &b[3..6])
+        );
+        assert!(all.of_range(10..10).pos.is_empty());
     }
 }

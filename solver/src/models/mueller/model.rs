@@ -1,9 +1,11 @@
 //! Müller's model (the `seed` and `cpp` presets) as the solver runs it: its constants
-//! ([`Params`]) as a [`Model`], and its step's three passes.
+//! ([`Params`]) as a [`Model`], and its step's two passes: density, then forces with each
+//! particle's update.
 
 use glam::DVec2;
 use sph_strategies::{Executor, KernelPanic};
 
+use crate::models::mueller::next_motion::NextMotion;
 use crate::models::mueller::passes;
 use crate::models::{
     Preset,
@@ -18,7 +20,7 @@ use crate::sph::state::{Domain, Fields, Positions, State};
 use crate::with_lanes;
 
 impl Model for Params {
-    type Scratch = ();
+    type Scratch = NextMotion;
 
     fn passes(&self) -> &'static [Pass] {
         &Pass::MUELLER
@@ -73,14 +75,16 @@ impl Model for Params {
         (own, 4.0 * own)
     }
 
-    fn scratch(&self, _: usize, _: &AnyNeighbors) {}
+    fn scratch(&self, n: usize, _: &AnyNeighbors) -> NextMotion {
+        NextMotion::new(n)
+    }
 
     fn run_pass<E: Executor>(
         &self,
         exec: &E,
         pass: Pass,
         on: Particles<'_>,
-        _: &mut (),
+        next: &mut NextMotion,
     ) -> Result<(), KernelPanic> {
         let Particles {
             state: s,
@@ -93,14 +97,16 @@ impl Model for Params {
                 with_search_lanes!(nb, lanes, (nb, lists, l) => density(exec, l, &*nb, lists, s, self))
             }
             Pass::Forces => {
-                with_search!(nb, (nb, lists) => with_lanes!(lanes, l => forces(exec, l, &*nb, lists, s, self)))
+                let moved = with_search!(nb, (nb, lists) => with_lanes!(lanes, l => forces_and_moves(exec, l, &*nb, lists, s, next, self, domain)));
+                // Only a finished pass moves the particles: after a kernel's panic the state
+                // keeps the step's starting positions and velocities.
+                moved.map(|()| next.swap_into(s))
             }
-            Pass::Integrate => with_lanes!(lanes, l => integrate(exec, l, s, self, domain)),
             other => no_such_pass(self.preset(), other),
         }
     }
 
-    fn last_dt(&self, _: &()) -> f64 {
+    fn last_dt(&self, _: &NextMotion) -> f64 {
         self.dt
     }
 
@@ -140,66 +146,77 @@ pub fn density<E: Executor, N: Neighbors, L: Lanes>(
     })
 }
 
-/// Writes fx, fy; reads positions, velocities, rho, p and the neighbour lists.
-pub fn forces<E: Executor, N: Neighbors, L: Lanes>(
+/// Writes fx, fy and, into `next`, each particle's position and velocity at the end of the
+/// step (the symplectic Euler update and the walls, from its own force and density); reads
+/// positions, velocities, rho, p and the neighbour lists, which no chunk writes. Each chunk
+/// computes its forces, then moves its particles in a loop of its own.
+#[allow(clippy::too_many_arguments)]
+pub fn forces_and_moves<E: Executor, N: Neighbors, L: Lanes>(
     exec: &E,
     lanes: L,
     nb: &N,
     lists: &NeighborLists<N::Key>,
     s: &mut State,
+    next: &mut NextMotion,
     prm: &Params,
+    domain: Domain,
 ) -> Result<(), KernelPanic> {
     let input = Fields::new((&s.x, &s.y), (&s.vx, &s.vy), &s.rho, &s.p);
-    exec.for_each_chunk((&mut s.fx[..], &mut s.fy[..]), |first, (fx, fy)| {
+    let forces = (&mut s.fx[..], &mut s.fy[..]);
+    let moved = (
+        &mut next.x[..],
+        &mut next.y[..],
+        &mut next.vx[..],
+        &mut next.vy[..],
+    );
+    exec.for_each_chunk((forces, moved), |first, ((fx, fy), moved)| {
         lanes.vectorize(
             #[inline(always)]
             || {
-                for (k, (fx, fy)) in fx.iter_mut().zip(fy).enumerate() {
+                for (k, (fx, fy)) in fx.iter_mut().zip(fy.iter_mut()).enumerate() {
                     let i = first + k;
                     let f = passes::force(i, lanes, &input, lists.of(i), nb, prm);
                     (*fx, *fy) = (f.x, f.y);
                 }
             },
-        )
+        );
+        let now = input.of_range(first..first + fx.len());
+        move_particles(lanes, now, (fx, fy), moved, prm, domain);
     })
 }
 
-/// Writes positions and velocities (each particle only its own); reads fx, fy, rho. Runs inside
-/// [`Lanes::vectorize`], on inputs cut to each chunk's length, so that the compiler may take
-/// several particles per instruction on the path's registers (the clamps are selects).
-pub fn integrate<E: Executor, L: Lanes>(
-    exec: &E,
+/// Moves each particle of a chunk (symplectic Euler, then the walls): `now` and the forces are
+/// the chunk's, `moved` receives its new positions and velocities. Runs inside
+/// [`Lanes::vectorize`], on inputs cut to one length, so that the compiler may take several
+/// particles per instruction on the path's registers (the clamps are selects).
+#[inline(always)]
+fn move_particles<L: Lanes>(
     lanes: L,
-    s: &mut State,
+    now: Fields<'_>,
+    (fx, fy): (&[f64], &[f64]),
+    (x, y, vx, vy): (&mut [f64], &mut [f64], &mut [f64], &mut [f64]),
     prm: &Params,
     domain: Domain,
-) -> Result<(), KernelPanic> {
-    let (fx, fy, rho) = (&s.fx[..], &s.fy[..], &s.rho[..]);
-    let out = (&mut s.x[..], &mut s.y[..], &mut s.vx[..], &mut s.vy[..]);
-    exec.for_each_chunk(out, |first, (x, y, vx, vy)| {
-        let len = x.len();
-        let (fx, fy, rho) = (
-            &fx[first..][..len],
-            &fy[first..][..len],
-            &rho[first..][..len],
-        );
-        lanes.vectorize(
-            #[inline(always)]
-            || {
-                // Cut to one length, so that one bounds check covers every read and write.
-                let (y, vx, vy) = (&mut y[..len], &mut vx[..len], &mut vy[..len]);
-                for k in 0..len {
-                    let (p, v) = passes::integrate(
-                        DVec2::new(x[k], y[k]),
-                        DVec2::new(vx[k], vy[k]),
-                        DVec2::new(fx[k], fy[k]),
-                        rho[k],
-                        prm,
-                        domain,
-                    );
-                    (x[k], y[k], vx[k], vy[k]) = (p.x, p.y, v.x, v.y);
-                }
-            },
-        )
-    })
+) {
+    lanes.vectorize(
+        #[inline(always)]
+        || {
+            // Cut to one length, so that one bounds check covers every read and write.
+            let now = now.to_common_length();
+            let len = now.pos.len();
+            let (fx, fy) = (&fx[..len], &fy[..len]);
+            let (x, y, vx, vy) = (&mut x[..len], &mut y[..len], &mut vx[..len], &mut vy[..len]);
+            for k in 0..len {
+                let (p, v) = passes::integrate(
+                    now.pos.at(k),
+                    DVec2::new(now.vx[k], now.vy[k]),
+                    DVec2::new(fx[k], fy[k]),
+                    now.rho[k],
+                    prm,
+                    domain,
+                );
+                (x[k], y[k], vx[k], vy[k]) = (p.x, p.y, v.x, v.y);
+            }
+        },
+    )
 }
