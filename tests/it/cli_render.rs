@@ -339,7 +339,7 @@ fn a_render_larger_than_the_available_memory_is_refused_before_anything_is_writt
     assert!(!o.status.success());
     assert_eq!(
         stderr(&o),
-        "Error: --n 100000 needs about 20 MB of memory (all-pairs search); \
+        "Error: --n 100000 needs about 23 MB of memory (all-pairs search); \
          this machine has 1.0 MB available\n"
     );
     assert!(names(dir.path()).is_empty());

@@ -397,7 +397,7 @@ fn a_run_larger_than_the_available_memory_is_refused_before_allocating() {
     assert!(!o.status.success());
     assert_eq!(
         stderr(&o),
-        "Error: --n 100000000 needs about 14 GB of memory (grid search); \
+        "Error: --n 100000000 needs about 17 GB of memory (grid search); \
          this machine has 9.0 GB available\n"
     );
     fails_with(

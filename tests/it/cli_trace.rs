@@ -75,7 +75,7 @@ struct Kernel {
 }
 
 /// The complete events of the worker tracks whose category is one of `cats` (`pass` for the
-/// three passes, `rebuild` for the grid rebuild's kernel calls).
+/// model's passes, `rebuild` for the grid rebuild's kernel calls).
 fn kernels(json: &Value, cats: &[&str]) -> Vec<Kernel> {
     json["traceEvents"]
         .as_array()
@@ -194,7 +194,7 @@ fn check_stats_csv(strategy: StrategyName, dir: &Path, kernel_events: usize, gri
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     let kinds: Vec<&str> = rows.iter().map(|r| r[0]).collect();
     let mut expected = vec!["worker"; workers(strategy)];
-    expected.extend(vec!["pass"; if grid { 4 } else { 3 }]);
+    expected.extend(vec!["pass"; PASSES.len() + usize::from(grid)]);
     expected.push("total");
     assert_eq!(kinds, expected, "{strategy}");
     assert!(rows.iter().all(|r| r.len() == 8));

@@ -159,7 +159,7 @@ mod tests {
             chunks: 45,
             cores: 2,
             steps,
-            passes: 3,
+            passes: 2,
             neighbors: NeighborMode::AllPairs,
         }
     }
@@ -168,12 +168,12 @@ mod tests {
     fn the_estimate_counts_one_event_per_kernel_call_and_two_per_step() {
         assert_eq!(
             plan(StrategyName::RayonChunks, 1000, 5).events(),
-            45 * 3 * 5 + 10
+            45 * 2 * 5 + 10
         );
         assert_eq!(plan(StrategyName::RayonChunks, 20, 5).calls_per_pass(), 20);
         assert_eq!(
             plan(StrategyName::RayonSpawn, 1000, 5).kernel_calls(),
-            15_000
+            10_000
         );
         assert_eq!(plan(StrategyName::StdStatic, 1000, 1).calls_per_pass(), 2);
         assert_eq!(plan(StrategyName::Seq, 1000, 1).calls_per_pass(), 1);
@@ -181,7 +181,7 @@ mod tests {
             neighbors: NeighborMode::Grid,
             ..plan(StrategyName::RayonChunks, 1000, 1)
         };
-        assert_eq!(grid.kernel_calls(), 45 * 5);
+        assert_eq!(grid.kernel_calls(), 45 * 4);
     }
 
     #[test]
@@ -191,8 +191,8 @@ mod tests {
             .unwrap_err();
         assert_eq!(
             err.to_string(),
-            "a trace of rayon-spawn with N = 20000 over 50 steps would record about 3000100 \
-             events (about 510 MB of trace.json); the most is 1000000: lower --steps or --n \
+            "a trace of rayon-spawn with N = 20000 over 50 steps would record about 2000100 \
+             events (about 340 MB of trace.json); the most is 1000000: lower --steps or --n \
              (rayon-spawn records one event per particle and pass)"
         );
         assert!(plan(StrategyName::RayonSpawn, 1000, 5).check().is_ok());

@@ -155,13 +155,6 @@ pub trait Scratch: Debug + Clone + Send + Sync + 'static {
     fn heap_bytes(&self) -> usize;
 }
 
-/// No scratch (Müller's model keeps nothing between passes).
-impl Scratch for () {
-    fn heap_bytes(&self) -> usize {
-        0
-    }
-}
-
 /// Any model's scratch, held by a simulation that does not name its model.
 #[derive(Debug)]
 pub struct AnyScratch(Box<dyn Erased>);

