@@ -1,14 +1,14 @@
-//! Which SIMD instructions the neighbour tests and Müller's force pass (with its update) run on:
-//! a portable path (whatever the compiled target guarantees: SSE2 on x86-64, NEON on aarch64)
+//! Which SIMD instructions the neighbour tests and Müller's force pass (with its update) run
+//! on: a portable path (whatever the compiled target guarantees: SSE2 on x86-64, NEON on aarch64)
 //! and, on x86-64, AVX2 and AVX-512, chosen at start-up from what the CPU has
 //! ([`SimdPath::widest`]) or forced with `--simd`.
 //!
 //! The all-pairs search tests eight candidates per call ([`Lanes::near8`]); every pass that
 //! searches runs inside [`Lanes::vectorize`], so the compiler may use the path's instructions
 //! for the rest of the pass too, and so does the update loop of Müller's force pass (its wall
-//! clamps written as selects, the compiler takes eight particles an instruction on AVX-512). On AVX-512 the grid
-//! of up to 4096 particles, and a larger grid's blocks of 16 candidates or more, scan a row's
-//! candidates eight at a time and pack the hits in registers ([`Lanes::hits8`], `vpcompressq`;
+//! clamps written as selects, the compiler takes eight particles an instruction on AVX-512).
+//! On AVX-512 the grid of up to 4096 particles, and a larger grid's blocks of 16 candidates or
+//! more, scan a row's candidates eight at a time and pack the hits in registers ([`Lanes::hits8`], `vpcompressq`;
 //! a larger grid's sparse blocks measured faster one by one; the grid's `scans_packed`
 //! decides). Otherwise, and on the other paths, the grid tests them one by one and its search
 //! passes run as the target compiles them: a row holds only 3–12 candidates, and blocks of

@@ -97,7 +97,9 @@ impl Model for Params {
                 with_search_lanes!(nb, lanes, (nb, lists, l) => density(exec, l, &*nb, lists, s, self))
             }
             Pass::Forces => {
-                let moved = with_search!(nb, (nb, lists) => with_lanes!(lanes, l => forces_and_moves(exec, l, &*nb, lists, s, next, self, domain)));
+                let moved = with_search!(nb, (nb, lists) => with_lanes!(lanes, l => {
+                    forces_and_moves(exec, l, &*nb, lists, s, next, self, domain)
+                }));
                 // Only a finished pass moves the particles: after a kernel's panic the state
                 // keeps the step's starting positions and velocities.
                 moved.map(|()| next.swap_into(s))

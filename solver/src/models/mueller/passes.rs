@@ -1,9 +1,9 @@
 //! What a step of Müller's model (the `seed` and `cpp` presets) computes for each particle —
-//! density and pressure, force, and the update, run in two passes — each a pure
-//! function of one particle and read-only state (Müller, Charypar & Gross 2003, as the seed
-//! and C++ sources evaluate it; operation order is part of the contract — see the book's
-//! "Physics" page, book/src/physics.md). No threads, clocks, I/O or allocation here: the solver decides which
-//! particles each call covers.
+//! density and pressure, force, and the update, run in two passes — each a pure function of
+//! one particle and read-only state (Müller, Charypar & Gross 2003, as the seed and C++
+//! sources evaluate it; operation order is part of the contract — see the book's "Physics"
+//! page, book/src/physics.md). No threads, clocks, I/O or allocation here: the solver decides
+//! which particles each call covers.
 
 use glam::DVec2;
 
