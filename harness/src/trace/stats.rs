@@ -212,13 +212,13 @@ fn ms(ns: u64) -> f64 {
     ns as f64 / 1e6
 }
 
-/// Writes `stats.csv` (header [`CSV_HEADER`]): one `worker` row per worker track (`name` the
-/// worker index, `threads` how many OS threads held it, `span_ms` the step loop's wall time),
-/// one `pass` row per pass (`name` the model's passes, Müller's density and forces, preceded
-/// by `grid rebuild` when the grid's rebuild ran kernel calls; `span_ms` summed over steps, `imbalance` as in
-/// [`PassStats`]), and
-/// one `total` row (`threads` the distinct worker threads, `kernel_calls` the tasks created).
-/// Times in milliseconds, idle shares in percent; empty where a column does not apply.
+/// Writes `stats.csv` (header [`CSV_HEADER`]): one `worker` row per worker track (`name` the worker
+/// index, `threads` how many OS threads held it, `span_ms` the step loop's wall time), one `pass`
+/// row per pass (`name` the model's passes, Müller's density and forces, preceded by `grid rebuild`
+/// when the grid's rebuild ran kernel calls; `span_ms` summed over steps, `imbalance` as in
+/// [`PassStats`]), and one `total` row (`threads` the distinct worker threads, `kernel_calls` the
+/// tasks created). Times in milliseconds, idle shares in percent; empty where a column does not
+/// apply.
 pub fn write_csv<W: Write>(stats: &Stats, out: W) -> Result<(), csv::Error> {
     let mut w = csv::Writer::from_writer(out);
     for s in &stats.workers {

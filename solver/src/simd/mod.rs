@@ -4,19 +4,18 @@
 //! ([`SimdPath::widest`]) or forced with `--simd`.
 //!
 //! The all-pairs search tests eight candidates per call ([`Lanes::near8`]); every pass that
-//! searches runs inside [`Lanes::vectorize`], so the compiler may use the path's instructions
-//! for the rest of the pass too, and so does the update loop of Müller's force pass (its wall
-//! clamps written as selects, the compiler takes eight particles an instruction on AVX-512).
-//! On AVX-512 the grid of up to 4096 particles, and a larger grid's blocks of 16 candidates or
-//! more, scan a row's candidates eight at a time and pack the hits in registers ([`Lanes::hits8`], `vpcompressq`;
-//! a larger grid's sparse blocks measured faster one by one; the grid's `scans_packed`
-//! decides). Otherwise, and on the other paths, the grid tests them one by one and its search
-//! passes run as the target compiles them: a row holds only 3–12 candidates, and blocks of
-//! eight whose hits are taken bit by bit measured slower there. Müller's force
-//! pass, on either search, takes two neighbours at a time on the x86 paths, in four lanes
-//! ([`F64x4`], `quad.rs`), which halves its divisions and square roots (measured 6 % faster;
-//! four pairs at a time in eight lanes measured no faster again: the pass is not bound by the
-//! divider on this project's EPYC VM).
+//! searches runs inside [`Lanes::vectorize`], so the compiler may use the path's instructions for
+//! the rest of the pass too, and so does the update loop of Müller's force pass (its wall clamps
+//! written as selects, the compiler takes eight particles an instruction on AVX-512). On AVX-512
+//! the grid of up to 4096 particles, and a larger grid's blocks of 16 candidates or more, scan a
+//! row's candidates eight at a time and pack the hits in registers ([`Lanes::hits8`],
+//! `vpcompressq`; a larger grid's sparse blocks measured faster one by one; the grid's
+//! `scans_packed` decides). Otherwise, and on the other paths, the grid tests them one by one and
+//! its search passes run as the target compiles them: a row holds only 3–12 candidates, and blocks
+//! of eight whose hits are taken bit by bit measured slower there. Müller's force pass, on either
+//! search, takes two neighbours at a time on the x86 paths, in four lanes ([`F64x4`], `quad.rs`),
+//! which halves its divisions and square roots (measured 6 % faster; four pairs at a time in eight
+//! lanes measured no faster again: the pass is not bound by the divider on this project's EPYC VM).
 //!
 //! Müller's density pass in the grid's cell order sums in eight lanes on every path, a row's
 //! candidate k in lane k mod 8. On AVX-512 each row's candidates are tested eight at a time

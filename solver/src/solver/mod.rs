@@ -1,11 +1,11 @@
-//! One step = the model's passes over the particles, each handed to a strategy's executor,
-//! plus the grid rebuild before them and the divergence check after them: two passes for
-//! Müller's model (density; forces, which also move each particle), six for WCSPH (max speed,
-//! neighbours, walls, momentum, continuity, integrate). What the solver asks of a model is [`model::Model`];
-//! the registry of models is [`crate::models::Physics`], and how each model cuts its passes
-//! into kernel calls lives in its folder of `crate::models`; here is
-//! the one step loop ([`Simulation::advance_with`]) and the [`StepHooks`] through which a
-//! caller wraps each phase's executor (tracing, fault injection) or the check, in `step`.
+//! One step = the model's passes over the particles, each handed to a strategy's executor, plus the
+//! grid rebuild before them and the divergence check after them: two passes for Müller's model
+//! (density; forces, which also move each particle), six for WCSPH (max speed, neighbours, walls,
+//! momentum, continuity, integrate). What the solver asks of a model is [`model::Model`]; the
+//! registry of models is [`crate::models::Physics`], and how each model cuts its passes into kernel
+//! calls lives in its folder of `crate::models`; here is the one step loop
+//! ([`Simulation::advance_with`]) and the [`StepHooks`] through which a caller wraps each phase's
+//! executor (tracing, fault injection) or the check, in `step`.
 
 pub mod model;
 pub mod pass;
