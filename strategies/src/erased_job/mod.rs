@@ -22,6 +22,9 @@
 //! jobs; any number of threads may serve, each one that joins is counted). The worst a misuse
 //! can cause is a hang — e.g. a job that waits for a worker that never comes — never a
 //! dangling reference.
+//!
+//! `scripts/miri.sh` runs this module's tests, and `team`'s, under Miri with 16 scheduling
+//! seeds; it found no undefined behaviour on 6 December (nightly 2026-05-19).
 
 #![allow(unsafe_code)]
 
