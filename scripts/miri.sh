@@ -5,7 +5,7 @@
 # data race, an unsynchronised read. Each test runs under every scheduling seed in SEEDS, so
 # Miri tries that many interleavings of the threads.
 #
-# Usage: scripts/miri.sh [SEEDS]      (default SEEDS: 0..16, as Miri's -Zmiri-many-seeds takes it)
+# Usage: scripts/miri.sh [SEEDS]      (default SEEDS: 0..16; FROM..TO, 0 <= FROM < TO <= 1000)
 # Needs the nightly toolchain with Miri:
 #     rustup toolchain install nightly --component miri,rust-src
 # Takes a few minutes (Miri interprets; each seed's tests take about 20 s).
@@ -15,6 +15,12 @@
 set -euo pipefail
 
 SEEDS="${1:-0..16}"
+# A range FROM..TO of seeds, 0 <= FROM < TO <= 1000 (each seed runs every test once).
+if ! [[ "$SEEDS" =~ ^([0-9]{1,4})\.\.([0-9]{1,4})$ ]] || ((10#${BASH_REMATCH[1]} >= 10#${BASH_REMATCH[2]})) ||
+    ((10#${BASH_REMATCH[2]} > 1000)); then
+    echo "Error: SEEDS must be FROM..TO with 0 <= FROM < TO <= 1000, not '$SEEDS'" >&2
+    exit 2
+fi
 cd "$(dirname "$0")/.."
 
 if ! cargo +nightly miri --version >/dev/null 2>&1; then
