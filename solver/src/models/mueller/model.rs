@@ -151,8 +151,7 @@ pub fn density<E: Executor, N: Neighbors, L: Lanes>(
 /// Writes fx, fy and, into `next`, each particle's position and velocity at the end of the
 /// step (the symplectic Euler update and the walls, from its own force and density); reads
 /// positions, velocities, rho, each particle's own p and the neighbour lists, which no chunk
-/// writes. Each chunk
-/// computes its forces, then moves its particles in a loop of its own.
+/// writes. Each chunk computes its forces, then moves its particles in a loop of its own.
 #[allow(clippy::too_many_arguments)]
 pub fn forces_and_moves<E: Executor, N: Neighbors, L: Lanes>(
     exec: &E,

@@ -131,11 +131,11 @@ fn density_in_lanes<N: Neighbors, L: Lanes>(
     (s04 + s26) + (s15 + s37)
 }
 
-/// Force on particle `i` from this step's densities and pressures in `input`: pressure (Müller
-/// 2003 eq. 10 with the spiky gradient, eq. 21) plus viscosity (eq. 14 with the viscosity
-/// Laplacian, eq. 22) over j ≠ i with `r < H`, in the search's visit order (index order unless
-/// a grid in cell order), plus `G · rho_i`. A neighbour's pressure is computed from its
-/// density ([`pressure`]); only particle i's own is read.
+/// Force on particle `i` from this step's densities and i's own pressure in `input`: pressure
+/// (Müller 2003 eq. 10 with the spiky gradient, eq. 21) plus viscosity (eq. 14 with the
+/// viscosity Laplacian, eq. 22) over j ≠ i with `r < H`, in the search's visit order (index
+/// order unless a grid in cell order), plus `G · rho_i`. A neighbour's pressure is computed
+/// from its density (`pressure`, below), not read.
 ///
 /// Two particles at the same point (r = 0, j ≠ i) have no pressure direction: that term is
 /// zero there (the Haskell source divides by zero), the viscosity term is still added.
