@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
 # How the strategies hold up when a core is shared (issue 11.5): runs `bench-sph simulate` for
-# seq, rayon-chunks and crossbeam-pool at 1 and 2 cores, 45 chunks, while ONE busy process
+# seq, rayon-chunks, crossbeam-pool and team at 1 and 2 cores, 45 chunks, while ONE busy process
 # (`sh -c 'while :; do :; done'`) competes for the cores, and prints per cell the median wall
 # time, its spread, the median CPU time and the ratio to the strategy's own 1-core median.
 # On a 2-core machine a 2-core run then has three runnable threads for two cores: a strategy
-# whose waiting leaves a shared core to whoever can use it stays near or below its 1-core
-# time (ratio <= 1), one that collapses does not.
+# whose waiting threads neither keep a CPU from a thread of their own that needs it nor give
+# their CPU away to the busy process for long stays near its 1-core time (ratio near 1); one
+# that does either collapses.
 #
 # Usage: scripts/contention-bench.sh [--quiet-machine]
 #   --quiet-machine   no busy process: the same table for comparison (also: NO_BUSY=1)
@@ -13,7 +14,7 @@
 #   REPS=5                      repetitions of every cell, interleaved (rep 1 of every cell,
 #                               then rep 2, ...), so a slow spell hits every cell alike
 #   STEPS, N                    --steps and --n (default: simulate's own, 1000 and 1000)
-#   STRATEGIES="seq rayon-chunks crossbeam-pool"   CORES="1 2"   CHUNKS=45
+#   STRATEGIES="seq rayon-chunks crossbeam-pool team"   CORES="1 2"   CHUNKS=45
 #   CARGO_TARGET_DIR            where the release binary is built (default: target)
 #
 # Run it on an otherwise quiet machine: it warns when the 1-minute load is already >= 0.5.
@@ -40,7 +41,7 @@ for arg in "$@"; do
 done
 
 REPS="${REPS:-5}"
-STRATEGIES="${STRATEGIES:-seq rayon-chunks crossbeam-pool}"
+STRATEGIES="${STRATEGIES:-seq rayon-chunks crossbeam-pool team}"
 CORES="${CORES:-1 2}"
 CHUNKS="${CHUNKS:-45}"
 if ! [[ "$REPS" =~ ^[1-9][0-9]*$ ]]; then

@@ -47,6 +47,7 @@ pub mod team;
 mod testing;
 mod thread_start;
 pub mod wake;
+mod whereabouts;
 
 pub use panic::KernelPanic;
 pub use placement::Placement;

@@ -1,10 +1,10 @@
 //! Where a strategy's worker threads run: what each of them does first, on itself, when it
 //! starts (e.g. pin itself to a CPU).
 //!
-//! This crate does not place threads itself (it knows no CPUs and makes no OS call): a
-//! [`Placement`] carries the caller's hook, and every strategy calls it on each worker thread
-//! it starts, with the worker's 0-based index, before the worker does anything else. Worker i
-//! of a run is:
+//! This crate does not place threads itself (it asks the OS no more than which CPU a thread
+//! runs on, in `whereabouts`): a [`Placement`] carries the caller's hook, and every strategy
+//! calls it on each worker thread it starts, with the worker's 0-based index, before the worker
+//! does anything else. Worker i of a run is:
 //! - for the rayon strategies, pool thread i (called once, when the pool starts it);
 //! - for `crossbeam-pool` and `team`, thread i of the run (0 runs the session);
 //! - for `chili`, worker 0 is the thread that runs the session (it computes too), and the

@@ -4,18 +4,28 @@
 //! Passes follow each other within microseconds, and waking a sleeping thread costs tens of
 //! microseconds (more on a virtual machine), so a thread that waits for the next pass, or for
 //! the end of one, first watches an atomic hint. How it watches matters when cores are
-//! shared: a thread that only spins keeps its core from the very thread it waits for, or from
-//! another process, for the whole time. So it spins busily only briefly ([`SPINS`] pause
-//! instructions, checking after each), then yields its core between checks (`yield_now`: immediate when the core is free, a real hand-over when
-//! another thread wants it), and after [`LIMIT`] gives up, so the caller sleeps.
+//! shared. Two ways, both beginning with [`SPINS`] busy pauses (checking after each) and both
+//! giving up after a limit, so that the caller sleeps:
+//! - [`spin_then_yield`] then yields its core between checks (`yield_now`: immediate when the
+//!   core is free, a hand-over when another thread wants it and the scheduler lets it have
+//!   it), for threads that expect to share their CPU with the very thread they wait for
+//!   (`crossbeam-pool`, and a `team` of more threads than CPUs);
+//! - [`spin_unless_beside`] keeps spinning, so that it keeps its CPU, and gives up early once
+//!   a thread it waits for turns out to run on the same CPU (a `team` of no more threads than
+//!   CPUs; see `whereabouts` for why yielding to a busy process costs a whole slice).
 
 use std::time::{Duration, Instant};
 
-/// How long a thread watches a hint, spinning then yielding, before it sleeps.
-const LIMIT: Duration = Duration::from_micros(200);
+use crate::whereabouts::Whereabouts;
 
-/// Pauses spun, checking between them, before the watch yields.
+/// How long a thread watches a hint before it sleeps.
+pub(crate) const LIMIT: Duration = Duration::from_micros(200);
+
+/// Pauses spun, checking between them, before the watch yields or starts looking at the clock.
 const SPINS: u32 = 127;
+
+/// Pauses between two looks at the clock and at who shares the CPU, in [`spin_unless_beside`].
+const CHECK_EVERY: u32 = 16;
 
 /// Returns `true` as soon as `done()` holds, or `false` once [`LIMIT`] has passed without it.
 ///
@@ -32,11 +42,8 @@ pub(crate) fn spin_then_yield_for(limit: Duration, done: impl Fn() -> bool) -> b
     // replaced), but the condition is checked after every one: `Backoff`'s last run of 64
     // pauses between checks is several microseconds on a CPU with a slow `pause` (about 140
     // cycles on Sapphire Rapids), and a pass's start waited that long to be seen.
-    for _ in 0..SPINS {
-        if done() {
-            return true;
-        }
-        std::hint::spin_loop();
+    if spun(SPINS, &done) {
+        return true;
     }
     let start = Instant::now();
     loop {
@@ -47,6 +54,97 @@ pub(crate) fn spin_then_yield_for(limit: Duration, done: impl Fn() -> bool) -> b
             return false;
         }
         std::thread::yield_now();
+    }
+}
+
+/// Returns `true` as soon as `done()` holds, or `false` once `limit` has passed without it or
+/// once `beside()` says that a thread being waited for shares the caller's CPU (so that the
+/// caller sleeps and leaves the CPU to it). Never yields: on a CPU it does not share with a
+/// thread it waits for, the caller keeps its CPU until it sleeps (see `whereabouts`).
+pub(crate) fn spin_unless_beside(
+    limit: Duration,
+    done: impl Fn() -> bool,
+    beside: impl Fn() -> bool,
+) -> bool {
+    if spun(SPINS, &done) {
+        return true;
+    }
+    let start = Instant::now();
+    loop {
+        if spun(CHECK_EVERY, &done) {
+            return true;
+        }
+        if beside() || start.elapsed() > limit {
+            return done();
+        }
+    }
+}
+
+/// Spins up to `pauses` pauses, checking `done()` before each; whether it came to hold.
+fn spun(pauses: u32, done: &impl Fn() -> bool) -> bool {
+    (0..pauses).any(|_| {
+        done() || {
+            std::hint::spin_loop();
+            false
+        }
+    })
+}
+
+/// How a team's threads watch for what they wait for before they sleep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Waiting {
+    /// No more threads than CPUs: a waiter spins, keeping its CPU, unless a thread of the team
+    /// at work runs on the same CPU, and then it sleeps ([`spin_unless_beside`]).
+    Spin,
+    /// More threads than CPUs, or a system that cannot say which CPU a thread runs on: the
+    /// team's threads may share CPUs among themselves, so a waiter yields its CPU between
+    /// checks, to whichever of them wants it, before it sleeps ([`spin_then_yield`]).
+    Yield,
+}
+
+impl Waiting {
+    /// How a team of `threads` threads that may use `cpus` CPUs waits.
+    pub(crate) fn for_team(threads: usize, cpus: usize) -> Waiting {
+        if threads <= cpus && Whereabouts::available() {
+            Waiting::Spin
+        } else {
+            Waiting::Yield
+        }
+    }
+}
+
+/// A team's way of watching: its [`Waiting`], and where its threads work.
+pub(crate) struct Watch {
+    waiting: Waiting,
+    cpus: Whereabouts,
+}
+
+impl Watch {
+    /// For a team of `threads` threads (thread 0 included) that waits as `waiting` says.
+    pub(crate) fn new(threads: usize, waiting: Waiting) -> Self {
+        Watch {
+            waiting,
+            cpus: Whereabouts::new(threads),
+        }
+    }
+
+    /// Thread `me` starts work: it notes the CPU it runs on.
+    pub(crate) fn busy(&self, me: usize) {
+        self.cpus.busy(me);
+    }
+
+    /// Thread `me` has stopped work.
+    pub(crate) fn away(&self, me: usize) {
+        self.cpus.away(me);
+    }
+
+    /// Watches for `done()` before thread `me` sleeps; whether it came. A yielding watch
+    /// lasts `yield_limit`, a spinning one [`LIMIT`].
+    pub(crate) fn watch(&self, me: usize, yield_limit: Duration, done: impl Fn() -> bool) -> bool {
+        match self.waiting {
+            Waiting::Yield => spin_then_yield_for(yield_limit, done),
+            Waiting::Spin => spin_unless_beside(LIMIT, done, || self.cpus.beside_busy(me)),
+        }
     }
 }
 
@@ -68,6 +166,39 @@ mod tests {
     #[test]
     fn a_condition_that_never_holds_gives_up_so_that_the_caller_can_sleep() {
         assert!(!spin_then_yield(|| false));
+    }
+
+    #[test]
+    fn a_watch_that_keeps_its_cpu_gives_up_early_beside_a_thread_it_waits_for() {
+        let long = Duration::from_secs(60);
+        assert!(spin_unless_beside(long, || true, || true), "done at once");
+        // Beside a busy thread: gives up at its first look, with a last look at the condition.
+        let looks = AtomicUsize::new(0);
+        let came = spin_unless_beside(
+            long,
+            || false,
+            || {
+                looks.fetch_add(1, Ordering::Relaxed);
+                true
+            },
+        );
+        assert!(!came && looks.into_inner() == 1, "one look");
+        let flag = AtomicBool::new(false);
+        let came = spin_unless_beside(
+            long,
+            || flag.load(Ordering::Relaxed),
+            || {
+                flag.store(true, Ordering::Relaxed);
+                true
+            },
+        );
+        assert!(came, "what holds at the last look counts");
+        // Alone on its CPU: gives up once the limit has passed.
+        assert!(!spin_unless_beside(
+            Duration::from_millis(2),
+            || false,
+            || false
+        ));
     }
 
     #[test]

@@ -18,14 +18,25 @@
 //!
 //! **Cost.** No thread start-up per pass. Per pass the session's thread opens the pass with
 //! one atomic store and closes it with one read-modify-write; a worker joins with one
-//! compare-and-swap and leaves with one subtraction (`TeamBoard`, in `erased_job`); each
+//! compare-and-swap and leaves with one subtraction (`TeamBoard`, in `erased_job`), and each
+//! notes its CPU (a `sched_getcpu`, one store to a line of its own, and one more to clear it
+//! for a worker; see below); each
 //! chunk is taken with one compare-and-swap on its share's word (a cache line of its own, the
 //! owner's unless others help) and moved out of its slot under an uncontended lock. The
 //! thread that opens a pass does not reset the shares (each word carries its pass's tag; see
 //! `Share`), so a share's line does not travel to it and back every pass. No queue, nothing
-//! per element. Between passes a thread watches the pass word for up to 200 µs (spinning, then yielding its core between checks;
-//! see `spin_wait`) before it sleeps on a condition variable, so back-to-back passes need no
-//! wake-up; the watching shows up as CPU time.
+//! per element. Between passes a thread watches the pass word for up to 200 µs before it sleeps
+//! on a condition variable, so back-to-back passes need no wake-up; the watching shows up as
+//! CPU time.
+//!
+//! **A shared CPU.** With no more threads than CPUs, a watching thread spins: it keeps its
+//! CPU, since giving it up to another process (a yield, a sleep) costs a whole scheduling slice
+//! of milliseconds before it comes back, while the pass waits. It sleeps at once, though, when
+//! a thread of the team that is at work runs on the same CPU, so as to leave the CPU to it:
+//! each thread notes its CPU when it starts work in a pass (`whereabouts`). With more threads
+//! than CPUs (`--cores` above the CPUs the threads may use), the team's threads share CPUs
+//! among themselves, and a watching thread yields its CPU between checks instead (see
+//! `spin_wait`).
 //!
 //! **Panics.** A kernel panic is caught per chunk; the first one is returned as
 //! [`KernelPanic`] once the pass has finished, and the threads keep serving later passes.
@@ -43,6 +54,7 @@ use crossbeam::utils::CachePadded;
 
 use crate::erased_job::{ShutDownOnDrop, TeamBoard};
 use crate::panic::FirstPanic;
+use crate::spin_wait::{Waiting, Watch};
 use crate::thread_start::ThreadStarts;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Placement, Session, Split, Strategy,
@@ -85,7 +97,7 @@ impl Strategy for Team {
     /// # Panics
     /// Re-raises a panic of `session` itself once the threads have been joined.
     fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError> {
-        let board = TeamBoard::new();
+        let board = TeamBoard::new(Watch::new(self.cores, self.waiting()));
         let executor = TeamExecutor {
             board: &board,
             threads: self.cores,
@@ -120,6 +132,14 @@ impl Strategy for Team {
             let joined = session_thread.join();
             Ok(joined.unwrap_or_else(|payload| std::panic::resume_unwind(payload)))
         })
+    }
+}
+
+impl Team {
+    /// How the team's threads wait: more threads than the CPUs they may use share CPUs among
+    /// themselves (see [`Waiting`]).
+    fn waiting(&self) -> Waiting {
+        Waiting::for_team(self.cores, self.placement.parallelism())
     }
 }
 
@@ -355,7 +375,7 @@ mod tests {
         // first pass has tag 0, which the new shares' words carry too: words as if left 2¹⁶
         // passes before, which only the reset tells from this pass's (without it, the first
         // pass would take no chunk).
-        let board = TeamBoard::new();
+        let board = TeamBoard::new(Watch::new(3, Waiting::Spin));
         let executor = TeamExecutor {
             board: &board,
             threads: 3,
@@ -386,6 +406,25 @@ mod tests {
         let all: Vec<_> = passes.concat();
         assert!((2..=3).contains(&distinct(&all)), "{passes:?}");
         assert!(!all.contains(&std::thread::current().id()));
+    }
+
+    #[test]
+    fn a_team_of_more_threads_than_cpus_yields_and_one_of_no_more_spins_where_cpus_are_known() {
+        let team = |cores, cpus| Team {
+            cores,
+            chunks: 8,
+            placement: Placement::new(&|_| {}, cpus),
+            starts: ThreadStarts::default(),
+        };
+        let spin = if crate::whereabouts::Whereabouts::available() {
+            Waiting::Spin
+        } else {
+            Waiting::Yield
+        };
+        assert_eq!(team(2, 2).waiting(), spin);
+        assert_eq!(team(2, 4).waiting(), spin);
+        assert_eq!(team(3, 2).waiting(), Waiting::Yield);
+        assert_eq!(team(2, 1).waiting(), Waiting::Yield);
     }
 
     #[test]

@@ -12,8 +12,9 @@
 //! - [`TeamBoard`] (`team`) keeps them in one atomic word, with the job on its cache line
 //!   (written only between passes, read only by a worker inside one), so that a pass costs the
 //!   dispatcher one store and one read-modify-write on it (and two on a flag that only it
-//!   touches) and each worker two, and takes a lock only to sleep, to wake a sleeper, or to
-//!   keep a panic.
+//!   touches) and each worker two, besides a store or two by each thread to a slot of its own
+//!   saying where it works (`spin_wait::Watch`), and takes a lock only to sleep, to wake a
+//!   sleeper, or to keep a panic.
 //!
 //! The soundness argument lives entirely in this module, behind a safe API: no caller can make
 //! a board call a job after `run` has returned, whatever the job does (a job that panics is

@@ -5,9 +5,10 @@
 //! worker joins it with a compare-and-swap that succeeds only while the pass is open, and
 //! leaves it with a subtraction; the dispatcher closes it with an `and`, after which no
 //! compare-and-swap can succeed, and waits until the count is zero. The pass's job sits on the
-//! word's cache line, so a worker that sees the pass open has its job too. Everything else —
-//! sleeping after a short watch, waking sleepers, keeping the first panic — happens only when
-//! somebody sleeps or something panicked.
+//! word's cache line, so a worker that sees the pass open has its job too. Besides, each
+//! thread notes in a slot of its own the CPU it works on (`whereabouts`), for the watch before
+//! a sleep (`spin_wait::Watch`). Everything else — sleeping after that watch, waking sleepers,
+//! keeping the first panic — happens only when somebody sleeps or something panicked.
 
 use std::cell::UnsafeCell;
 use std::mem;
@@ -18,7 +19,8 @@ use std::time::Duration;
 use crossbeam::utils::CachePadded;
 
 use super::{AbortOnUnwind, ErasedJob};
-use crate::{KernelPanic, panic, spin_wait};
+use crate::spin_wait::{self, Watch};
+use crate::{KernelPanic, panic};
 
 /// The pass is open: workers may join it.
 const OPEN: u64 = 1 << 31;
@@ -27,10 +29,10 @@ const INSIDE: u64 = OPEN - 1;
 /// One epoch.
 const EPOCH: u64 = 1 << 32;
 
-/// How long the dispatcher watches for the last worker of a closed pass before it sleeps.
-/// Short: by then every chunk has been taken, so a worker still inside is either busy with
-/// its last chunk or descheduled in it, and a sleeping dispatcher leaves its core idle, which
-/// lets the operating system move a descheduled worker onto it.
+/// How long the dispatcher of a team that yields (`Waiting::Yield`) watches for the last worker
+/// of a closed pass before it sleeps. Short: by then every chunk has been taken, so a worker
+/// still inside is either busy with its last chunk or descheduled in it, perhaps on the
+/// dispatcher's own CPU.
 const LAST_OUT: Duration = Duration::from_micros(20);
 
 /// What a worker reads to join a pass.
@@ -76,11 +78,13 @@ pub(crate) struct TeamBoard {
     sleep: Mutex<()>,
     to_workers: Condvar,
     to_dispatcher: Condvar,
+    /// How the team's threads watch before they sleep, and where they work.
+    watch: Watch,
 }
 
 impl TeamBoard {
-    /// A board with no pass yet.
-    pub(crate) fn new() -> Self {
+    /// A board with no pass yet, whose threads watch as `watch` says.
+    pub(crate) fn new(watch: Watch) -> Self {
         TeamBoard {
             pass: CachePadded::new(PassLine {
                 word: AtomicU64::new(0),
@@ -95,6 +99,7 @@ impl TeamBoard {
             sleep: Mutex::new(()),
             to_workers: Condvar::new(),
             to_dispatcher: Condvar::new(),
+            watch,
         }
     }
 
@@ -116,6 +121,8 @@ impl TeamBoard {
             !self.in_flight.swap(true, Ordering::Acquire),
             "a team board runs one pass at a time"
         );
+        // The dispatcher counts as at work throughout: it is the one that opens every pass.
+        self.watch.busy(0);
         // From opening the pass until no worker is inside it, an unwind out of `run` would
         // end the borrow of `job` under a running worker: the guard turns any unwind in that
         // window into an abort.
@@ -170,9 +177,11 @@ impl TeamBoard {
     /// open when it looks, until [`shut_down`](Self::shut_down).
     pub(crate) fn serve(&self, index: usize) {
         let mut seen = 0;
-        while let Some(word) = self.wait_for_pass(seen) {
+        while let Some(word) = self.wait_for_pass(index, seen) {
             seen = epoch(word);
+            self.watch.busy(index);
             if !self.join(word) {
+                self.watch.away(index);
                 continue; // closed before this worker looked: skipped
             }
             let guard = AbortOnUnwind;
@@ -202,6 +211,7 @@ impl TeamBoard {
                 drop(self.lock());
                 self.to_dispatcher.notify_one();
             }
+            self.watch.away(index);
         }
     }
 
@@ -232,9 +242,12 @@ impl TeamBoard {
 
     /// Waits until a pass after epoch `seen` has been opened (its word), or the board shuts
     /// down (`None`): watching first (see `spin_wait`), then asleep.
-    fn wait_for_pass(&self, seen: u64) -> Option<u64> {
+    fn wait_for_pass(&self, index: usize, seen: u64) -> Option<u64> {
         let news = |order| self.shutdown.load(order) || epoch(self.pass.word.load(order)) != seen;
-        if !spin_wait::spin_then_yield(|| news(Ordering::Acquire)) {
+        if !self
+            .watch
+            .watch(index, spin_wait::LIMIT, || news(Ordering::Acquire))
+        {
             let mut sleep = self.lock();
             self.workers_asleep.fetch_add(1, Ordering::SeqCst);
             while !news(Ordering::SeqCst) {
@@ -254,7 +267,7 @@ impl TeamBoard {
     /// Waits until no worker is inside the closed pass: watching first, then asleep.
     fn wait_for_workers(&self) {
         let drained = |order| self.pass.word.load(order) & INSIDE == 0;
-        if spin_wait::spin_then_yield_for(LAST_OUT, || drained(Ordering::Acquire)) {
+        if self.watch.watch(0, LAST_OUT, || drained(Ordering::Acquire)) {
             return;
         }
         let mut sleep = self.lock();
@@ -266,6 +279,8 @@ impl TeamBoard {
                 .unwrap_or_else(PoisonError::into_inner);
         }
         self.dispatcher_asleep.store(false, Ordering::Relaxed);
+        // Woken, perhaps on another CPU.
+        self.watch.busy(0);
     }
 
     /// The lock that sleepers and wakers share; it guards nothing else, so poisoning carries
@@ -279,23 +294,26 @@ impl TeamBoard {
 mod tests {
     use super::*;
     use crate::erased_job::{ShutDownOnDrop, wait_for};
+    use crate::spin_wait::Waiting;
     use std::collections::HashMap;
     use std::sync::atomic::AtomicUsize;
     use std::thread::{self, ThreadId};
     use std::time::Duration;
 
-    /// Serves `board` on `workers` scoped threads (indices 1..) while `f` runs, then shuts
-    /// it down.
-    fn served(workers: usize, f: impl FnOnce(&TeamBoard) + Send) {
-        let board = TeamBoard::new();
-        thread::scope(|s| {
-            for i in 1..=workers {
-                let board = &board;
-                s.spawn(move || board.serve(i));
-            }
-            let _stop = ShutDownOnDrop(&board);
-            f(&board);
-        });
+    /// Serves a board on `workers` scoped threads (indices 1..) while `f` runs, then shuts
+    /// it down; once for each way of waiting.
+    fn served(workers: usize, f: impl Fn(&TeamBoard) + Sync) {
+        for waiting in [Waiting::Spin, Waiting::Yield] {
+            let board = TeamBoard::new(Watch::new(workers + 1, waiting));
+            thread::scope(|s| {
+                for i in 1..=workers {
+                    let board = &board;
+                    s.spawn(move || board.serve(i));
+                }
+                let _stop = ShutDownOnDrop(&board);
+                f(&board);
+            });
+        }
     }
 
     #[test]
