@@ -14,7 +14,7 @@
 //!
 //! A slot is a hint: a thread moved by the operating system since it wrote it is found where
 //! it was. Where the CPU cannot be asked (not Linux, or under Miri), no thread is ever found
-//! beside another, and waiters spin for their limit before they sleep.
+//! beside another, so `team` watches by yielding there instead (`spin_wait::Waiting`).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 

@@ -59,10 +59,18 @@ fn beyond(deps: &BTreeMap<String, Vec<String>>, krate: &str, allowed: &[&str]) -
 #[test]
 fn the_strategies_crate_depends_on_threads_only() {
     let deps = dependencies();
+    // `nix` only for `sched_getcpu`: which CPU a `team` thread runs on (whereabouts.rs).
     let extra = beyond(
         &deps,
         "sph-strategies",
-        &["rayon", "crossbeam", "chili", "paralight", "thiserror"],
+        &[
+            "rayon",
+            "crossbeam",
+            "chili",
+            "paralight",
+            "thiserror",
+            "nix",
+        ],
     );
     assert!(extra.is_empty(), "sph-strategies depends on {extra:?}");
 }
