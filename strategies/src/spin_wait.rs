@@ -120,11 +120,17 @@ pub(crate) struct Watch {
 }
 
 impl Watch {
-    /// For a team of `threads` threads (thread 0 included) that waits as `waiting` says.
+    /// For a team of `threads` threads (thread 0 included) that waits as `waiting` says. A
+    /// yielding watch never asks where the threads are, so it keeps no slots, and its threads
+    /// ask no CPU when they start work.
     pub(crate) fn new(threads: usize, waiting: Waiting) -> Self {
+        let slots = match waiting {
+            Waiting::Spin => threads,
+            Waiting::Yield => 0,
+        };
         Watch {
             waiting,
-            cpus: Whereabouts::new(threads),
+            cpus: Whereabouts::new(slots),
         }
     }
 

@@ -18,9 +18,9 @@
 //!
 //! **Cost.** No thread start-up per pass. Per pass the session's thread opens the pass with
 //! one atomic store and closes it with one read-modify-write; a worker joins with one
-//! compare-and-swap and leaves with one subtraction (`TeamBoard`, in `erased_job`), and each
-//! notes its CPU (a `sched_getcpu`, one store to a line of its own, and one more to clear it
-//! for a worker; see below); each
+//! compare-and-swap and leaves with one subtraction (`TeamBoard`, in `erased_job`), and in a
+//! team that spins while it waits (see below) each notes its CPU (a `sched_getcpu`, one store
+//! to a line of its own, and one more to clear it for a worker); each
 //! chunk is taken with one compare-and-swap on its share's word (a cache line of its own, the
 //! owner's unless others help) and moved out of its slot under an uncontended lock. The
 //! thread that opens a pass does not reset the shares (each word carries its pass's tag; see
