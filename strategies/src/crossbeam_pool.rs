@@ -24,17 +24,26 @@
 //! A waiting thread (a worker between passes, the session's thread at the end of a pass)
 //! watches an atomic hint for up to 200 µs before it sleeps on a condition variable, so
 //! back-to-back passes need no wake-up (waking a sleeping thread costs tens of microseconds,
-//! far more on a virtual machine); the watching shows up as CPU time.
+//! far more on a virtual machine); the watching shows up as CPU time. Where the session's thread
+//! spins while it waits (see below), a worker inside a pass also notes its CPU (a
+//! `sched_getcpu` and a store to a line of its own, and one more to clear it).
 //!
 //! **Contention.** The pool must not collapse when its cores are shared (another busy
-//! process, more threads than cores). So the watching spins only a few short rounds and then
-//! yields the core between checks, leaving it to whichever thread — ours or not — is ready to
-//! run; and a pass never waits for a worker that has not joined it: the pass closes when the
-//! session's thread finds no chunk left, and only the workers already inside it (each busy
-//! with a chunk it took) are waited for. A descheduled worker thus costs the pass its help,
-//! not a scheduling round-trip. The pool never gives its threads up: every pass offers its
-//! chunks to all of them, whatever the machine is doing, so a run does the same work on a
-//! busy machine as on a quiet one, and a busy machine shows in its time.
+//! process, more threads than cores). A pass never waits for a worker that has not joined it:
+//! the pass closes when the session's thread finds no chunk left, and only the workers already
+//! inside it (each busy with a chunk it took) are waited for. A descheduled worker thus costs
+//! the pass its help, not a scheduling round-trip. So a worker waiting for the next pass spins
+//! a few short rounds and then yields its CPU between checks, leaving it to whichever thread —
+//! ours or not — is ready to run, between passes rather than inside one. The session's thread,
+//! waiting for the workers inside a pass, holds the pass up (see `spin_wait`): with no more
+//! threads than CPUs it spins, as `team`'s does, keeping its CPU — giving it up to another
+//! process costs a whole scheduling slice before it comes back — unless a worker it waits for
+//! was last seen on its CPU, and then it sleeps at once; with more threads than CPUs the
+//! pool's threads share CPUs among themselves, and it yields between checks too, for up to
+//! 200 µs (`team`'s, 20 µs). The pool
+//! never gives its threads up: every pass offers its chunks to all of them, whatever the
+//! machine is doing, so a run does the same work on a busy machine as on a quiet one, and a
+//! busy machine shows in its time.
 //!
 //! **Panics.** A kernel panic is caught per chunk; the first one is returned as
 //! [`KernelPanic`] once the pass has finished, and the workers keep serving later passes.
@@ -50,6 +59,7 @@
 
 use crate::erased_job::{JobBoard, ShutDownOnDrop};
 use crate::panic::FirstPanic;
+use crate::spin_wait::{Waiting, Watch};
 use crate::thread_start::ThreadStarts;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Placement, Session, Split, Strategy,
@@ -93,7 +103,10 @@ impl Strategy for CrossbeamPool {
     /// # Panics
     /// Re-raises a panic of `session` itself once the workers have been joined.
     fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError> {
-        let board = JobBoard::new();
+        let board = JobBoard::new(Watch::new(
+            self.cores,
+            Waiting::for_team(self.cores, self.placement),
+        ));
         let executor = PoolExecutor {
             board: &board,
             threads: self.cores,
@@ -113,7 +126,7 @@ impl Strategy for CrossbeamPool {
                         .name(format!("crossbeam-pool-{i}"))
                         .spawn(move |_| {
                             placement.on_start(i);
-                            board.serve()
+                            board.serve(i)
                         })
                 })?;
             }

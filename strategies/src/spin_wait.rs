@@ -8,14 +8,20 @@
 //! giving up after a limit, so that the caller sleeps:
 //! - [`spin_then_yield`] then yields its core between checks (`yield_now`: immediate when the
 //!   core is free, a hand-over when another thread wants it and the scheduler lets it have
-//!   it), for threads that expect to share their CPU with the very thread they wait for
-//!   (`crossbeam-pool`, and a `team` of more threads than CPUs);
+//!   it). A worker waiting for the next pass always watches so: a pass does not wait for a
+//!   worker that has not joined it, so a worker that gives its CPU away costs the pass only its
+//!   help, and it gives the CPU away between passes, never inside one;
 //! - [`spin_unless_beside`] keeps spinning, so that it keeps its CPU, and gives up early once
-//!   a thread it waits for turns out to run on the same CPU (a `team` of no more threads than
-//!   CPUs; see `whereabouts` for why yielding to a busy process costs a whole slice).
+//!   a thread it waits for turns out to run on the same CPU: the session's thread waiting for
+//!   the last workers of a pass, with no more threads than CPUs ([`Watch`]). It holds up the
+//!   pass, and a yield to a busy process costs it a whole scheduling slice (see
+//!   `whereabouts`).
+//!
+//! A "team" below is the threads of either board: `team`'s or `crossbeam-pool`'s.
 
 use std::time::{Duration, Instant};
 
+use crate::Placement;
 use crate::whereabouts::Whereabouts;
 
 /// How long a thread watches a hint before it sleeps.
@@ -27,17 +33,12 @@ const SPINS: u32 = 127;
 /// Pauses between two looks at the clock and at who shares the CPU, in [`spin_unless_beside`].
 const CHECK_EVERY: u32 = 16;
 
-/// Returns `true` as soon as `done()` holds, or `false` once [`LIMIT`] has passed without it.
+/// Returns `true` as soon as `done()` holds, or `false` once `limit` has passed without it.
 ///
 /// Busy spinning lasts only [`SPINS`] pauses; after that every check is separated by a
 /// `yield_now`, so a thread waiting here never holds a contended core for more than one
 /// scheduling decision at a time.
-pub(crate) fn spin_then_yield(done: impl Fn() -> bool) -> bool {
-    spin_then_yield_for(LIMIT, done)
-}
-
-/// [`spin_then_yield`], giving up once `limit` has passed.
-pub(crate) fn spin_then_yield_for(limit: Duration, done: impl Fn() -> bool) -> bool {
+pub(crate) fn spin_then_yield(limit: Duration, done: impl Fn() -> bool) -> bool {
     // As many pauses as crossbeam's `Backoff` spins (1 + 2 + ... + 64, which this loop
     // replaced), but the condition is checked after every one: `Backoff`'s last run of 64
     // pauses between checks is several microseconds on a CPU with a slow `pause` (about 140
@@ -90,22 +91,23 @@ fn spun(pauses: u32, done: &impl Fn() -> bool) -> bool {
     })
 }
 
-/// How a team's threads watch for what they wait for before they sleep.
+/// How the session's thread watches for the last workers of a pass before it sleeps.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Waiting {
-    /// No more threads than CPUs: a waiter spins, keeping its CPU, unless a thread of the team
-    /// at work runs on the same CPU, and then it sleeps ([`spin_unless_beside`]).
+    /// No more threads than CPUs: it spins, keeping its CPU, unless a worker inside the pass
+    /// was last seen on the same CPU, and then it sleeps ([`spin_unless_beside`]).
     Spin,
     /// More threads than CPUs, or a system that cannot say which CPU a thread runs on: the
-    /// team's threads may share CPUs among themselves, so a waiter yields its CPU between
-    /// checks, to whichever of them wants it, before it sleeps ([`spin_then_yield`]).
+    /// team's threads may share CPUs among themselves, so it yields its CPU between checks, to
+    /// whichever of them wants it, before it sleeps ([`spin_then_yield`]).
     Yield,
 }
 
 impl Waiting {
-    /// How a team of `threads` threads that may use `cpus` CPUs waits.
-    pub(crate) fn for_team(threads: usize, cpus: usize) -> Waiting {
-        if threads <= cpus && Whereabouts::available() {
+    /// How a team of `threads` threads placed as `placement` says waits: more threads than
+    /// the CPUs they may use share CPUs among themselves.
+    pub(crate) fn for_team(threads: usize, placement: Placement) -> Waiting {
+        if threads <= placement.parallelism() && Whereabouts::available() {
             Waiting::Spin
         } else {
             Waiting::Yield
@@ -113,16 +115,17 @@ impl Waiting {
     }
 }
 
-/// A team's way of watching: its [`Waiting`], and where its threads work.
+/// How a team's session thread watches for the last workers of a pass: its [`Waiting`], and
+/// where the workers inside the pass work.
 pub(crate) struct Watch {
     waiting: Waiting,
     cpus: Whereabouts,
 }
 
 impl Watch {
-    /// For a team of `threads` threads (thread 0 included) that waits as `waiting` says. A
-    /// yielding watch never asks where the threads are, so it keeps no slots, and its threads
-    /// ask no CPU when they start work.
+    /// For a team of `threads` threads (thread 0, the session's, included) that waits as
+    /// `waiting` says. A yielding watch never asks where the threads are, so it keeps no
+    /// slots, and its threads ask no CPU when they start work.
     pub(crate) fn new(threads: usize, waiting: Waiting) -> Self {
         let slots = match waiting {
             Waiting::Spin => threads,
@@ -134,22 +137,23 @@ impl Watch {
         }
     }
 
-    /// Thread `me` starts work: it notes the CPU it runs on.
+    /// Worker `me` (1 and up) is about to work in a pass: it notes the CPU it runs on.
     pub(crate) fn busy(&self, me: usize) {
         self.cpus.busy(me);
     }
 
-    /// Thread `me` has stopped work.
+    /// Worker `me` has left the pass.
     pub(crate) fn away(&self, me: usize) {
         self.cpus.away(me);
     }
 
-    /// Watches for `done()` before thread `me` sleeps; whether it came. A yielding watch
-    /// lasts `yield_limit`, a spinning one [`LIMIT`].
-    pub(crate) fn watch(&self, me: usize, yield_limit: Duration, done: impl Fn() -> bool) -> bool {
+    /// Watches, on the session's thread, for `done()` (the last workers have left the pass)
+    /// before it sleeps; whether it came. A yielding watch lasts `yield_limit`, a spinning one
+    /// [`LIMIT`].
+    pub(crate) fn last_out(&self, yield_limit: Duration, done: impl Fn() -> bool) -> bool {
         match self.waiting {
-            Waiting::Yield => spin_then_yield_for(yield_limit, done),
-            Waiting::Spin => spin_unless_beside(LIMIT, done, || self.cpus.beside_busy(me)),
+            Waiting::Yield => spin_then_yield(yield_limit, done),
+            Waiting::Spin => spin_unless_beside(LIMIT, done, || self.cpus.beside_busy(0)),
         }
     }
 }
@@ -162,7 +166,7 @@ mod tests {
     #[test]
     fn a_condition_that_already_holds_returns_at_once() {
         let checks = AtomicUsize::new(0);
-        assert!(spin_then_yield(|| {
+        assert!(spin_then_yield(LIMIT, || {
             checks.fetch_add(1, Ordering::Relaxed);
             true
         }));
@@ -171,7 +175,7 @@ mod tests {
 
     #[test]
     fn a_condition_that_never_holds_gives_up_so_that_the_caller_can_sleep() {
-        assert!(!spin_then_yield(|| false));
+        assert!(!spin_then_yield(LIMIT, || false));
     }
 
     #[test]
@@ -208,12 +212,61 @@ mod tests {
     }
 
     #[test]
+    fn the_sessions_watch_gives_up_at_its_first_look_when_a_worker_in_the_pass_shares_its_cpu() {
+        if !Whereabouts::available() {
+            return; // no CPU to ask: never beside, which the slots' own test checks
+        }
+        let watch = Watch::new(2, Waiting::Spin);
+        let checks = AtomicUsize::new(0);
+        let count = || {
+            checks.fetch_add(1, Ordering::Relaxed);
+            false
+        };
+        // Worker 1 is this thread, pretending: it runs on the watcher's CPU. The thread may
+        // move between the note and the look, so a few tries are allowed. A try that took its
+        // whole limit would also end at its first look: it does not count.
+        let gave_up_at_once = (0..100).any(|_| {
+            checks.store(0, Ordering::Relaxed);
+            watch.busy(1);
+            let start = Instant::now();
+            !watch.last_out(LIMIT, count)
+                && start.elapsed() < LIMIT
+                && checks.load(Ordering::Relaxed) <= (SPINS + CHECK_EVERY + 1) as usize
+        });
+        assert!(gave_up_at_once);
+        // Worker 1 has left the pass: the watch lasts its limit, looking many times (once the
+        // limit has passed it ends at its next look, so a watch descheduled past its limit
+        // looks no more than at once beside a worker: a few tries are allowed).
+        watch.away(1);
+        let watched_on = (0..100).any(|_| {
+            checks.store(0, Ordering::Relaxed);
+            !watch.last_out(LIMIT, count)
+                && checks.load(Ordering::Relaxed) > (SPINS + CHECK_EVERY + 1) as usize
+        });
+        assert!(watched_on);
+    }
+
+    #[test]
+    fn a_team_of_more_threads_than_cpus_yields_and_one_of_no_more_spins_where_cpus_are_known() {
+        let waiting = |threads, cpus| Waiting::for_team(threads, Placement::new(&|_| {}, cpus));
+        let spin = if Whereabouts::available() {
+            Waiting::Spin
+        } else {
+            Waiting::Yield
+        };
+        assert_eq!(waiting(2, 2), spin);
+        assert_eq!(waiting(2, 4), spin);
+        assert_eq!(waiting(3, 2), Waiting::Yield);
+        assert_eq!(waiting(2, 1), Waiting::Yield);
+    }
+
+    #[test]
     fn a_condition_set_by_another_thread_is_seen() {
         let flag = AtomicBool::new(false);
         std::thread::scope(|s| {
             s.spawn(|| flag.store(true, Ordering::Release));
             // The other thread may not have run within one limit on a loaded machine: retry.
-            while !spin_then_yield(|| flag.load(Ordering::Acquire)) {}
+            while !spin_then_yield(LIMIT, || flag.load(Ordering::Acquire)) {}
         });
     }
 }

@@ -18,9 +18,9 @@
 //!
 //! **Cost.** No thread start-up per pass. Per pass the session's thread opens the pass with
 //! one atomic store and closes it with one read-modify-write; a worker joins with one
-//! compare-and-swap and leaves with one subtraction (`TeamBoard`, in `erased_job`), and in a
-//! team that spins while it waits (see below) each notes its CPU (a `sched_getcpu`, one store
-//! to a line of its own, and one more to clear it for a worker); each
+//! compare-and-swap and leaves with one subtraction (`TeamBoard`, in `erased_job`), and where
+//! the session's thread spins while it waits (see below) each worker notes its CPU (a
+//! `sched_getcpu` and a store to a line of its own, and one more store to clear it); each
 //! chunk is taken with one compare-and-swap on its share's word (a cache line of its own, the
 //! owner's unless others help) and moved out of its slot under an uncontended lock. The
 //! thread that opens a pass does not reset the shares (each word carries its pass's tag; see
@@ -29,13 +29,16 @@
 //! on a condition variable, so back-to-back passes need no wake-up; the watching shows up as
 //! CPU time.
 //!
-//! **A shared CPU.** With no more threads than CPUs, a watching thread spins: it keeps its
-//! CPU, since giving it up to another process (a yield, a sleep) costs a whole scheduling slice
-//! of milliseconds before it comes back, while the pass waits. It sleeps at once, though, when
-//! a thread of the team that is at work runs on the same CPU, so as to leave the CPU to it:
-//! each thread notes its CPU when it starts work in a pass (`whereabouts`). With more threads
-//! than CPUs (`--cores` above the CPUs the threads may use), the team's threads share CPUs
-//! among themselves, and a watching thread yields its CPU between checks instead (see
+//! **A shared CPU.** A worker waiting for the next pass spins briefly, then yields its CPU
+//! between checks: a pass does not wait for a worker that has not joined it, so a worker that
+//! gives its CPU away (to a busy process, for a whole scheduling slice) costs the pass only its
+//! help, and it gives it away between passes, not inside one. The session's thread, waiting
+//! for the last workers of a pass, holds the pass up: with no more threads than CPUs it spins,
+//! keeping its CPU, since giving it up costs a slice of milliseconds before it comes back; it
+//! sleeps at once, though, when a worker inside the pass was last seen on its CPU, so as to
+//! leave the CPU to it (each worker notes its CPU when it joins a pass: `whereabouts`). With
+//! more threads than CPUs (`--cores` above the CPUs the threads may use), the team's threads
+//! share CPUs among themselves, and it yields between checks too, for 20 µs (see
 //! `spin_wait`).
 //!
 //! **Panics.** A kernel panic is caught per chunk; the first one is returned as
@@ -97,7 +100,10 @@ impl Strategy for Team {
     /// # Panics
     /// Re-raises a panic of `session` itself once the threads have been joined.
     fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError> {
-        let board = TeamBoard::new(Watch::new(self.cores, self.waiting()));
+        let board = TeamBoard::new(Watch::new(
+            self.cores,
+            Waiting::for_team(self.cores, self.placement),
+        ));
         let executor = TeamExecutor {
             board: &board,
             threads: self.cores,
@@ -132,14 +138,6 @@ impl Strategy for Team {
             let joined = session_thread.join();
             Ok(joined.unwrap_or_else(|payload| std::panic::resume_unwind(payload)))
         })
-    }
-}
-
-impl Team {
-    /// How the team's threads wait: more threads than the CPUs they may use share CPUs among
-    /// themselves (see [`Waiting`]).
-    fn waiting(&self) -> Waiting {
-        Waiting::for_team(self.cores, self.placement.parallelism())
     }
 }
 
@@ -406,25 +404,6 @@ mod tests {
         let all: Vec<_> = passes.concat();
         assert!((2..=3).contains(&distinct(&all)), "{passes:?}");
         assert!(!all.contains(&std::thread::current().id()));
-    }
-
-    #[test]
-    fn a_team_of_more_threads_than_cpus_yields_and_one_of_no_more_spins_where_cpus_are_known() {
-        let team = |cores, cpus| Team {
-            cores,
-            chunks: 8,
-            placement: Placement::new(&|_| {}, cpus),
-            starts: ThreadStarts::default(),
-        };
-        let spin = if crate::whereabouts::Whereabouts::available() {
-            Waiting::Spin
-        } else {
-            Waiting::Yield
-        };
-        assert_eq!(team(2, 2).waiting(), spin);
-        assert_eq!(team(2, 4).waiting(), spin);
-        assert_eq!(team(3, 2).waiting(), Waiting::Yield);
-        assert_eq!(team(2, 1).waiting(), Waiting::Yield);
     }
 
     #[test]

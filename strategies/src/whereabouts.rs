@@ -1,20 +1,22 @@
-//! Which CPU each of a team's busy threads runs on, so that a thread that waits for another
-//! can tell whether they share a CPU (`team`'s board, in `erased_job`).
+//! Which CPU each worker of a team runs on while it is inside a pass, so that the session's
+//! thread, waiting for the last workers of a pass, can tell whether one of them shares its CPU
+//! (the boards of `team` and `crossbeam-pool`, in `erased_job`).
 //!
-//! A waiting thread has two ways to wait, and each is right in one case only. Spinning keeps
-//! its CPU until the operating system takes it away, which is what it wants when the thread
-//! it waits for runs elsewhere: giving the CPU up (a yield, a sleep) hands it to whatever else
-//! is runnable there, and a busy process, once it has the CPU, keeps it for a whole
-//! scheduling slice (milliseconds; on Linux's EEVDF scheduler a yield also gives it to no
-//! other thread that has had more than its share lately, so a yielding waiter often just
-//! spins on). Sleeping at once is right when the thread it waits for is queued behind it on
-//! the same CPU: spinning there only delays it. So each thread writes its CPU into its slot
-//! while it works and clears it while it waits, and a waiter that finds a busy thread on its
-//! own CPU sleeps.
+//! That thread holds up the pass, and it has two ways to wait, each right in one case only.
+//! Spinning keeps its CPU until the operating system takes it away, which is what it wants
+//! when the workers it waits for run elsewhere: giving the CPU up (a yield, a sleep) hands it
+//! to whatever else is runnable there, and a busy process, once it has the CPU, keeps it for a
+//! whole scheduling slice (milliseconds; on Linux's EEVDF scheduler a yield also gives it to
+//! no other thread that has had more than its share lately, so a yielding waiter often just
+//! spins on). Sleeping at once is right when a worker it waits for is queued behind it on the
+//! same CPU: spinning there only delays it. So each worker writes its CPU into its slot when it
+//! joins a pass and clears it when it leaves, and the waiting thread, finding a worker on its
+//! own CPU, sleeps.
 //!
 //! A slot is a hint: a thread moved by the operating system since it wrote it is found where
 //! it was. Where the CPU cannot be asked (not Linux, or under Miri), no thread is ever found
-//! beside another, so `team` watches by yielding there instead (`spin_wait::Waiting`).
+//! beside another, so the session's thread of `team` and `crossbeam-pool` watches by yielding
+//! there instead (`spin_wait::Waiting`).
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -23,7 +25,8 @@ use crossbeam::utils::CachePadded;
 /// A slot's value while its thread waits.
 const AWAY: usize = usize::MAX;
 
-/// One slot per thread of a team (0 is the dispatcher).
+/// One slot per thread of a team (0 is the session's thread, which the boards never note: only
+/// it looks).
 pub(crate) struct Whereabouts {
     /// The CPU (as `sched_getcpu` numbers it) each thread last said it works on, or [`AWAY`].
     slots: Box<[CachePadded<AtomicUsize>]>,

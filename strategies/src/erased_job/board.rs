@@ -1,5 +1,9 @@
 //! [`JobBoard`]: a job borrowed for one pass, run by whichever serving threads join the pass
 //! while it is open (`crossbeam-pool`'s board).
+//!
+//! Besides its books, each worker notes in a slot of its own the CPU it works on while it is
+//! inside a job (`whereabouts`), for the dispatcher's watch before it sleeps
+//! (`spin_wait::Watch`), as on `team`'s board.
 
 use std::mem;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
@@ -8,7 +12,8 @@ use std::sync::{Condvar, Mutex, MutexGuard, PoisonError};
 use crossbeam::utils::CachePadded;
 
 use super::{AbortOnUnwind, ErasedJob};
-use crate::{KernelPanic, panic, spin_wait};
+use crate::spin_wait::{self, Watch};
+use crate::{KernelPanic, panic};
 
 /// What the dispatcher and the workers share, behind one mutex.
 struct State {
@@ -40,7 +45,9 @@ struct Sleepers {
 
 /// A rendezvous between a dispatching thread and the worker threads that serve the board.
 ///
-/// Any number of threads may call [`serve`](Self::serve) (none at all, too); [`run`](Self::run)
+/// Any number of threads may call [`serve`](Self::serve) (none at all, too), each with an index
+/// of its own from 1, its slot in the watch (0 is the dispatcher's, which it never notes);
+/// [`run`](Self::run)
 /// runs a job on the calling thread and on every worker that joins while the pass is open, and
 /// [`shut_down`](Self::shut_down) makes `serve` return.
 ///
@@ -52,9 +59,10 @@ struct Sleepers {
 /// else has taken (the pool's job pops chunks from a queue until none is left), so the
 /// work is complete once the dispatcher's call has returned and everyone who joined has left.
 ///
-/// **Waiting.** A waiting thread first watches an atomic hint, spinning briefly and then
-/// yielding its core between checks (see `spin_wait`), and sleeps on a condition variable
-/// after that. Every decision is taken under the mutex; a stale hint only costs a lock.
+/// **Waiting.** A waiting thread first watches an atomic hint — a worker spinning briefly, then
+/// yielding its core between checks; the dispatcher, waiting for the last workers of a pass,
+/// as its [`Watch`] says (see `spin_wait`) — and sleeps on a condition variable after that.
+/// Every decision is taken under the mutex; a stale hint only costs a lock.
 pub(crate) struct JobBoard {
     state: Mutex<State>,
     /// Hint: `State::epoch`, bumped again at shut-down. Watched by idle workers; padded to a
@@ -67,11 +75,14 @@ pub(crate) struct JobBoard {
     to_workers: Condvar,
     /// Wakes dispatchers: the workers left a closed pass, or a `run` returned.
     to_dispatcher: Condvar,
+    /// How the dispatcher watches for the last workers of a pass, and where the workers inside
+    /// a pass run.
+    watch: Watch,
 }
 
 impl JobBoard {
-    /// A board with no job yet.
-    pub(crate) fn new() -> Self {
+    /// A board with no job yet, whose dispatcher watches as `watch` says.
+    pub(crate) fn new(watch: Watch) -> Self {
         JobBoard {
             epoch_hint: CachePadded::new(AtomicU64::new(0)),
             running_hint: CachePadded::new(AtomicUsize::new(0)),
@@ -86,6 +97,7 @@ impl JobBoard {
             }),
             to_workers: Condvar::new(),
             to_dispatcher: Condvar::new(),
+            watch,
         }
     }
 
@@ -143,7 +155,8 @@ impl JobBoard {
         state.job = None;
         while state.running > 0 {
             drop(state);
-            spin_wait::spin_then_yield(|| self.running_hint.load(Ordering::Acquire) == 0);
+            let drained = || self.running_hint.load(Ordering::Acquire) == 0;
+            self.watch.last_out(spin_wait::LIMIT, drained);
             state = self.lock();
             if state.running > 0 {
                 state = self.wait_as_dispatcher(state);
@@ -161,11 +174,11 @@ impl JobBoard {
         escaped.map_or(Ok(()), Err)
     }
 
-    /// The worker loop: joins each pass that is still open when it looks, until
-    /// [`shut_down`](Self::shut_down).
+    /// The worker loop of the thread with `index` (1 and up): joins each pass that is still
+    /// open when it looks, until [`shut_down`](Self::shut_down).
     ///
     /// A job taken before the shut-down is still finished, so a pass in flight always ends.
-    pub(crate) fn serve(&self) {
+    pub(crate) fn serve(&self, index: usize) {
         let mut seen = 0;
         loop {
             let job = {
@@ -175,6 +188,9 @@ impl JobBoard {
                         seen = state.epoch;
                         // A pass that closed before this worker looked is skipped.
                         if let Some(job) = state.job {
+                            // Noted before it counts in, under the lock: a dispatcher that
+                            // finds it inside the pass finds where it runs too.
+                            self.watch.busy(index);
                             state.running += 1;
                             self.running_hint.store(state.running, Ordering::Relaxed);
                             break job;
@@ -184,7 +200,8 @@ impl JobBoard {
                         return;
                     }
                     drop(state);
-                    spin_wait::spin_then_yield(|| self.epoch_hint.load(Ordering::Acquire) != seen);
+                    let news = || self.epoch_hint.load(Ordering::Acquire) != seen;
+                    spin_wait::spin_then_yield(spin_wait::LIMIT, news);
                     state = self.lock();
                     if state.epoch == seen && !state.shutdown {
                         state = self.wait_as_worker(state);
@@ -213,6 +230,8 @@ impl JobBoard {
             if state.running == 0 && state.job.is_none() && state.asleep.dispatchers > 0 {
                 self.to_dispatcher.notify_all();
             }
+            drop(state);
+            self.watch.away(index);
         }
     }
 
@@ -257,22 +276,16 @@ impl JobBoard {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::erased_job::{ShutDownOnDrop, wait_for};
+    use crate::erased_job::wait_for;
     use std::collections::HashMap;
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::thread::{self, ThreadId};
     use std::time::Duration;
 
-    /// Serves `board` on `workers` scoped threads while `f` runs, then shuts it down.
-    fn served(workers: usize, f: impl FnOnce(&JobBoard) + Send) {
-        let board = JobBoard::new();
-        thread::scope(|s| {
-            for _ in 0..workers {
-                s.spawn(|| board.serve());
-            }
-            let _stop = ShutDownOnDrop(&board);
-            f(&board);
-        });
+    /// Serves a board on `workers` scoped threads while `f` runs, then shuts it down; once for
+    /// each way of waiting.
+    fn served(workers: usize, f: impl Fn(&JobBoard) + Sync) {
+        super::super::served(workers, JobBoard::new, JobBoard::serve, f);
     }
 
     #[test]

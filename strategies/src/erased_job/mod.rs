@@ -12,7 +12,7 @@
 //! - [`TeamBoard`] (`team`) keeps them in one atomic word, with the job on its cache line
 //!   (written only between passes, read only by a worker inside one), so that a pass costs the
 //!   dispatcher one store and one read-modify-write on it (and two on a flag that only it
-//!   touches) and each worker two, besides a store or two by each thread to a slot of its own
+//!   touches) and each worker two, besides two stores by each worker to a slot of its own
 //!   saying where it works (`spin_wait::Watch`), and takes a lock only to sleep, to wake a
 //!   sleeper, or to keep a panic.
 //!
@@ -105,6 +105,30 @@ impl<B: ShutDown> Drop for ShutDownOnDrop<'_, B> {
 fn wait_for(done: impl Fn() -> bool) {
     while !done() {
         std::thread::yield_now();
+    }
+}
+
+/// Serves a board made by `new` on `workers` scoped threads (indices 1 and up, each calling
+/// `serve`) while `f` runs, then shuts it down; once for each way of waiting. For the boards'
+/// tests.
+#[cfg(test)]
+fn served<B: ShutDown + Sync>(
+    workers: usize,
+    new: impl Fn(crate::spin_wait::Watch) -> B,
+    serve: impl Fn(&B, usize) + Sync,
+    f: impl Fn(&B) + Sync,
+) {
+    use crate::spin_wait::{Waiting, Watch};
+    for waiting in [Waiting::Spin, Waiting::Yield] {
+        let board = new(Watch::new(workers + 1, waiting));
+        std::thread::scope(|s| {
+            for index in 1..=workers {
+                let (board, serve) = (&board, &serve);
+                s.spawn(move || serve(board, index));
+            }
+            let _stop = ShutDownOnDrop(&board);
+            f(&board);
+        });
     }
 }
 

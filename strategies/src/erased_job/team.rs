@@ -6,9 +6,10 @@
 //! leaves it with a subtraction; the dispatcher closes it with an `and`, after which no
 //! compare-and-swap can succeed, and waits until the count is zero. The pass's job sits on the
 //! word's cache line, so a worker that sees the pass open has its job too. Besides, each
-//! thread notes in a slot of its own the CPU it works on (`whereabouts`), for the watch before
-//! a sleep (`spin_wait::Watch`). Everything else — sleeping after that watch, waking sleepers,
-//! keeping the first panic — happens only when somebody sleeps or something panicked.
+//! worker notes in a slot of its own the CPU it works on in a pass (`whereabouts`), for the
+//! dispatcher's watch before it sleeps (`spin_wait::Watch`). Everything else — sleeping after
+//! that watch, waking sleepers, keeping the first panic — happens only when somebody sleeps or
+//! something panicked.
 
 use std::cell::UnsafeCell;
 use std::mem;
@@ -78,12 +79,13 @@ pub(crate) struct TeamBoard {
     sleep: Mutex<()>,
     to_workers: Condvar,
     to_dispatcher: Condvar,
-    /// How the team's threads watch before they sleep, and where they work.
+    /// How the dispatcher watches for the last workers of a pass, and where the workers inside
+    /// a pass run.
     watch: Watch,
 }
 
 impl TeamBoard {
-    /// A board with no pass yet, whose threads watch as `watch` says.
+    /// A board with no pass yet, whose dispatcher watches as `watch` says.
     pub(crate) fn new(watch: Watch) -> Self {
         TeamBoard {
             pass: CachePadded::new(PassLine {
@@ -121,8 +123,6 @@ impl TeamBoard {
             !self.in_flight.swap(true, Ordering::Acquire),
             "a team board runs one pass at a time"
         );
-        // The dispatcher counts as at work throughout: it is the one that opens every pass.
-        self.watch.busy(0);
         // From opening the pass until no worker is inside it, an unwind out of `run` would
         // end the borrow of `job` under a running worker: the guard turns any unwind in that
         // window into an abort.
@@ -177,7 +177,7 @@ impl TeamBoard {
     /// open when it looks, until [`shut_down`](Self::shut_down).
     pub(crate) fn serve(&self, index: usize) {
         let mut seen = 0;
-        while let Some(word) = self.wait_for_pass(index, seen) {
+        while let Some(word) = self.wait_for_pass(seen) {
             seen = epoch(word);
             self.watch.busy(index);
             if !self.join(word) {
@@ -242,12 +242,9 @@ impl TeamBoard {
 
     /// Waits until a pass after epoch `seen` has been opened (its word), or the board shuts
     /// down (`None`): watching first (see `spin_wait`), then asleep.
-    fn wait_for_pass(&self, index: usize, seen: u64) -> Option<u64> {
+    fn wait_for_pass(&self, seen: u64) -> Option<u64> {
         let news = |order| self.shutdown.load(order) || epoch(self.pass.word.load(order)) != seen;
-        if !self
-            .watch
-            .watch(index, spin_wait::LIMIT, || news(Ordering::Acquire))
-        {
+        if !spin_wait::spin_then_yield(spin_wait::LIMIT, || news(Ordering::Acquire)) {
             let mut sleep = self.lock();
             self.workers_asleep.fetch_add(1, Ordering::SeqCst);
             while !news(Ordering::SeqCst) {
@@ -267,7 +264,7 @@ impl TeamBoard {
     /// Waits until no worker is inside the closed pass: watching first, then asleep.
     fn wait_for_workers(&self) {
         let drained = |order| self.pass.word.load(order) & INSIDE == 0;
-        if self.watch.watch(0, LAST_OUT, || drained(Ordering::Acquire)) {
+        if self.watch.last_out(LAST_OUT, || drained(Ordering::Acquire)) {
             return;
         }
         let mut sleep = self.lock();
@@ -279,8 +276,6 @@ impl TeamBoard {
                 .unwrap_or_else(PoisonError::into_inner);
         }
         self.dispatcher_asleep.store(false, Ordering::Relaxed);
-        // Woken, perhaps on another CPU.
-        self.watch.busy(0);
     }
 
     /// The lock that sleepers and wakers share; it guards nothing else, so poisoning carries
@@ -293,8 +288,7 @@ impl TeamBoard {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::erased_job::{ShutDownOnDrop, wait_for};
-    use crate::spin_wait::Waiting;
+    use crate::erased_job::wait_for;
     use std::collections::HashMap;
     use std::sync::atomic::AtomicUsize;
     use std::thread::{self, ThreadId};
@@ -303,17 +297,7 @@ mod tests {
     /// Serves a board on `workers` scoped threads (indices 1..) while `f` runs, then shuts
     /// it down; once for each way of waiting.
     fn served(workers: usize, f: impl Fn(&TeamBoard) + Sync) {
-        for waiting in [Waiting::Spin, Waiting::Yield] {
-            let board = TeamBoard::new(Watch::new(workers + 1, waiting));
-            thread::scope(|s| {
-                for i in 1..=workers {
-                    let board = &board;
-                    s.spawn(move || board.serve(i));
-                }
-                let _stop = ShutDownOnDrop(&board);
-                f(&board);
-            });
-        }
+        super::super::served(workers, TeamBoard::new, TeamBoard::serve, f);
     }
 
     #[test]
