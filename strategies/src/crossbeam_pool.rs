@@ -59,7 +59,7 @@
 
 use crate::erased_job::{JobBoard, ShutDownOnDrop};
 use crate::panic::FirstPanic;
-use crate::spin_wait::{Waiting, Watch};
+use crate::spin_wait::Watch;
 use crate::thread_start::ThreadStarts;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Placement, Session, Split, Strategy,
@@ -103,10 +103,7 @@ impl Strategy for CrossbeamPool {
     /// # Panics
     /// Re-raises a panic of `session` itself once the workers have been joined.
     fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError> {
-        let board = JobBoard::new(Watch::new(
-            self.cores,
-            Waiting::for_team(self.cores, self.placement),
-        ));
+        let board = JobBoard::new(Watch::for_team(self.cores, self.placement));
         let executor = PoolExecutor {
             board: &board,
             threads: self.cores,

@@ -137,6 +137,12 @@ impl Watch {
         }
     }
 
+    /// For a team of `threads` threads placed as `placement` says: it waits as
+    /// [`Waiting::for_team`] says.
+    pub(crate) fn for_team(threads: usize, placement: Placement) -> Self {
+        Self::new(threads, Waiting::for_team(threads, placement))
+    }
+
     /// Worker `me` (1 and up) is about to work in a pass: it notes the CPU it runs on.
     pub(crate) fn busy(&self, me: usize) {
         self.cpus.busy(me);

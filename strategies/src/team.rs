@@ -57,7 +57,7 @@ use crossbeam::utils::CachePadded;
 
 use crate::erased_job::{ShutDownOnDrop, TeamBoard};
 use crate::panic::FirstPanic;
-use crate::spin_wait::{Waiting, Watch};
+use crate::spin_wait::Watch;
 use crate::thread_start::ThreadStarts;
 use crate::{
     BuildError, Config, Executor, Info, KernelPanic, Placement, Session, Split, Strategy,
@@ -100,10 +100,7 @@ impl Strategy for Team {
     /// # Panics
     /// Re-raises a panic of `session` itself once the threads have been joined.
     fn run<S: Session>(&self, session: S) -> Result<S::Output, BuildError> {
-        let board = TeamBoard::new(Watch::new(
-            self.cores,
-            Waiting::for_team(self.cores, self.placement),
-        ));
+        let board = TeamBoard::new(Watch::for_team(self.cores, self.placement));
         let executor = TeamExecutor {
             board: &board,
             threads: self.cores,
@@ -310,6 +307,7 @@ impl Executor for TeamExecutor<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spin_wait::Waiting;
     use crate::testing::{distinct, run_counting, thread_ids_per_pass};
     use std::iter;
 
